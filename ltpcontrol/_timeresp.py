@@ -1,0 +1,476 @@
+"""Time responses of LTP systems.
+
+Continuous-time systems are simulated exactly for inputs that are linear
+between samples (first-order hold, as `control.forced_response`) or constant
+(zero-order hold).  On a uniform grid whose step divides the period, the
+transition data of one period, ``x_{k+1} = Φ_k x_k + Γ0_k u_k + Γ1_k (u_{k+1} - u_k)``
+(see ``_transition``), is computed once and reused; the march is vectorised
+over periods and input traces:
+
+1. ``z_p = Σ_k Φ(T, t_{k+1}) w_{p,k}``: response to one period of forcing from
+   zero (loop over the N steps, all periods and traces at once);
+2. ``x_{(p+1)N} = Φ_T x_{pN} + z_p`` (loop over periods);
+3. the states inside every period (loop over the N steps again).
+
+A reference path (``method='solve_ivp'``) integrates with
+`scipy.integrate.solve_ivp` between switching instants.
+"""
+
+import warnings
+
+import numpy as np
+import control as ct
+from control.exception import ControlArgument, ControlDimension
+from scipy.integrate import solve_ivp
+
+from ._ltpsys import LTPStateSpace
+from ._transition import step_transitions
+from ._validation import check_kwargs, real_array
+
+__all__ = ['forced_response', 'step_response', 'initial_response', 'impulse_response']
+
+
+def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
+                    method='transition', input_hold='foh', rtol=1e-12,
+                    return_states=False, squeeze=None, transpose=False, **kwargs):
+    """Response of an LTP system to arbitrary inputs, for one or many traces.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        System to simulate.
+    timepts : array_like or float
+        Increasing time points (1D).  A scalar gives ``[0, timepts]`` with
+        50 samples per period.  Discrete-time systems need multiples of `dt`.
+    inputs : array_like or float
+        Input values, shape ``(ninputs, len(timepts))``, or ``(ninputs,
+        ntraces, len(timepts))`` to simulate several input signals in one
+        call.  SISO inputs may be 1D.
+    initial_state : array_like or float
+        Initial state, shape ``(nstates,)`` or ``(nstates, ntraces)``.
+    method : {'transition', 'solve_ivp'}
+        'transition' (default) is exact for the chosen input hold and
+        reuses one period of transition matrices; 'solve_ivp' is a
+        reference integration (DOP853, tolerance `rtol`).
+    input_hold : {'foh', 'zoh'}
+        Inputs linear between samples (default, as `control.forced_response`)
+        or constant (zero-order hold).
+    rtol : float
+        Relative accuracy of the transition matrices or of the integrator.
+    return_states : bool
+        Keep the legacy tuple form ``t, y, x`` when unpacking.
+    squeeze, transpose : bool, optional
+        As in `control.forced_response`.
+
+    Returns
+    -------
+    resp : control.TimeResponseData
+        ``resp.time``, ``resp.outputs``, ``resp.states``, ``resp.inputs``;
+        with several traces the arrays have shape ``(signals, ntraces,
+        len(timepts))``.  ``resp.plot()`` draws the response.
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> t = np.linspace(0, 5, 501)
+    >>> resp = ltp.forced_response(sys, t, np.ones_like(t))
+    >>> round(float(resp.outputs[-1]), 6) == round(1 - np.exp(-5), 6)
+    True
+    """
+    check_kwargs(kwargs, 'forced_response')
+    sys = _check_system(sys)
+    if method not in ('transition', 'solve_ivp'):
+        raise ValueError(f"method must be 'transition' or 'solve_ivp', got {method!r}")
+    if input_hold not in ('foh', 'zoh'):
+        raise ValueError(f"input_hold must be 'foh' or 'zoh', got {input_hold!r}")
+    t = _time_vector(sys, timepts)
+    u, ntraces = _input_array(sys, inputs, len(t))
+    x0 = _initial_state(sys, initial_state, ntraces)
+    if sys.isdtime():
+        x = _march_discrete(sys, t, u, x0)
+    elif method == 'solve_ivp':
+        x = _solve_ivp(sys, t, u, x0, input_hold, rtol)
+    else:
+        x = _march_continuous(sys, t, u, x0, input_hold, rtol)
+    y = _outputs(sys, t, x, u)
+    multi = u.shape[1] > 1 or np.ndim(inputs) == 3
+    if not multi:
+        x, y, u = x[:, 0], y[:, 0], u[:, 0]
+    return ct.TimeResponseData(
+        t, y, x, u, issiso=sys.issiso() and not multi, output_labels=sys.output_labels,
+        input_labels=sys.input_labels, state_labels=sys.state_labels,
+        title="Forced response for " + sys.name, transpose=transpose,
+        return_x=return_states, squeeze=squeeze, multi_trace=multi,
+        sysname=sys.name, plot_inputs=True)
+
+
+def step_response(sys, timepts=None, initial_state=0.0, input_indices=None,
+                  output_indices=None, *, return_states=False, squeeze=None,
+                  transpose=False, **kwargs):
+    """Step response of an LTP system, one trace per input.
+
+    The step is applied at the first time point; for an LTP system the
+    response depends on that phase of the period.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        System to simulate.
+    timepts : array_like or float, optional
+        Time points; default five periods or the settling time of the
+        slowest Floquet exponent, whichever is longer.
+    initial_state : array_like or float
+        Initial state.
+    input_indices, output_indices : int or list of int, optional
+        Inputs to step and outputs to keep (default all).
+    return_states, squeeze, transpose : bool, optional
+        As in `control.step_response`.
+    **kwargs
+        `method`, `input_hold` and `rtol` as in `forced_response`.
+
+    Returns
+    -------
+    resp : control.TimeResponseData
+        Outputs of shape ``(noutputs, ninputs, len(timepts))``.
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss([[-2.0]], [[2.0]], [[1.0]], 0, period=1.0)
+    >>> resp = ltp.step_response(sys, 4.0)
+    >>> round(float(resp.outputs[-1]), 3)
+    1.0
+    """
+    sys = _check_system(sys)
+    t = _time_vector(sys, timepts)
+    ins = _indices(input_indices, sys.ninputs, 'input_indices')
+    outs = _indices(output_indices, sys.noutputs, 'output_indices')
+    u = np.zeros((sys.ninputs, len(ins), len(t)))
+    for trace, i in enumerate(ins):
+        u[i, trace] = 1.0
+    x0 = _initial_state(sys, initial_state, len(ins))
+    return _trace_response(sys, t, u, x0, ins, outs, 'step', 'Step response',
+                           return_states, squeeze, transpose, kwargs)
+
+
+def initial_response(sys, timepts=None, initial_state=0.0, output_indices=None, *,
+                     return_states=False, squeeze=None, transpose=False, **kwargs):
+    """Free response of an LTP system from an initial state.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        System to simulate.
+    timepts : array_like or float, optional
+        Time points (default as in `step_response`).
+    initial_state : array_like or float
+        Initial state at the first time point.
+    output_indices : int or list of int, optional
+        Outputs to keep (default all).
+    return_states, squeeze, transpose : bool, optional
+        As in `control.initial_response`.
+    **kwargs
+        `method`, `input_hold` and `rtol` as in `forced_response`.
+
+    Returns
+    -------
+    resp : control.TimeResponseData
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> resp = ltp.initial_response(sys, 1.0, initial_state=2.0)
+    >>> round(float(resp.outputs[-1]), 6) == round(2 * np.exp(-1), 6)
+    True
+    """
+    sys = _check_system(sys)
+    t = _time_vector(sys, timepts)
+    outs = _indices(output_indices, sys.noutputs, 'output_indices')
+    resp = forced_response(sys, t, np.zeros((sys.ninputs, len(t))), initial_state,
+                           return_states=return_states, squeeze=squeeze,
+                           transpose=transpose, **kwargs)
+    if len(outs) == sys.noutputs:
+        return resp
+    return ct.TimeResponseData(
+        resp.t, resp.y[outs], resp.x, resp.u, issiso=len(outs) == 1 and sys.ninputs == 1,
+        output_labels=[sys.output_labels[i] for i in outs], input_labels=sys.input_labels,
+        state_labels=sys.state_labels, title=resp.title, transpose=transpose,
+        return_x=return_states, squeeze=squeeze, sysname=sys.name)
+
+
+def impulse_response(sys, timepts=None, input_indices=None, output_indices=None, *,
+                     return_states=False, squeeze=None, transpose=False, **kwargs):
+    """Impulse response of an LTP system, one trace per input.
+
+    Continuous time: a unit impulse at the first time point ``t0`` sets
+    ``x(t0+) = B(t0) e_j``; the impulse in the output through ``D(t0)`` is
+    not representable and gives a warning.  Discrete time: a unit-area
+    pulse ``u[0] = 1/dt`` as in `control.impulse_response`.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        System to simulate.
+    timepts : array_like or float, optional
+        Time points (default as in `step_response`).
+    input_indices, output_indices : int or list of int, optional
+        Inputs to excite and outputs to keep (default all).
+    return_states, squeeze, transpose : bool, optional
+        As in `control.impulse_response`.
+    **kwargs
+        `method`, `input_hold` and `rtol` as in `forced_response`.
+
+    Returns
+    -------
+    resp : control.TimeResponseData
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> resp = ltp.impulse_response(sys, 1.0)
+    >>> round(float(resp.outputs[-1]), 6) == round(np.exp(-1), 6)
+    True
+    """
+    sys = _check_system(sys)
+    t = _time_vector(sys, timepts)
+    ins = _indices(input_indices, sys.ninputs, 'input_indices')
+    outs = _indices(output_indices, sys.noutputs, 'output_indices')
+    u = np.zeros((sys.ninputs, len(ins), len(t)))
+    if sys.isdtime():
+        for trace, i in enumerate(ins):
+            u[i, trace, 0] = 1.0 / sys.dt
+        x0 = np.zeros((sys.nstates, len(ins)))
+    else:
+        if np.any(sys.D(t[0])[np.ix_(outs, ins)] != 0):
+            warnings.warn("the system has direct feedthrough D(t0) != 0: the impulse in "
+                          "the output at t0 is not shown", UserWarning, stacklevel=2)
+        x0 = sys.B(t[0])[:, ins]
+    return _trace_response(sys, t, u, x0, ins, outs, 'impulse', 'Impulse response',
+                           return_states, squeeze, transpose, kwargs)
+
+
+#
+# Simulation engines
+#
+
+def _march_continuous(sys, t, u, x0, hold, rtol):
+    h = np.diff(t)
+    n = sys.nstates
+    if len(t) == 1:
+        return x0[:, :, None].copy()
+    nper = sys.period / h[0]
+    uniform = np.allclose(h, h[0], rtol=1e-10, atol=0)
+    if uniform and abs(nper - round(nper)) < 1e-9 * nper and round(nper) <= len(h):
+        N = int(round(nper))
+        Phi, G0, G1 = step_transitions(sys.A, sys.B, t[0] + h[0] * np.arange(N), h[0], rtol)
+        if hold == 'zoh':
+            G1 = np.zeros_like(G1)
+        return _march_periodic(Phi, G0, G1, u, x0)
+    Phi, G0, G1 = step_transitions(sys.A, sys.B, t[:-1], h, rtol)
+    if hold == 'zoh':
+        G1 = np.zeros_like(G1)
+    x = np.empty((n,) + u.shape[1:])
+    x[:, :, 0] = x0
+    du = np.diff(u, axis=2)
+    for k in range(len(h)):
+        x[:, :, k + 1] = Phi[k] @ x[:, :, k] + G0[k] @ u[:, :, k] + G1[k] @ du[:, :, k]
+    return x
+
+
+def _march_periodic(Phi, G0, G1, u, x0):
+    """Exact march with periodic step data (see the module docstring)."""
+    N, n = Phi.shape[0], Phi.shape[1]
+    nu, R, L = u.shape
+    P = -(-(L - 1) // N)
+    # pad the input to P whole periods (the extra samples are discarded) and
+    # lay it out as (step in period, input, trace x period)
+    upad = np.concatenate([u, np.repeat(u[:, :, -1:], P * N + 1 - L, axis=2)], axis=2)
+    ustep = upad[:, :, :-1].reshape(nu, R, P, N).transpose(3, 0, 1, 2).reshape(N, nu, R * P)
+    unext = upad[:, :, 1:].reshape(nu, R, P, N).transpose(3, 0, 1, 2).reshape(N, nu, R * P)
+    # forcing w_k = Γ0_k u_k + Γ1_k (u_{k+1} - u_k), shape (N, n, R*P)
+    w = (G0 - G1) @ ustep + G1 @ unext
+    # 1. response to one period of forcing from zero, all periods at once
+    z = np.zeros((n, R * P))
+    PhiT = np.eye(n)
+    for k in range(N):
+        z = Phi[k] @ z + w[k]
+        PhiT = Phi[k] @ PhiT
+    # 2. period-start states x_{(p+1)N} = Φ_T x_{pN} + z_p
+    z = z.reshape(n, R, P)
+    starts = np.empty((n, R, P))
+    xp = x0
+    for p in range(P):
+        starts[:, :, p] = xp
+        xp = PhiT @ xp + z[:, :, p]
+    # 3. states inside every period
+    x = np.empty((N, n, R * P))
+    xk = starts.reshape(n, R * P)
+    for k in range(N):
+        x[k] = xk
+        xk = Phi[k] @ xk + w[k]
+    x = x.reshape(N, n, R, P).transpose(1, 2, 3, 0).reshape(n, R, P * N)
+    return np.concatenate([x, xp[:, :, None]], axis=2)[:, :, :L]
+
+
+def _march_discrete(sys, t, u, x0):
+    N = sys.nsteps
+    k0 = int(round(t[0] / sys.dt))
+    phase = (k0 + np.arange(N)) % N
+    Ak = sys.A.sample(N)[phase]
+    Bk = sys.B.sample(N)[phase]
+    return _march_periodic(Ak, Bk, np.zeros_like(Bk), u, x0)
+
+
+def _solve_ivp(sys, t, u, x0, hold, rtol):
+    n, R = sys.nstates, u.shape[1]
+    bps = np.unique(np.concatenate([sys.A.breakpoints, sys.B.breakpoints]))
+    cuts = np.array([])
+    if bps.size:
+        shifts = np.arange(np.floor(t[0] / sys.period), np.floor(t[-1] / sys.period) + 1)
+        cuts = (bps[None, :] + sys.period * shifts[:, None]).ravel()
+        cuts = cuts[(cuts > t[0]) & (cuts < t[-1])]
+    edges = np.unique(np.concatenate([[t[0]], cuts, [t[-1]]]))
+    x = np.empty((n, R, len(t)))
+
+    def uval(tau, r):
+        if hold == 'zoh':
+            idx = np.clip(np.searchsorted(t, tau, side='right') - 1, 0, len(t) - 1)
+            return u[:, r, idx]
+        return np.array([np.interp(tau, t, u[i, r]) for i in range(u.shape[0])])
+
+    for r in range(R):
+        xr = x0[:, r]
+        x[:, r, 0] = xr
+        for a, b in zip(edges[:-1], edges[1:]):
+            sel = (t > a) & (t < b)
+            sol = solve_ivp(lambda tau, xx: sys.A(tau) @ xx + sys.B(tau) @ uval(tau, r),
+                            (a, b), xr, method='DOP853', rtol=rtol, atol=rtol * 1e-3,
+                            t_eval=np.append(t[sel], b))
+            if not sol.success:
+                raise RuntimeError(f"solve_ivp failed: {sol.message}")
+            x[:, r, sel] = sol.y[:, :-1]
+            xr = sol.y[:, -1]
+            x[:, r, t == b] = xr[:, None]
+    return x
+
+
+def _outputs(sys, t, x, u):
+    if sys.isdtime():
+        N = sys.nsteps
+        idx = np.round(t / sys.dt).astype(int) % N
+        C, D = sys.C.sample(N)[idx], sys.D.sample(N)[idx]
+    else:
+        C, D = sys.C(t), sys.D(t)
+    # y_l = C(t_l) x_l + D(t_l) u_l, batched over time
+    y = C @ x.transpose(2, 0, 1) + D @ u.transpose(2, 0, 1)
+    return y.transpose(1, 2, 0)
+
+
+#
+# Argument processing
+#
+
+def _check_system(sys):
+    if isinstance(sys, (ct.StateSpace, ct.TransferFunction)):
+        raise ControlArgument("sys is an LTI system: use control.forced_response, or "
+                              "convert it with ltpss(sys, period)")
+    if not isinstance(sys, LTPStateSpace):
+        raise ControlArgument(f"sys must be an LTPStateSpace, got {type(sys).__name__}")
+    return sys
+
+
+def _time_vector(sys, timepts):
+    if timepts is None:
+        timepts = _default_final_time(sys)
+    t = real_array(timepts, 'timepts', ndim=(0, 1))
+    if t.ndim == 0:
+        if t <= 0:
+            raise ValueError(f"timepts as a final time must be positive, got {float(t)}")
+        step = sys.dt if sys.isdtime() else sys.period / 50
+        t = np.arange(int(np.floor(float(t) / step + 1e-9)) + 1) * step
+    if len(t) == 0:
+        raise ValueError("timepts is empty")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("timepts must be strictly increasing")
+    if sys.isdtime():
+        k = t / sys.dt
+        if np.any(np.abs(k - np.round(k)) > 1e-9 * np.maximum(1, np.abs(k))):
+            raise ValueError(f"timepts must be multiples of dt={sys.dt} for a "
+                             "discrete-time system")
+        if np.any(np.diff(np.round(k)) != 1):
+            raise ValueError(f"timepts must be consecutive samples spaced by dt={sys.dt}")
+    return t
+
+
+def _default_final_time(sys):
+    # five periods, or five time constants of the slowest multiplier |μ| = e^{σT}
+    try:
+        mu = np.max(np.abs(sys.floquet_multipliers()))
+    except Exception:
+        mu = 1.0
+    settle = 5 * sys.period / -np.log(mu) if 0 < mu < 1 else 0.0
+    return min(max(5 * sys.period, settle), 1000 * sys.period)
+
+
+def _input_array(sys, inputs, L):
+    u = real_array(inputs, 'inputs', ndim=(0, 1, 2, 3))
+    m = sys.ninputs
+    if u.ndim == 0:
+        return np.full((m, 1, L), float(u)), 1
+    if u.ndim == 1:
+        if m != 1:
+            raise ControlDimension(f"inputs must have shape ({m}, {L}) for a system with "
+                                   f"{m} inputs, got {u.shape}")
+        u = u[np.newaxis]
+    if u.ndim == 2:
+        u = u[:, np.newaxis, :]
+    if u.shape[0] != m or u.shape[2] != L:
+        raise ControlDimension(f"inputs must have shape ({m}, [ntraces,] {L}), got {u.shape}")
+    return u, u.shape[1]
+
+
+def _initial_state(sys, x0, ntraces):
+    x0 = real_array(x0, 'initial_state', ndim=(0, 1, 2))
+    n = sys.nstates
+    if x0.ndim == 0:
+        return np.full((n, ntraces), float(x0))
+    if x0.ndim == 1:
+        if x0.shape[0] != n:
+            raise ControlDimension(f"initial_state must have {n} entries, got {x0.shape[0]}")
+        return np.repeat(x0[:, None], ntraces, axis=1)
+    if x0.shape != (n, ntraces):
+        raise ControlDimension(f"initial_state must have shape ({n}, {ntraces}), got {x0.shape}")
+    return x0.copy()
+
+
+def _indices(spec, count, name):
+    if spec is None:
+        return list(range(count))
+    spec = [spec] if np.isscalar(spec) else list(spec)
+    for i in spec:
+        if not isinstance(i, (int, np.integer)) or not 0 <= i < count:
+            raise ValueError(f"{name} must contain integers in [0, {count}), got {i!r}")
+    return [int(i) for i in spec]
+
+
+def _trace_response(sys, t, u, x0, ins, outs, trace_type, title, return_states,
+                    squeeze, transpose, kwargs):
+    method = kwargs.pop('method', 'transition')
+    hold = kwargs.pop('input_hold', 'foh')
+    rtol = kwargs.pop('rtol', 1e-12)
+    check_kwargs(kwargs, title.split()[0].lower() + '_response')
+    if sys.isdtime():
+        x = _march_discrete(sys, t, u, x0)
+    elif method == 'solve_ivp':
+        x = _solve_ivp(sys, t, u, x0, hold, rtol)
+    elif method == 'transition':
+        x = _march_continuous(sys, t, u, x0, hold, rtol)
+    else:
+        raise ValueError(f"method must be 'transition' or 'solve_ivp', got {method!r}")
+    y = _outputs(sys, t, x, u)[outs]
+    return ct.TimeResponseData(
+        t, y, x, u, issiso=len(outs) == 1 and len(ins) == 1,
+        output_labels=[sys.output_labels[i] for i in outs], input_labels=sys.input_labels,
+        state_labels=sys.state_labels, title=f"{title} for {sys.name}",
+        transpose=transpose, return_x=return_states, squeeze=squeeze, multi_trace=True,
+        trace_labels=[f"From {sys.input_labels[i]}" for i in ins],
+        trace_types=[trace_type] * len(ins), sysname=sys.name, plot_inputs=False)

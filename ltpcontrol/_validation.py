@@ -1,0 +1,104 @@
+"""Input checks shared by every public entry point.
+
+Each helper raises python-control's exceptions (`ControlDimension` is a
+`ValueError`, `ControlArgument` a `TypeError`) or a builtin with a message
+that names the offending argument.
+"""
+
+import numbers
+
+import numpy as np
+from control.exception import ControlArgument, ControlDimension
+
+__all__ = []
+
+
+def check_kwargs(kwargs, where):
+    """Reject leftover keyword arguments, as python-control does."""
+    if kwargs:
+        raise TypeError(f"{where}: unrecognized keyword(s): {sorted(kwargs)}")
+
+
+def check_period(period, name="period"):
+    """Return `period` as a positive finite float."""
+    if isinstance(period, (bool, np.bool_)) or not isinstance(
+            period, (numbers.Real, np.floating, np.integer)):
+        raise ControlArgument(f"{name} must be a real number, got {period!r}")
+    period = float(period)
+    if not np.isfinite(period) or period <= 0:
+        raise ValueError(f"{name} must be positive and finite, got {period}")
+    return period
+
+
+def check_positive_int(value, name, minimum=1):
+    """Return `value` as an int >= `minimum`."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(
+            value, (numbers.Integral, np.integer)):
+        if isinstance(value, (float, np.floating)) and float(value).is_integer():
+            value = int(value)
+        else:
+            raise ControlArgument(f"{name} must be an integer, got {value!r}")
+    value = int(value)
+    if value < minimum:
+        raise ValueError(f"{name} must be >= {minimum}, got {value}")
+    return value
+
+
+def real_array(data, name, ndim=None, allow_complex=False):
+    """Convert `data` to a finite float (or complex) ndarray.
+
+    Parameters
+    ----------
+    data : array_like
+        Data to convert.
+    name : str
+        Argument name used in error messages.
+    ndim : int or tuple of int, optional
+        Allowed numbers of dimensions.
+    allow_complex : bool
+        Keep complex data instead of rejecting it.
+    """
+    try:
+        arr = np.asarray(data)
+    except Exception as exc:  # ragged lists and the like
+        raise ControlArgument(f"{name} could not be converted to an array: {exc}")
+    if arr.dtype == object:
+        raise ControlArgument(f"{name} must be numeric (got a ragged or object array)")
+    if arr.dtype.kind == "c":
+        if not allow_complex:
+            if np.all(arr.imag == 0):
+                arr = arr.real
+            else:
+                raise ControlArgument(f"{name} must be real-valued, got complex data")
+    elif arr.dtype.kind not in "biuf":
+        raise ControlArgument(f"{name} must be numeric, got dtype {arr.dtype}")
+    arr = arr.astype(complex if arr.dtype.kind == "c" else float)
+    if ndim is not None:
+        allowed = (ndim,) if isinstance(ndim, int) else tuple(ndim)
+        if arr.ndim not in allowed:
+            raise ControlDimension(
+                f"{name} must have {' or '.join(map(str, allowed))} dimensions, "
+                f"got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} contains NaN or inf")
+    return arr
+
+
+def commensurate(a, b, rtol=1e-9):
+    """Return the common period of `a` and `b` if one is an integer multiple of the other."""
+    big, small = max(a, b), min(a, b)
+    ratio = big / small
+    if abs(ratio - round(ratio)) <= rtol * ratio:
+        return big
+    raise ValueError(f"periods {a} and {b} are not commensurate "
+                     "(one must be an integer multiple of the other)")
+
+
+def steps_per_period(period, dt, name="dt"):
+    """Return ``N = period/dt`` as an int, or raise if it is not an integer."""
+    ratio = period / dt
+    nsteps = int(round(ratio))
+    if nsteps < 1 or abs(ratio - nsteps) > 1e-9 * max(1.0, ratio):
+        raise ValueError(f"{name}={dt} does not divide the period {period} into an "
+                         f"integer number of steps (period/{name} = {ratio})")
+    return nsteps
