@@ -12,7 +12,10 @@ Examples assume::
 from ._periodic_matrix import PeriodicMatrix
 from ._ltpsys import LTPStateSpace, ltpss, series, parallel, feedback, append, negate
 from ._timeresp import forced_response, step_response, initial_response, impulse_response
+from ._htf import HTF, htf
+from ._htfplot import htf_response, bode_htf, htf_map_plot
 from ._fdsubspace import fdsubspace, FDSubspaceInfo
+from ._hybrid_ls import hybrid_ls, HybridLSResult
 
 __version__ = "0.1.0"
 
@@ -20,5 +23,6 @@ __all__ = [
     'PeriodicMatrix', 'LTPStateSpace', 'ltpss',
     'series', 'parallel', 'feedback', 'append', 'negate',
     'forced_response', 'step_response', 'initial_response', 'impulse_response',
-    'fdsubspace', 'FDSubspaceInfo',
+    'HTF', 'htf', 'htf_response', 'bode_htf', 'htf_map_plot',
+    'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
 ]

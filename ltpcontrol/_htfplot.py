@@ -1,0 +1,200 @@
+"""Plots of harmonic transfer functions.
+
+`bode_htf` follows python-control's compute-then-plot split: the requested
+components ``G_k(jω)`` of each HTF are computed as
+`control.FrequencyResponseData` objects (`htf_response`) and drawn by
+`control.bode_plot`, so ``ct.config.defaults['freqplot.*']`` (dB, Hz, deg,
+grid, ...) apply unchanged.  `htf_map_plot` shows ``|H_{n,m}(jω)|`` as an
+image, the second view of an HTF.
+"""
+
+import numpy as np
+import control as ct
+import matplotlib.pyplot as plt
+from control.exception import ControlArgument
+
+from ._htf import HTF, _harmonic
+from ._validation import check_positive_int, real_array
+
+__all__ = ['htf_response', 'bode_htf', 'htf_map_plot']
+
+
+def htf_response(htfs, omega=None, harmonics=(-1, 0, 1), *, omega_limits=None,
+                 omega_num=None):
+    """Components ``G_k(jω)`` of one or several HTFs as FRDs.
+
+    Parameters
+    ----------
+    htfs : HTF or list of HTF
+        Harmonic transfer functions (model or data).
+    omega : array_like, optional
+        Frequencies in rad/s.  Data HTFs use their own grid when omitted.
+    harmonics : sequence of int
+        Harmonic indices k to return (default -1, 0, 1).
+    omega_limits : (float, float), optional
+        Frequency range of the default grid for model HTFs.
+    omega_num : int, optional
+        Number of points of the default grid (default 500).
+
+    Returns
+    -------
+    list of list of control.FrequencyResponseData
+        ``resp[i][j]`` is component ``harmonics[j]`` of ``htfs[i]``.
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> resp = ltp.htf_response(ltp.htf(sys, 1), [1.0, 2.0])
+    >>> len(resp[0]), resp[0][1].omega.shape
+    (3, (2,))
+    """
+    htfs = _htf_list(htfs)
+    harmonics = list(harmonics)
+    out = []
+    for H in htfs:
+        for k in harmonics:
+            _harmonic(k, H.nharmonics)
+        w = omega
+        if w is None and H.omega is None:
+            w = _grid(H, omega_limits, omega_num)
+        elif w is not None:
+            w = real_array(w, 'omega', ndim=1)
+        out.append([H.component(k, w) for k in harmonics])
+    return out
+
+
+def bode_htf(htfs, omega=None, *fmt, harmonics=(-1, 0, 1), omega_limits=None,
+             omega_num=None, plot_phase=None, label=None, ax=None, title=None,
+             **kwargs):
+    """Bode plot of selected HTF components ``G_k(jω)``.
+
+    Magnitude and phase of components k (default -1, 0, 1) of one or several
+    HTFs on one figure, as the thesis's Figs. 3.5/3.6 and 4.2.  Several
+    HTFs (for example true and estimated) are overlaid with a legend.
+
+    Parameters
+    ----------
+    htfs : HTF or list of HTF
+        Harmonic transfer functions to draw.
+    omega : array_like, optional
+        Frequencies in rad/s (see `htf_response`).
+    *fmt : str, optional
+        Matplotlib format string applied to every line.
+    harmonics : sequence of int
+        Components to draw.
+    omega_limits, omega_num : optional
+        Default grid for model HTFs (see `htf_response`).
+    plot_phase : bool, optional
+        Draw the phase (default `config.defaults['freqplot.plot_phase']`).
+    label : list of str, optional
+        Legend entries, one per line (HTF-major order).
+    ax : array of matplotlib.axes.Axes, optional
+        Axes to draw into (for overlaying onto an existing plot).
+    title : str, optional
+        Figure title.
+    **kwargs
+        Passed to `control.bode_plot` (``dB``, ``Hz``, ``deg``, ``grid``,
+        matplotlib line properties, ...).
+
+    Returns
+    -------
+    control.ControlPlot
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> cplt = ltp.bode_htf(ltp.htf(sys, 1), omega_num=20)
+    >>> type(cplt).__name__
+    'ControlPlot'
+    """
+    htfs = _htf_list(htfs)
+    resp = htf_response(htfs, omega, harmonics, omega_limits=omega_limits,
+                        omega_num=omega_num)
+    frds, labels = [], []
+    for H, comps in zip(htfs, resp):
+        for k, frd in zip(harmonics, comps):
+            if np.all(frd.frdata == 0):
+                continue            # an identically zero component has no Bode plot
+            frds.append(frd)
+            labels.append(f"{H.name}: G_{k}" if len(htfs) > 1 else f"G_{k}")
+    if not frds:
+        raise ValueError("all requested HTF components are identically zero")
+    if label is not None:
+        labels = list(label)
+        if len(labels) != len(frds):
+            raise ValueError(f"label must have {len(frds)} entries, got {len(labels)}")
+    if title is None:
+        title = "HTF components of " + ", ".join(H.name for H in htfs)
+    return ct.bode_plot(frds, None, *fmt, plot_phase=plot_phase, label=labels, ax=ax,
+                        title=title, **kwargs)
+
+
+def htf_map_plot(htf, omega, *, dB=True, ax=None, title=None, cmap='viridis'):
+    """Image of the harmonic magnitudes ``|H_{n,m}(jω)|`` at one frequency.
+
+    Parameters
+    ----------
+    htf : HTF
+        Model HTF (or data HTF with ``ω + nω_p`` on its grid).
+    omega : float
+        Base frequency in rad/s.
+    dB : bool
+        Show ``20 log10 |H|`` (default) or the magnitude.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+    title : str, optional
+        Plot title.
+    cmap : str
+        Matplotlib colormap.
+
+    Returns
+    -------
+    control.ControlPlot
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> cplt = ltp.htf_map_plot(ltp.htf(sys, 2), 1.0)
+    >>> cplt.axes.shape
+    (1, 1)
+    """
+    if not isinstance(htf, HTF):
+        raise ControlArgument(f"htf must be an HTF, got {type(htf).__name__}")
+    omega = float(real_array(omega, 'omega', ndim=0))
+    M = np.abs(htf(1j * omega))
+    if dB:
+        with np.errstate(divide='ignore'):
+            M = 20 * np.log10(M)
+        M[~np.isfinite(M)] = np.nan
+    if ax is None:
+        fig, ax = plt.subplots()
+    fig = ax.figure
+    K = htf.nharmonics
+    ext = (-K - 0.5, K + 0.5, K + 0.5, -K - 0.5)
+    image = ax.imshow(M, cmap=cmap, extent=ext, interpolation='nearest')
+    ax.set_xlabel("input harmonic m")
+    ax.set_ylabel("output harmonic n")
+    fig.colorbar(image, ax=ax, label="|H_{n,m}| [dB]" if dB else "|H_{n,m}|")
+    ax.set_title(title or f"{htf.name}: |H(jω)| at ω = {omega:g} rad/s")
+    return ct.ControlPlot(np.array([[[image]]], dtype=object), np.array([[ax]]), fig)
+
+
+def _htf_list(htfs):
+    htfs = list(htfs) if isinstance(htfs, (list, tuple)) else [htfs]
+    for H in htfs:
+        if not isinstance(H, HTF):
+            raise ControlArgument(f"htfs must be HTF objects, got {type(H).__name__}")
+    return htfs
+
+
+def _grid(H, limits, num):
+    num = 500 if num is None else check_positive_int(num, 'omega_num', minimum=2)
+    if limits is None:
+        w = H.omega_p
+        limits = (w / 100, 10 * w * max(1, H.nharmonics))
+        if H.dt:
+            limits = (limits[0], min(limits[1], 0.999 * np.pi / H.dt))
+    lo, hi = real_array(limits, 'omega_limits', ndim=1)
+    if not 0 < lo < hi:
+        raise ValueError(f"omega_limits must satisfy 0 < low < high, got {limits}")
+    return np.logspace(np.log10(lo), np.log10(hi), num)

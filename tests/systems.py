@@ -1,0 +1,36 @@
+"""Reference systems from the thesis used across the test suite."""
+
+import numpy as np
+
+import ltpcontrol as ltp
+
+
+def mathieu(wp=4 * np.pi, wn=2 * np.pi, zeta=0.3, beta_b=0.2, beta_c=0.1):
+    """Thesis eq. (4.115): constant A, periodic B and C, T = 2π/ω_p."""
+    T = 2 * np.pi / wp
+    B = ltp.PeriodicMatrix([[[0.0], [beta_b]], [[0.0], [1.0]], [[0.0], [beta_b]]], T)
+    C = ltp.PeriodicMatrix([[[beta_c, 0.0]], [[1.0, 0.0]], [[beta_c, 0.0]]], T)
+    return ltp.ltpss([[0, 1], [-wn ** 2, -2 * zeta * wn]], B, C, 0, period=T,
+                     name='mathieu')
+
+
+def damped_mathieu(wn=2 * np.pi, zeta=0.1, beta=0.2, T=0.5):
+    """Thesis eq. (4.24) with a genuinely periodic A(t)."""
+    wp = 2 * np.pi / T
+    A = ltp.PeriodicMatrix([[[0, 0], [-beta * wn ** 2, 0]],
+                            [[0, 1], [-wn ** 2, -2 * zeta * wn]],
+                            [[0, 0], [-beta * wn ** 2, 0]]], T)
+    return ltp.ltpss(A, [[0], [1]], [[1, 0]], 0, period=T, name='damped_mathieu')
+
+
+def switching_mathieu(t_switch=0.25, T=0.5, wn=2 * np.pi):
+    """Thesis eq. (4.25) with the Table 4.1 parameters (switch at `t_switch`)."""
+    wp = 2 * np.pi / T
+
+    def piece(zeta, beta):
+        return ltp.PeriodicMatrix([[[0, 0], [-beta * wn ** 2, 0]],
+                                   [[0, 1], [-wn ** 2, -2 * zeta * wn]],
+                                   [[0, 0], [-beta * wn ** 2, 0]]], T)
+    A = ltp.PeriodicMatrix.switching([piece(0.3, 0.1), piece(0.1, 0.2)],
+                                     [0.0, t_switch], T)
+    return ltp.ltpss(A, [[0], [1]], [[1, 0]], 0, period=T, name='switching_mathieu')
