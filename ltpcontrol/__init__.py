@@ -12,17 +12,44 @@ Examples assume::
 from ._periodic_matrix import PeriodicMatrix
 from ._ltpsys import LTPStateSpace, ltpss, series, parallel, feedback, append, negate
 from ._timeresp import forced_response, step_response, initial_response, impulse_response
+from ._floquet import (monodromy, floquet_multipliers, floquet_exponents, is_stable,
+                       floquet_transform)
 from ._htf import HTF, htf
 from ._htfplot import htf_response, bode_htf, htf_map_plot
+from ._discretize import sample_system, d2c
+from ._lifting import lift
+from ._hybrid import HybridMode, HybridPlant, simulate_hybrid, saltation_matrix
+from ._orbits import PeriodicOrbit, periodic_orbit, period_map, linearize_orbit
+from ._excitation import Excitation, chirp_replicas, multisine, sine_experiments
+from ._htf_estimate import estimate_htf
+from ._htf_fit import HTFFit, DelayEstimate, fit_htf, estimate_delays
+from ._metrics import e_rms, nrmse
 from ._fdsubspace import fdsubspace, FDSubspaceInfo
 from ._hybrid_ls import hybrid_ls, HybridLSResult
 
 __version__ = "0.1.0"
 
+#: Alias of `sample_system`, as in python-control.
+c2d = sample_system
+
 __all__ = [
+    # systems and periodic matrices
     'PeriodicMatrix', 'LTPStateSpace', 'ltpss',
     'series', 'parallel', 'feedback', 'append', 'negate',
+    # time responses
     'forced_response', 'step_response', 'initial_response', 'impulse_response',
+    # Floquet theory
+    'monodromy', 'floquet_multipliers', 'floquet_exponents', 'is_stable',
+    'floquet_transform',
+    # frequency domain
     'HTF', 'htf', 'htf_response', 'bode_htf', 'htf_map_plot',
+    'sample_system', 'c2d', 'd2c', 'lift',
+    # rhythmic plants and their orbits
+    'HybridMode', 'HybridPlant', 'simulate_hybrid', 'saltation_matrix',
+    'PeriodicOrbit', 'periodic_orbit', 'period_map', 'linearize_orbit',
+    # identification
+    'Excitation', 'chirp_replicas', 'multisine', 'sine_experiments',
+    'estimate_htf', 'HTFFit', 'DelayEstimate', 'fit_htf', 'estimate_delays',
+    'e_rms', 'nrmse',
     'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
 ]

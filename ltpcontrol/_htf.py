@@ -413,6 +413,10 @@ def htf(sys, nharmonics, *, internal_harmonics=None, method='auto', **kwargs):
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
     if method not in ('auto', 'modal', 'solve'):
         raise ValueError(f"method must be 'auto', 'modal' or 'solve', got {method!r}")
+    if not sys.is_stable():
+        warnings.warn(f"{sys.name} is unstable: its HTF is defined wherever the harmonic "
+                      "resolvent exists, but on the imaginary axis it describes no "
+                      "steady-state response", UserWarning, stacklevel=2)
     H = HTF.__new__(HTF)
     H._init(sys.period, K, sys.noutputs, sys.ninputs, sys.dt, sys.name,
             sys.input_labels, sys.output_labels)
@@ -451,15 +455,20 @@ class _HarmonicStateSpace:
                 HV = (Hc.reshape(Hc.shape[0], nb, n) @ W).reshape(Hc.shape[0], -1)
                 VG = (Winv @ G.reshape(nb, n, -1)).reshape(nb * n, -1)
                 self.modal = (lam, HV, VG)
-                return
-        if method in ('auto', 'modal'):
-            lam, V = np.linalg.eig(F)
-            cond = np.linalg.cond(V)
-            if method == 'modal' or cond < 1e8:
-                Vinv = np.linalg.solve(V, np.eye(len(lam)))
-                self.modal = (lam, Hc @ V, Vinv @ G)
-            elif method == 'auto':
-                self.modal = None
+        self.method = method
+
+    def _ensure_modal(self, npoints):
+        """Diagonalise F once when it pays off (or when asked to)."""
+        if self.modal is not None or self.method == 'solve':
+            return
+        if self.method == 'auto' and npoints < self.F.shape[0] / 4:
+            return                  # a few dense solves are cheaper than eig(F)
+        lam, V = np.linalg.eig(self.F)
+        if self.method == 'modal' or np.linalg.cond(V) < 1e8:
+            Vinv = np.linalg.solve(V, np.eye(len(lam)))
+            self.modal = (lam, self.Hc @ V, Vinv @ self.G)
+        else:
+            self.method = 'solve'   # ill-conditioned eigenvectors: stay with solves
 
     @classmethod
     def continuous(cls, sys, K, Ki, method):
@@ -506,13 +515,15 @@ class _HarmonicStateSpace:
         c = slice(None) if cols is None else np.concatenate(
             [np.arange((k + K) * nu, (k + K + 1) * nu) for k in cols])
         J = self.J[r][:, c]
+        self._ensure_modal(len(x))
         if self.modal is not None:
             lam, HV, VG = self.modal
             HV, VG = HV[r], VG[:, c]
-            res = 1.0 / (x[:, None] - lam[None, :])
-            if not np.all(np.isfinite(res)):
+            gap = x[:, None] - lam[None, :]
+            if np.any(np.abs(gap) <= 1e-13 * np.maximum(1.0, np.abs(lam))):
                 raise ValueError("the HTF is not defined at a Floquet exponent "
                                  "(evaluation point is a pole)")
+            res = 1.0 / gap
             return np.einsum('iq,sq,qj->sij', HV, res, VG, optimize=True) + J
         ident = np.eye(self.F.shape[0])
         M = x[:, None, None] * ident - self.F

@@ -1,0 +1,384 @@
+"""Input signals for identifying harmonic transfer functions from data.
+
+Three experiment designs are provided:
+
+* `chirp_replicas`: phase-shifted replicas of one linear chirp, concatenated
+  in a single input (thesis eqs. 3.40, 3.48, 3.57-3.58).  Replica ``r`` is
+  started ``r T/R`` later in the cycle than replica 0, so that with
+  ``R >= 2K+1`` replicas the extended power spectrum ``Φ_UU`` is diagonal and
+  every HTF component up to order K is identifiable at each frequency.
+* `multisine`: periodic multisines on the DFT grid of an integer number of
+  periods, with ``R`` experiments time-shifted by ``T/R`` (same property).
+* `sine_experiments`: single sinusoids, one per experiment, for validation
+  (thesis §3.7.4) or sine-by-sine identification.
+
+Every design returns the analysis windows (``segments``) of an integer number
+of periods that `estimate_htf` expects.  Frequencies at multiples of
+``ω_p/2`` are flagged: there an input at ``ω`` and its mirror ``-ω`` produce
+output at the same frequencies, and neighbouring components cannot be
+separated with sinusoidal inputs.
+"""
+
+from typing import Callable, NamedTuple
+
+import warnings
+
+import numpy as np
+
+from ._validation import (check_kwargs, check_period, check_positive_int,
+                          real_array, steps_per_period)
+
+__all__ = ['chirp_replicas', 'multisine', 'sine_experiments', 'Excitation']
+
+
+class Excitation(NamedTuple):
+    """Sampled excitation returned by the experiment design functions.
+
+    Attributes
+    ----------
+    time : ndarray, shape (nt,)
+        Sample times, starting at 0 (the phase reference of the period).
+    inputs : ndarray, shape (nt,) or (nexp, nt)
+        Input samples; one row per experiment for multi-experiment designs.
+    segments : ndarray of int, shape (nseg, 2)
+        ``[start, stop)`` sample indices of the analysis windows, each an
+        integer number of periods long.  Pass them to `estimate_htf`.
+    signal : callable
+        ``signal(t)`` evaluates the continuous-time input (shape like
+        `inputs` with the time axis replaced by ``t``); use it with
+        variable-step simulators.
+    frequencies : ndarray or None
+        Excited frequencies in rad/s for sinusoidal designs, else None.
+
+    Examples
+    --------
+    >>> t, u, segments, signal, _ = ltp.chirp_replicas(1.0, 3, 2.0, 0.0, 5.0, dt=0.01)
+    >>> segments.shape, bool(np.allclose(signal(t), u))
+    ((3, 2), True)
+    """
+
+    time: np.ndarray
+    inputs: np.ndarray
+    segments: np.ndarray
+    signal: Callable
+    frequencies: np.ndarray = None
+
+
+def _check_dt(dt, period):
+    dt = check_period(dt, "dt")
+    return dt, steps_per_period(period, dt, "dt")
+
+
+def _check_frequency(value, name, allow_zero=True):
+    value = real_array(value, name, ndim=0)
+    value = float(value)
+    if value < 0 or (value == 0 and not allow_zero):
+        raise ValueError(f"{name} must be {'>=' if allow_zero else '>'} 0, got {value}")
+    return value
+
+
+def _warn_half_multiples(omega, period, tol, what):
+    """Warn when any of `omega` lies within `tol` of a multiple of ω_p/2."""
+    half = np.pi / period                     # ω_p / 2
+    q = omega / half
+    bad = np.abs(q - np.round(q)) * half <= tol
+    if np.any(bad):
+        warnings.warn(
+            f"{what} {np.round(omega[bad], 6).tolist()} rad/s are multiples of "
+            f"omega_p/2 = {half:.6g} rad/s: the responses to +omega and -omega "
+            "fall on the same output frequencies there and adjacent HTF "
+            "components cannot be separated", UserWarning, stacklevel=3)
+    return bad
+
+
+def chirp_replicas(period, nreplicas, duration, f0, f1, *, dt,
+                   amplitude=1.0, gap=0.0, **kwargs):
+    """Phase-shifted replicas of a linear chirp for HTF identification.
+
+    Replica ``r = 0..R-1`` occupies its own record window
+    ``[r L T, (r+1) L T)`` of ``L`` whole periods and is the chirp
+
+    ``c(τ) = amplitude · sin(2π (f0 τ + (f1 - f0) τ² / (2 D)))``, ``0 <= τ < D``
+
+    started at ``t = r L T + r T / R``, i.e. shifted by ``T/R`` in the cycle
+    phase relative to the previous replica (thesis eqs. 3.48, 3.57-3.58).
+    Each record ends with at least `gap` seconds of zero input, so that the
+    response settles before the next replica starts; L is the smallest
+    integer with ``L T >= (R-1) T / R + D + gap``.
+
+    Parameters
+    ----------
+    period : float
+        Period T of the system (s).
+    nreplicas : int
+        Number R of replicas; use ``R >= 2K+1`` to identify K harmonics
+        without regularisation.
+    duration : float
+        Chirp duration D (s).
+    f0, f1 : float
+        Start and end frequencies of the sweep (Hz), ``0 <= f0 < f1``; f1
+        must be below the Nyquist frequency ``1/(2 dt)``.
+    dt : float
+        Sample time; ``period/dt`` must be an integer.
+    amplitude : float, optional
+        Chirp amplitude (default 1).
+    gap : float, optional
+        Minimum quiet time after each chirp (s, default 0).  Choose several
+        settling times of the system for leakage-free estimates.
+
+    Returns
+    -------
+    Excitation
+        ``(time, inputs, segments, signal, frequencies)``; ``inputs`` has
+        shape (nt,), ``segments`` (R, 2) holds the record windows.
+
+    Notes
+    -----
+    The instantaneous frequency is ``f0 + (f1 - f0) τ / D``.  Eq. 3.48 of the
+    thesis follows this form; eqs. 3.40 and 3.57 as printed sweep to twice
+    the stated end frequency.  When ``T / (R dt)`` is an integer the sampled
+    replicas are exact delayed copies of each other, which makes the sampled
+    ``Φ_UU`` exactly diagonal; otherwise the decoupling holds up to the
+    aliasing of the chirp's switching edges.
+
+    Examples
+    --------
+    >>> exc = ltp.chirp_replicas(1.0, 3, 4.0, 0.0, 2.0, dt=0.01, gap=1.0)
+    >>> exc.segments.tolist()
+    [[0, 600], [600, 1200], [1200, 1800]]
+    >>> exc.time.shape, exc.inputs.shape
+    ((1800,), (1800,))
+    >>> float(np.round(exc.signal(np.array([600 * 0.01 + 1 / 3]))[0], 12))
+    0.0
+    """
+    check_kwargs(kwargs, "chirp_replicas")
+    period = check_period(period)
+    nrep = check_positive_int(nreplicas, "nreplicas")
+    duration = check_period(duration, "duration")
+    dt, nper = _check_dt(dt, period)
+    f0 = _check_frequency(f0, "f0")
+    f1 = _check_frequency(f1, "f1", allow_zero=False)
+    if f1 <= f0:
+        raise ValueError(f"f1 must exceed f0, got f0={f0}, f1={f1}")
+    if f1 >= 0.5 / dt:
+        raise ValueError(f"f1={f1} Hz is not below the Nyquist frequency "
+                         f"{0.5 / dt} Hz of dt={dt}")
+    amplitude = float(real_array(amplitude, "amplitude", ndim=0))
+    gap = float(real_array(gap, "gap", ndim=0))
+    if gap < 0:
+        raise ValueError(f"gap must be >= 0, got {gap}")
+
+    # record length: L whole periods holding shift + chirp + gap
+    need = (nrep - 1) * period / nrep + duration + gap
+    nrec = int(np.ceil(need / period - 1e-9))
+    length = nrec * period
+    starts = np.arange(nrep) * (length + period / nrep)   # r L T + r T/R
+    sweep = (f1 - f0) / (2 * duration)
+
+    def signal(t):
+        t = np.asarray(t, dtype=float)
+        # replica index from the record window, local chirp time τ
+        r = np.clip(np.floor(t / length).astype(int), 0, nrep - 1)
+        tau = t - starts[r]
+        on = (tau >= 0) & (tau < duration) & (t >= 0) & (t < nrep * length)
+        return np.where(on, amplitude * np.sin(2 * np.pi * (f0 + sweep * tau) * tau), 0.0)
+
+    nsamp = nrec * nper
+    time = np.arange(nrep * nsamp) * dt
+    segments = np.column_stack([np.arange(nrep) * nsamp,
+                                np.arange(1, nrep + 1) * nsamp])
+    return Excitation(time, signal(time), segments, signal, None)
+
+
+def _grid_frequencies(frequencies, window, name):
+    """Snap frequencies (rad/s) to the DFT grid 2π i / window; return (omega, bins)."""
+    omega = real_array(frequencies, name, ndim=(0, 1)).ravel()
+    if omega.size == 0:
+        raise ValueError(f"{name} must not be empty")
+    if np.any(omega <= 0):
+        raise ValueError(f"{name} must be positive (rad/s)")
+    step = 2 * np.pi / window
+    bins = np.round(omega / step).astype(int)
+    if np.any(bins < 1):
+        raise ValueError(f"{name} below the frequency resolution {step:.6g} rad/s "
+                         "of the window; increase nperiods")
+    bins = np.unique(bins)
+    return bins * step, bins
+
+
+def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitude, what):
+    """Sum-of-cosines experiments; experiment r is delayed by r T / nexp."""
+    nper = steps_per_period(period, dt, "dt")
+    if np.max(omega) >= np.pi / dt:
+        raise ValueError(f"{what} reach the Nyquist frequency {np.pi / dt:.6g} rad/s "
+                         f"of dt={dt}")
+    _warn_half_multiples(omega, period, 1e-9 * np.max(omega), what)
+    delays = np.arange(nexp) * period / nexp
+
+    def signal(t):
+        t = np.asarray(t, dtype=float)
+        # u_r(t) = Σ_l a cos(ω_l (t - τ_r) + φ_l)
+        arg = omega[None, :, None] * (t[None, None, :] - delays[:, None, None]) \
+            + phases[None, :, None]
+        return amplitude * np.cos(arg).sum(axis=1)
+
+    nsamp = (settle + nperiods) * nper
+    time = np.arange(nsamp) * dt
+    segments = np.array([[settle * nper, nsamp]])
+    return time, signal, segments
+
+
+def _check_common(period, dt, nperiods, settle):
+    period = check_period(period)
+    dt = check_period(dt, "dt")
+    nperiods = check_positive_int(nperiods, "nperiods")
+    settle = check_positive_int(settle, "settle", minimum=0)
+    return period, dt, nperiods, settle
+
+
+def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
+                     amplitude=1.0, **kwargs):
+    """One sinusoid per experiment, on the DFT grid of the analysis window.
+
+    Experiment ``e`` is ``amplitude · cos(ω_e t)`` for
+    ``(settle + nperiods)`` periods; the analysis window is the last
+    `nperiods` periods.  Each ``ω_e`` is rounded to the nearest multiple of
+    ``2π / (nperiods T)`` so that the window holds whole periods of both the
+    system and the input (leakage-free steady state).  A UserWarning is
+    issued for frequencies at multiples of ``ω_p/2``.
+
+    Parameters
+    ----------
+    frequencies : array_like
+        Requested frequencies (rad/s), positive.
+    period : float
+        System period T (s).
+    dt : float
+        Sample time; ``period/dt`` must be an integer.
+    nperiods : int
+        Number of periods in the analysis window.
+    settle : int, optional
+        Periods simulated before the window to let transients decay.
+    amplitude : float, optional
+        Amplitude of each sinusoid.
+
+    Returns
+    -------
+    Excitation
+        ``inputs`` has shape (nexp, nt); ``frequencies`` holds the rounded
+        frequencies (duplicates after rounding are removed).
+
+    Examples
+    --------
+    >>> exc = ltp.sine_experiments([1.3, 2.2], 2 * np.pi, dt=np.pi / 50,
+    ...                            nperiods=4, settle=2)
+    >>> exc.frequencies.tolist(), exc.inputs.shape, exc.segments.tolist()
+    ([1.25, 2.25], (2, 600), [[200, 600]])
+    """
+    check_kwargs(kwargs, "sine_experiments")
+    period, dt, nperiods, settle = _check_common(period, dt, nperiods, settle)
+    amplitude = float(real_array(amplitude, "amplitude", ndim=0))
+    omega, _ = _grid_frequencies(frequencies, nperiods * period, "frequencies")
+    nper = steps_per_period(period, dt, "dt")
+    if np.max(omega) >= np.pi / dt:
+        raise ValueError(f"frequencies reach the Nyquist frequency {np.pi / dt:.6g} "
+                         f"rad/s of dt={dt}")
+    _warn_half_multiples(omega, period, 1e-9 * np.max(omega), "frequencies")
+
+    def signal(t):
+        t = np.asarray(t, dtype=float)
+        return amplitude * np.cos(omega[:, None] * t[None, :])
+
+    time = np.arange((settle + nperiods) * nper) * dt
+    segments = np.array([[settle * nper, time.size]])
+    return Excitation(time, signal(time), segments, signal, omega)
+
+
+def multisine(frequencies, period, *, dt, nperiods, nexperiments=1, settle=0,
+              amplitude=1.0, phases='schroeder', seed=None, **kwargs):
+    """Multisine experiments time-shifted by fractions of the period.
+
+    All experiments share the multisine
+    ``s(t) = amplitude · Σ_l cos(ω_l t + φ_l)`` with lines ``ω_l`` on the DFT
+    grid ``2π i / (nperiods T)``; experiment ``r`` applies ``s(t - r T/R)``
+    with ``R = nexperiments``.  With ``R >= 2K+1`` the extended power
+    spectrum is diagonal wherever the lines are dense (as for
+    `chirp_replicas`).
+
+    Parameters
+    ----------
+    frequencies : array_like or tuple
+        Line frequencies (rad/s), or ``('band', w0, w1)`` for every grid line
+        in ``[w0, w1]`` except multiples of ``ω_p/2``.
+    period : float
+        System period T (s).
+    dt : float
+        Sample time; ``period/dt`` must be an integer.
+    nperiods : int
+        Number of periods in the analysis window.
+    nexperiments : int, optional
+        Number R of time-shifted experiments (default 1).
+    settle : int, optional
+        Periods applied before the window to reach steady state.
+    amplitude : float, optional
+        Amplitude of each line.
+    phases : {'schroeder', 'random'} or array_like, optional
+        Line phases: Schroeder's low-crest-factor phases
+        ``φ_l = -π l (l - 1) / F``, uniform random phases, or given values.
+    seed : int or numpy.random.Generator, optional
+        Random source for ``phases='random'``.
+
+    Returns
+    -------
+    Excitation
+        ``inputs`` has shape (R, nt); ``frequencies`` holds the lines.
+
+    Examples
+    --------
+    >>> exc = ltp.multisine(('band', 0.5, 1.5), 2 * np.pi, dt=np.pi / 20,
+    ...                     nperiods=4, nexperiments=3)
+    >>> exc.frequencies.tolist()           # multiples of ω_p/2 = 0.5 skipped
+    [0.75, 1.25]
+    >>> exc.inputs.shape
+    (3, 160)
+    """
+    check_kwargs(kwargs, "multisine")
+    period, dt, nperiods, settle = _check_common(period, dt, nperiods, settle)
+    nexp = check_positive_int(nexperiments, "nexperiments")
+    amplitude = float(real_array(amplitude, "amplitude", ndim=0))
+    window = nperiods * period
+    if isinstance(frequencies, tuple) and len(frequencies) == 3 \
+            and isinstance(frequencies[0], str):
+        if frequencies[0] != 'band':
+            raise ValueError(f"frequencies: unknown specification {frequencies[0]!r}")
+        w0 = _check_frequency(frequencies[1], "frequencies[1]")
+        w1 = _check_frequency(frequencies[2], "frequencies[2]", allow_zero=False)
+        step = 2 * np.pi / window
+        bins = np.arange(max(1, int(np.ceil(w0 / step - 1e-9))),
+                         int(np.floor(w1 / step + 1e-9)) + 1)
+        # drop lines at multiples of ω_p/2 (every nperiods/2 bins)
+        keep = (2 * bins) % nperiods != 0
+        bins = bins[keep]
+        if bins.size == 0:
+            raise ValueError(f"frequencies: no grid line in [{w0}, {w1}] rad/s "
+                             f"(resolution {step:.6g} rad/s)")
+        omega = bins * step
+    else:
+        omega, bins = _grid_frequencies(frequencies, window, "frequencies")
+    nline = omega.size
+    if isinstance(phases, str):
+        if phases == 'schroeder':
+            ell = np.arange(1, nline + 1)
+            phi = -np.pi * ell * (ell - 1) / nline
+        elif phases == 'random':
+            phi = np.random.default_rng(seed).uniform(0, 2 * np.pi, nline)
+        else:
+            raise ValueError(f"phases must be 'schroeder', 'random' or an array, "
+                             f"got {phases!r}")
+    else:
+        phi = real_array(phases, "phases", ndim=1)
+        if phi.size != nline:
+            raise ValueError(f"phases has {phi.size} entries for {nline} lines")
+    time, signal, segments = _periodic_design(
+        omega, period, dt, nperiods, settle, nexp, phi, amplitude, "frequencies")
+    return Excitation(time, signal(time), segments, signal, omega)

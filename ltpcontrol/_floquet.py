@@ -1,0 +1,541 @@
+"""Floquet analysis: monodromy, characteristic multipliers and exponents,
+and the Floquet (Lyapunov) transform (thesis Section 4.2.2).
+
+The period map is the product of step transition matrices over a grid
+``0 = t_0 < t_1 < ... < t_M = T`` containing every switching instant,
+
+    Φ(T, 0) = Φ_{M-1} ... Φ_1 Φ_0,   Φ_k = Φ(t_{k+1}, t_k)
+
+(discrete time: ``Φ_k = A[k]``, M = N).  Multipliers and exponents come
+from the periodic real Schur form of the factors, which never forms the
+product, so multipliers far below machine precision relative to the
+largest one (stiff systems) keep full relative accuracy.
+
+The Floquet transform ``x = P(t) z`` uses the periodic Floquet vectors
+``p_i(t) = e^{-λ_i t} Φ(t, 0) v_i``, obtained as the periodic solutions
+of the cyclic two-point problem ``e^{λ_i h_k} p_{k+1} = Φ_k p_k``.  No
+growing or decaying exponential is ever multiplied out, which keeps the
+transform accurate for stiff systems.
+"""
+
+import warnings
+
+import numpy as np
+import scipy.linalg as la
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from control.exception import ControlArgument
+
+from ._periodic_matrix import PeriodicMatrix
+from ._transition import expm_batch, step_transitions
+from ._validation import check_kwargs, check_positive_int, steps_per_period
+
+__all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
+           'is_stable', 'floquet_transform']
+
+# largest condition number accepted for the matrix of Floquet vectors
+_COND_MAX = 1e10
+
+
+def monodromy(sys, nsteps=None):
+    """Monodromy (period) matrix ``Φ(T, 0)`` of an LTP system.
+
+    Continuous time: the ordered product of the exact transition matrices
+    of `nsteps` uniform steps, refined at every switching instant of A.
+    Discrete time: ``A[N-1] ... A[1] A[0]`` with ``N = period/dt``.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        Continuous- or discrete-time LTP system.
+    nsteps : int, optional
+        Continuous time only: number of uniform steps per period.  By
+        default ``ceil(T max_t ||A(t)||_2)`` clipped to [16, 4096], so that
+        every factor is well conditioned.
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+
+    Notes
+    -----
+    For stiff systems the product loses the small multipliers to rounding;
+    use `floquet_multipliers` and `floquet_exponents`, which do not form
+    the product.
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=2.0)
+    >>> np.allclose(ltp.monodromy(sys), np.exp(-2.0))
+    True
+    """
+    _, factors = _factors(sys, nsteps)
+    out = np.eye(factors.shape[1])
+    for phi in factors:
+        out = phi @ out
+    return out
+
+
+def floquet_multipliers(sys, nsteps=None):
+    """Characteristic (Floquet) multipliers: eigenvalues of ``Φ(T, 0)``.
+
+    Computed by the periodic real Schur decomposition of the factors
+    ``H_1 H_2 ... H_p`` with ``H_1 = Φ_{M-1}, ..., H_p = Φ_0`` (SLICOT
+    MB03VD/MB03WD) without forming the product.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        Continuous- or discrete-time LTP system.
+    nsteps : int, optional
+        Continuous time only; see `monodromy`.
+
+    Returns
+    -------
+    ndarray of complex, shape (n,)
+        Multipliers sorted by decreasing modulus; complex conjugate pairs
+        are adjacent with the positive imaginary part first.  Moduli below
+        about 1e-308 underflow to 0 (use `floquet_exponents`, which keeps
+        them).
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss([[-1.0, 0.0], [0.0, -3.0]], [[1.0], [1.0]],
+    ...                 [[1.0, 1.0]], 0, period=1.0)
+    >>> np.allclose(ltp.floquet_multipliers(sys), np.exp([-1.0, -3.0]))
+    True
+    """
+    logmod, arg = _log_multipliers(sys, nsteps)
+    with np.errstate(under='ignore'):
+        mu = np.exp(logmod) * np.exp(1j * arg)
+    real = (arg == 0) | (arg == np.pi)
+    mu[real] = np.where(arg[real] == 0, 1.0, -1.0) * np.exp(logmod[real])
+    return mu
+
+
+def floquet_exponents(sys, nsteps=None):
+    """Characteristic (Floquet) exponents of an LTP system.
+
+    Continuous time: the exponents λ with ``μ = e^{λT}``, ``λ = (log|μ| +
+    j arg μ)/T``, imaginary parts in the strip ``(-ω_p/2, ω_p/2]``
+    (exponents are defined modulo ``j k ω_p``).  The real parts are sums
+    of logarithms of the periodic Schur diagonals, so they stay accurate
+    when the multipliers span hundreds of orders of magnitude.  An LTI
+    system gives the eigenvalues of A (when their imaginary parts lie in
+    the strip).
+
+    Discrete time: the per-step z-plane exponents ``ρ = μ^{1/N}``
+    (principal root, ``arg ρ`` in ``(-π/N, π/N]``), i.e. the eigenvalues
+    of the constant matrix of the Floquet form ``z[k+1] = A_F z[k]``.
+    They are defined up to a factor ``e^{j2πk/N}``; an LTI system gives
+    the eigenvalues of A when their arguments lie in that sector.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        Continuous- or discrete-time LTP system.
+    nsteps : int, optional
+        Continuous time only; see `monodromy`.
+
+    Returns
+    -------
+    ndarray of complex, shape (n,)
+        In the order of `floquet_multipliers`.
+
+    Examples
+    --------
+    The stiff example ``A(t) = [[0, 1], [-10 cos t, -24 - 10 sin t]]``,
+    T = 2π, has exponents 0 and -24 (multipliers 1 and 1.6e-66):
+
+    >>> A = lambda t: np.array([[0.0, 1.0], [-10 * np.cos(t), -24 - 10 * np.sin(t)]])
+    >>> sys = ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=2 * np.pi)
+    >>> np.round(ltp.floquet_exponents(sys).real, 8) + 0.0
+    array([  0., -24.])
+    """
+    logmod, arg = _log_multipliers(sys, nsteps)
+    if sys.dt:
+        nper = steps_per_period(sys.period, sys.dt)
+        with np.errstate(under='ignore'):
+            return np.exp((logmod + 1j * arg) / nper)
+    return (logmod + 1j * arg) / sys.period
+
+
+def is_stable(sys, tol=1e-10, nsteps=None):
+    """True when every Floquet multiplier satisfies ``|μ| < 1 - tol``.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        Continuous- or discrete-time LTP system.
+    tol : float, optional
+        Stability margin on the multiplier moduli (default 1e-10), so that
+        a multiplier on the unit circle perturbed by rounding is not taken
+        as stable.
+    nsteps : int, optional
+        Continuous time only; see `monodromy`.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> A = lambda t: np.array([[0.0, 1.0], [-1 - 0.2 * np.cos(2 * t), -0.1]])
+    >>> ltp.is_stable(ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=np.pi))
+    True
+    """
+    if isinstance(tol, bool) or not np.isscalar(tol) or not 0 <= tol < 1:
+        raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
+    logmod, _ = _log_multipliers(sys, nsteps)
+    return bool(logmod.size == 0 or np.max(logmod) < np.log1p(-tol))
+
+
+def floquet_transform(sys, real=True, nsteps=None, **kwargs):
+    """Floquet (Lyapunov) transform to a system with constant A.
+
+    With ``x = P(t) z`` (thesis eqs. 4.30-4.35), ``Φ(t, 0) = P(t) e^{Ft}``,
+    ``P(0) = I`` and ``F = log(Φ(T, 0))/T``, the system becomes
+
+        ż = F z + P^{-1}(t) B(t) u,   y = C(t) P(t) z + D(t) u.
+
+    Discrete time: ``x[k] = P[k] z[k]``, ``z[k+1] = A_F z[k] + P[k+1]^{-1}
+    B[k] u[k]``, ``y[k] = C[k] P[k] z[k] + D[k] u[k]`` with
+    ``A_F^N = Φ(N, 0)``.
+
+    F is real.  A real logarithm (N-th root) of the monodromy with period T
+    does not exist when it has negative real eigenvalues; then, with
+    ``real=True``, P(t) is built 2T-periodic (thesis Remark 5; in discrete
+    time only when N is even) and the returned system has period 2T, which
+    is announced by a warning.
+
+    P(t) is computed from the periodic Floquet vectors (see the module
+    notes), so the transform is accurate for stiff systems; if the
+    monodromy is defective or has repeated multipliers it falls back to
+    ``F = logm(Φ(T, 0))/T`` and ``P(t) = Φ(t, 0) e^{-Ft}``, which is
+    accurate only when the multipliers span a moderate range (a warning is
+    issued otherwise).
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        Continuous- or discrete-time LTP system.
+    real : bool, optional
+        If True (default) double the period when needed to keep F real.  If
+        False the period is kept and a ValueError is raised when the
+        monodromy has negative real eigenvalues.
+    nsteps : int, optional
+        Continuous time only: uniform steps per period of the grid on which
+        ``P(t_k)`` is stored (switching instants are added); see
+        `monodromy`.
+
+    Returns
+    -------
+    sysF : LTPStateSpace
+        Floquet form with constant ``A = F``; same time base, inputs,
+        outputs and state count; period T or 2T.
+    P : PeriodicMatrix
+        The transformation ``x = P(t) z`` (discrete time: a 'hold' matrix
+        with ``P(k dt) = P[k]``), continuous with ``P(0) = I``.
+
+    Raises
+    ------
+    ValueError
+        If the monodromy is singular (discrete time with a singular A[k]),
+        or ``real=False`` and there is a negative real multiplier.
+
+    Examples
+    --------
+    The damped Mathieu equation (thesis eq. 4.24) in Floquet form:
+
+    >>> wn, wp = 2 * np.pi, 4 * np.pi
+    >>> A = lambda t: np.array([[0.0, 1.0],
+    ...                         [-(1 + 0.2 * np.cos(wp * t)) * wn**2, -0.6 * wn]])
+    >>> sys = ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=0.5)
+    >>> sysF, P = ltp.floquet_transform(sys)
+    >>> sysF.is_floquet_form
+    True
+    >>> F = sysF.A(0.0)
+    >>> np.allclose(np.linalg.eigvals(F * 0.5), np.log(ltp.floquet_multipliers(sys)))
+    True
+    >>> np.allclose(P(0.0), np.eye(2)), np.allclose(P(0.5), np.eye(2))
+    (True, True)
+    """
+    check_kwargs(kwargs, 'floquet_transform')
+    if not isinstance(real, (bool, np.bool_)):
+        raise ControlArgument(f"real must be True or False, got {real!r}")
+    grid, factors = _factors(sys, nsteps)
+    nstates = factors.shape[1]
+    if nstates == 0:
+        raise ValueError("sys has no states; there is nothing to transform")
+    if sys.dt:
+        # x[k] = P[k] z[k] needs an invertible period map: every A[k] regular
+        sv = np.linalg.svd(factors, compute_uv=False)
+        bad = np.flatnonzero(sv[:, -1] <= nstates * np.finfo(float).eps * sv[:, 0])
+        if bad.size:
+            raise ValueError(f"the monodromy of sys is singular (A[{bad[0]}] is singular): "
+                             "no Floquet transform exists")
+    logmod, arg = _log_multipliers(sys, nsteps, grid=grid, factors=factors)
+    negative = arg == np.pi
+    dtime = bool(sys.dt)
+    nper = len(factors)
+    # a real root/logarithm with the original period exists unless there are
+    # negative real multipliers (discrete time with N odd: -|μ|^{1/N} is real)
+    double = bool(np.any(negative)) and not (dtime and nper % 2 == 1)
+    if double and not real:
+        raise ValueError("the monodromy of sys has negative real eigenvalues: no real "
+                         "Floquet form with the same period exists; use real=True")
+    if double:
+        warnings.warn("the monodromy has negative real eigenvalues: the Floquet "
+                      "transform uses the period 2T to keep F real", UserWarning,
+                      stacklevel=2)
+        grid = np.concatenate([grid, grid[1:] + grid[-1]])
+        factors = np.concatenate([factors, factors])
+    # exponents per unit time (continuous) or per step (discrete), real for
+    # negative multipliers (whose sign is then absorbed by the period 2T or,
+    # for odd N, by the real root -|μ|^{1/N})
+    scale = nper if dtime else sys.period
+    rate = (logmod + 1j * np.where(negative, 0.0, arg)) / scale
+    flip = negative & dtime & (nper % 2 == 1)
+    modal = _floquet_vectors(grid, factors, rate, flip, dtime)
+    if modal is None:
+        grid_vals, E, R = _logm_form(grid, factors, logmod, dtime)
+    else:
+        grid_vals, E, R = modal
+    return _assemble(sys, grid, grid_vals, E, R, double)
+
+
+#
+# Private helpers
+#
+
+def _check_sys(sys):
+    for attr in ('A', 'B', 'C', 'D'):
+        if not isinstance(getattr(sys, attr, None), PeriodicMatrix):
+            raise ControlArgument("sys must be an LTPStateSpace (with PeriodicMatrix "
+                                  f"attributes A, B, C, D), got {type(sys).__name__}")
+    if getattr(sys, 'dt', None) is None or getattr(sys, 'period', None) is None:
+        raise ControlArgument("sys must have a period and a time base dt")
+
+
+def _factors(sys, nsteps):
+    """Grid ``t_0..t_M`` and step transition matrices ``Φ_k`` (M, n, n)."""
+    _check_sys(sys)
+    A, T = sys.A, sys.period
+    n = A.shape[0]
+    if sys.dt:
+        if nsteps is not None:
+            raise ControlArgument("nsteps applies to continuous-time systems only; a "
+                                  "discrete-time system has N = period/dt steps")
+        nper = steps_per_period(T, sys.dt)
+        return np.arange(nper + 1) * sys.dt, A.sample(nper)
+    if nsteps is None:
+        probe = np.concatenate([np.arange(256) * T / 256, A.breakpoints])
+        norm = np.max(np.linalg.norm(A(probe), ord=2, axis=(1, 2)), initial=0.0)
+        nsteps = int(np.clip(np.ceil(T * norm), 16, 4096))
+    nsteps = check_positive_int(nsteps, 'nsteps')
+    grid = np.union1d(np.linspace(0, T, nsteps + 1), A.breakpoints)
+    # drop grid points that nearly coincide with a switching instant
+    keep = np.concatenate([[True], np.diff(grid) > 1e-9 * T / nsteps])
+    keep[-1] = True
+    grid = grid[keep]
+    grid = grid[np.concatenate([np.diff(grid) > 0, [True]])]
+    grid[-1] = T
+    zero = PeriodicMatrix.constant(np.zeros((n, 0)), T)
+    phi, _, _ = step_transitions(A, zero, grid[:-1], np.diff(grid))
+    return grid, phi
+
+
+def _log_multipliers(sys, nsteps, grid=None, factors=None):
+    """``log|μ_i|`` and ``arg μ_i`` from the periodic Schur form, sorted."""
+    if factors is None:
+        grid, factors = _factors(sys, nsteps)
+    n = factors.shape[1]
+    if n == 0:
+        return np.zeros(0), np.zeros(0)
+    # slycot order H_1 H_2 ... H_p with H_1 = Φ_{M-1}, ..., H_p = Φ_0
+    H = np.asfortranarray(np.moveaxis(factors[::-1], 0, -1))
+    if n > 1:
+        from slycot import mb03vd, mb03wd
+        HQ, _ = mb03vd(n, 1, n, H.copy(order='F'))
+        # keep H_1 upper Hessenberg and H_2..H_p upper triangular
+        H = np.triu(np.moveaxis(HQ, -1, 0))
+        H[0] += np.diag(np.diag(HQ[:, :, 0], -1), -1)
+        H = np.asfortranarray(np.moveaxis(H, 0, -1))
+        H, _, _ = mb03wd('S', 'N', n, 1, n, 1, n, H, np.zeros_like(H))
+    logmod, arg = np.empty(n), np.empty(n)
+    i = 0
+    with np.errstate(divide='ignore'):
+        while i < n:
+            if i + 1 < n and H[i + 1, i, 0] != 0:
+                logmod[i:i + 2], arg[i:i + 2] = _block_2x2(H[i:i + 2, i:i + 2])
+                i += 2
+            else:
+                # μ = Π_j t_jj: log|μ| = Σ_j log|t_jj|
+                d = H[i, i]
+                logmod[i] = np.sum(np.log(np.abs(d)))
+                arg[i] = np.pi if np.count_nonzero(d < 0) % 2 else 0.0
+                i += 1
+    order = np.argsort(-logmod, kind='stable')
+    return logmod[order], arg[order]
+
+
+def _block_2x2(blocks):
+    """Eigenvalues of ``Π_j B_j`` (B_j = blocks[:, :, j]) in log form."""
+    prod, logscale = np.eye(2), 0.0
+    # running product normalised at every factor: Π_j B_j = e^{logscale} prod
+    for j in range(blocks.shape[2]):
+        prod = prod @ blocks[:, :, j]
+        s = np.abs(prod).max()
+        if s == 0:
+            return np.full(2, -np.inf), np.zeros(2)
+        prod /= s
+        logscale += np.log(s)
+    dets = np.linalg.det(np.moveaxis(blocks, -1, 0))
+    logdet = np.sum(np.log(np.abs(dets)))
+    detsign = -1.0 if np.count_nonzero(dets < 0) % 2 else 1.0
+    # y = x e^{-logscale} solves y² - tr y + δ = 0, δ = det e^{-2 logscale}
+    tr = np.trace(prod)
+    with np.errstate(under='ignore'):
+        delta = detsign * np.exp(logdet - 2 * logscale)
+    disc = tr * tr - 4 * delta
+    if disc < 0:
+        ang = np.angle(complex(0.5 * tr, 0.5 * np.sqrt(-disc)))
+        return np.full(2, 0.5 * logdet), np.array([ang, -ang])
+    y1 = 0.5 * (tr + np.copysign(np.sqrt(disc), tr))
+    if y1 == 0:
+        return np.full(2, -np.inf), np.zeros(2)
+    # the small root from the determinant: log|y2| = log|det| - log|y1|
+    log1 = np.log(abs(y1)) + logscale
+    sign2 = detsign * np.sign(y1)
+    return np.array([log1, logdet - log1]), np.array(
+        [0.0 if y1 > 0 else np.pi, 0.0 if sign2 > 0 else np.pi])
+
+
+def _floquet_vectors(grid, factors, rate, flip, dtime):
+    """Periodic Floquet vectors on the grid, real form.
+
+    For each exponent solve the cyclic problem ``c_k p_{k+1} = Φ_k p_k``,
+    ``p_M = p_0`` with ``c_k = e^{λ h_k}`` (continuous) or ``c_k = ρ``
+    (discrete), normalised by a border row.  Returns ``(G, Λ_r, Pm_0^{-1})``
+    with ``P(t_k) = G_k Pm_0^{-1}``, or None when the vectors are not a
+    well-conditioned basis (defective or repeated multipliers).
+    """
+    nsteps, n = factors.shape[0], factors.shape[1]
+    size = nsteps * n
+    h = np.diff(grid)
+    rng = np.random.default_rng(12345)
+    border_col, border_row = rng.standard_normal(size), rng.standard_normal(n)
+    # sparse pattern: -Φ_k in block (k, k), c_k I in block (k, k+1 mod M),
+    # the border column (index M n) and the border row acting on p_0
+    blk = np.arange(nsteps)[:, None, None] * n
+    diag_rows = np.broadcast_to(blk + np.arange(n)[None, :, None], factors.shape).ravel()
+    diag_cols = np.broadcast_to(blk + np.arange(n)[None, None, :], factors.shape).ravel()
+    shift_cols = (((np.arange(nsteps) + 1) % nsteps)[:, None] * n + np.arange(n)).ravel()
+    rows = np.concatenate([diag_rows, np.arange(size), np.arange(size), np.full(n, size)])
+    cols = np.concatenate([diag_cols, shift_cols, np.full(size, size), np.arange(n)])
+    vectors, blocks = [], []
+    i = 0
+    while i < n:
+        pair = rate[i].imag > 0
+        lam = rate[i] if pair else rate[i].real
+        sign = -1.0 if flip[i] else 1.0
+        coef = np.full(nsteps, sign * np.exp(lam)) if dtime else np.exp(lam * h)
+        dtype = complex if pair else float
+        values = np.concatenate([-factors.ravel(), np.repeat(coef, n), border_col, border_row])
+        L = sp.csc_matrix((values.astype(dtype), (rows, cols)), shape=(size + 1, size + 1))
+        rhs = np.zeros(size + 1, dtype)
+        rhs[-1] = 1.0
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter('error', spla.MatrixRankWarning)
+                sol = spla.splu(L).solve(rhs)
+        except (RuntimeError, spla.MatrixRankWarning):
+            return None
+        p = sol[:-1].reshape(nsteps, n)
+        p = p / np.linalg.norm(p[0])
+        if pair:
+            # rotate the phase so that Re p ⟂ Im p (best-conditioned real pair)
+            p = p * np.exp(-0.5j * np.angle(np.sum(p * p)))
+            vectors += [p.real, p.imag]
+            # x = e^{λt} p: [Re x, Im x] = [Re p, Im p] exp(t [[a, b], [-b, a]])
+            a, b = (np.exp(lam).real, np.exp(lam).imag) if dtime else (lam.real, lam.imag)
+            blocks.append(np.array([[a, b], [-b, a]]))
+            i += 2
+        else:
+            vectors.append(p.real)
+            blocks.append(np.array([[sign * np.exp(lam.real) if dtime else lam.real]]))
+            i += 1
+    G = np.stack(vectors, axis=-1)
+    if not np.all(np.isfinite(G)) or np.linalg.cond(G[0]) > _COND_MAX:
+        return None
+    return G, la.block_diag(*blocks), np.linalg.inv(G[0])
+
+
+def _logm_form(grid, factors, logmod, dtime):
+    """Fallback ``F = logm(Φ)/T``, ``P(t_k) = Φ(t_k, 0) e^{-F t_k}``."""
+    if np.ptp(logmod) > 25:
+        warnings.warn("the monodromy is defective or has repeated multipliers and its "
+                      f"multipliers span {np.ptp(logmod) / np.log(10):.0f} decades: the "
+                      "Floquet transform may be inaccurate", UserWarning, stacklevel=3)
+    cumulative = [np.eye(factors.shape[1])]
+    for phi in factors:
+        cumulative.append(phi @ cumulative[-1])
+    cumulative = np.array(cumulative)
+    L = la.logm(cumulative[-1])
+    if np.max(np.abs(np.imag(L)), initial=0.0) > 1e-8 * max(1.0, np.abs(L).max()):
+        raise ValueError("the monodromy of sys has no real logarithm")
+    L = np.real(L)
+    span = len(factors) if dtime else grid[-1]
+    E = la.expm(L / len(factors)) if dtime else L / span
+    # discrete time: P[k] = Φ(k, 0) A_F^{-k};  continuous: P = Φ(t_k, 0) e^{-F t_k}
+    times = np.arange(len(factors)) if dtime else grid[:-1]
+    G = cumulative[:-1] @ la.expm(-L[None] * (times / span)[:, None, None])
+    return G, E, np.eye(factors.shape[1])
+
+
+def _assemble(sys, grid, G, E, R, double):
+    """Build P(t) and the Floquet-form system from the grid values."""
+    from ._ltpsys import ltpss
+    period = grid[-1]
+    n = G.shape[1]
+    labels = {key: getattr(sys, f'{key[:-1]}_labels') for key in ('inputs', 'outputs',
+                                                                     'states')
+              if hasattr(sys, f'{key[:-1]}_labels')}
+    name = getattr(sys, 'name', None)
+    if name is not None:
+        labels['name'] = f'{name}$floquet'
+    if sys.dt:
+        # discrete time: P[k] = G_k R, B_F[k] = P[k+1]^{-1} B[k], C_F[k] = C[k] P[k]
+        nw = len(G)
+        Pk = G @ R
+        Bk = sys.B.with_period(period).sample(nw)
+        Ck = sys.C.with_period(period).sample(nw)
+        Dk = sys.D.with_period(period).sample(nw)
+        BF = np.linalg.solve(np.roll(Pk, -1, axis=0), Bk)
+        sysF = ltpss(np.linalg.solve(R, E @ R), BF, Ck @ Pk, Dk, period, dt=sys.dt,
+                     **labels)
+        return sysF, PeriodicMatrix.from_samples(Pk, period, kind='hold')
+    A = sys.A
+    zero = PeriodicMatrix.constant(np.zeros((n, 0)), A.period)
+    starts = grid[:-1]
+
+    def transform(t):
+        # P(t) = Φ(t, t_k) G_k e^{-E (t - t_k)} R for t_k <= t < t_{k+1}
+        t = np.atleast_1d(np.asarray(t, float))
+        tau = np.mod(t, period)
+        k = np.clip(np.searchsorted(starts, tau, side='right') - 1, 0, len(starts) - 1)
+        d = tau - starts[k]
+        phi, _, _ = step_transitions(A, zero, starts[k], d)
+        return phi @ G[k] @ expm_batch(-E[None] * d[:, None, None]) @ R
+
+    breaks = np.concatenate([M.with_period(period).breakpoints
+                             for M in (sys.A, sys.B, sys.C)])
+    P = PeriodicMatrix._new(period, (n, n), func=transform, breakpoints=breaks)
+    B, C = sys.B.with_period(period), sys.C.with_period(period)
+    BF = PeriodicMatrix._new(period, B.shape, breakpoints=breaks,
+                             func=lambda t: np.linalg.solve(transform(t), B(t)))
+    CF = PeriodicMatrix._new(period, C.shape, breakpoints=breaks,
+                             func=lambda t: C(t) @ transform(t))
+    sysF = ltpss(np.linalg.solve(R, E @ R), BF, CF, sys.D.with_period(period),
+                 period, **labels)
+    return sysF, P

@@ -1,0 +1,513 @@
+"""Nonparametric estimation of harmonic transfer functions from data.
+
+Implements the least-squares HTF estimator with curvature regularisation
+reviewed in thesis §3.3.3 (Siddiqi's method, eqs. 3.28-3.35).  The output
+spectrum of an LTP system obeys (thesis eq. 3.27)
+
+    Y(jω) = Σ_{k=-K..K} G_k(jω) U(jω - jkω_p).
+
+Each record (or segment of a record) is cut to an integer number L of
+periods, so that on its DFT grid ``ω_i = 2π i / (L T)`` a shift by ω_p is
+exactly L bins.  With the regressor
+``φ_r(i) = [U_r(i + KL), ..., U_r(i), ..., U_r(i - KL)]`` the extended
+spectra are ``Φ_UU(i) = Σ_r conj(φ_r) φ_rᵀ`` and ``Φ_UY(i) = Σ_r conj(φ_r) Y_r``.
+Per frequency, ``ĝ = Φ_UU⁻¹ Φ_UY`` (eq. 3.31).  The regularised estimate
+solves all frequencies jointly (eq. 3.35),
+
+    (blkdiag_i Φ_UU(i) + α s D₂ᵀD₂ ⊗ I) g = [Φ_UY(i)]_i,
+
+where ``D₂`` is the second difference along frequency and
+``s = mean_i tr Φ_UU(i) / P`` makes ``α`` independent of the input scale.
+"""
+
+from dataclasses import dataclass, field
+
+import warnings
+
+import numpy as np
+import scipy.linalg
+import scipy.optimize
+import scipy.sparse as sp
+from control.exception import ControlArgument, ControlDimension
+from control.timeresp import TimeResponseData
+from tqdm.auto import tqdm
+
+from ._htf import HTF
+from ._validation import (check_kwargs, check_period, check_positive_int,
+                          real_array, steps_per_period)
+
+__all__ = ['estimate_htf']
+
+# Φ_UU condition number above which the per-frequency solve is flagged
+_COND_WARN = 1e8
+# relative α grid searched by generalised cross-validation
+_GCV_GRID = np.logspace(-8, 6, 15)
+
+
+@dataclass
+class HTFEstimate:
+    """Result of a nonparametric HTF estimate.
+
+    Attributes
+    ----------
+    components : ndarray, shape (2K+1, ny, nu, F)
+        ``G_k(jω)`` for k = -K..K on `omega`.
+    omega : ndarray, shape (F,)
+        Output (base) frequencies in rad/s.
+    period : float
+        System period T.
+    std : ndarray, shape (2K+1, ny, nu, F)
+        Standard deviation of each component, ``sqrt(E|Ĝ_k - E Ĝ_k|²)``,
+        from the residual (white output noise assumed).  For α > 0 it
+        excludes the regularisation bias.  NaN when the residual has no
+        degrees of freedom.
+    cond : ndarray, shape (F,)
+        Condition number of ``Φ_UU`` at each frequency.
+    residual : ndarray, shape (ny,)
+        Root-mean-square residual ``|Y - Ŷ|`` per output over all equations.
+    noise_var : ndarray, shape (ny,)
+        Estimated variance of one output DFT coefficient.
+    alpha : float
+        Relative curvature weight used.
+    dof : float
+        Residual degrees of freedom ``n - tr H``.
+    gcv : float
+        Generalised cross-validation score ``n |Y - Ŷ|² / (n - tr H)²``.
+    nrecords : int
+        Number of analysed windows R.
+    """
+
+    components: np.ndarray
+    omega: np.ndarray
+    period: float
+    std: np.ndarray
+    cond: np.ndarray
+    residual: np.ndarray
+    noise_var: np.ndarray
+    alpha: float
+    dof: float
+    gcv: float
+    nrecords: int
+    labels: dict = field(default_factory=dict, repr=False)
+
+
+# ---------------------------------------------------------------- data input
+def _as_records(data):
+    """Return a list of ``(t, u, y, labels)`` with u (nu, nt) and y (ny, nt)."""
+    if isinstance(data, (TimeResponseData, tuple)):
+        data = [data]
+    if not isinstance(data, list) or len(data) == 0:
+        raise ControlArgument(
+            "data must be a TimeResponseData, a tuple (t, u, y) or a non-empty "
+            f"list of these, got {type(data).__name__}")
+    records = []
+    for i, rec in enumerate(data):
+        name = f"data[{i}]"
+        if isinstance(rec, TimeResponseData):
+            if rec.u is None:
+                raise ControlArgument(f"{name} has no inputs")
+            t, u, y = rec.t, np.asarray(rec.u), np.asarray(rec.y)
+            labels = {"inputs": rec.input_labels, "outputs": rec.output_labels}
+            if u.ndim == 3:          # (nu, ntraces, nt): one record per trace
+                for j in range(u.shape[1]):
+                    records.append(_check_record(t, u[:, j], y[:, j], f"{name} trace {j}")
+                                   + (labels,))
+                continue
+        elif isinstance(rec, tuple) and len(rec) == 3:
+            t, u, y = rec
+            labels = {}
+        else:
+            raise ControlArgument(f"{name} must be a TimeResponseData or a tuple (t, u, y)")
+        records.append(_check_record(t, u, y, name) + (labels,))
+    return records
+
+
+def _check_record(t, u, y, name):
+    t = real_array(t, f"{name} time", ndim=1)
+    u = np.atleast_2d(real_array(u, f"{name} inputs", ndim=(1, 2)))
+    y = np.atleast_2d(real_array(y, f"{name} outputs", ndim=(1, 2)))
+    if t.size < 2:
+        raise ValueError(f"{name} time must hold at least 2 samples")
+    if u.shape[1] != t.size or y.shape[1] != t.size:
+        raise ControlDimension(
+            f"{name}: inputs {u.shape} and outputs {y.shape} must have the "
+            f"time axis last with {t.size} samples")
+    step = np.diff(t)
+    if np.any(step <= 0) or np.ptp(step) > 1e-6 * step[0]:
+        raise ValueError(f"{name} time must be uniformly sampled and increasing")
+    return t, u, y
+
+
+def _spectra(records, period, nharmonics, segments):
+    """Integer-period DFTs of all windows: U (R, nu, Ns), Y (R, ny, Ns), L, dt."""
+    dts = np.array([rec[0][1] - rec[0][0] for rec in records])
+    dt = float(dts[0])
+    if np.any(np.abs(dts - dt) > 1e-9 * dt):
+        raise ValueError(f"all records must share one sample time, got {np.unique(dts)}")
+    try:
+        nper = steps_per_period(period, dt, "dt")
+    except ValueError as exc:
+        raise ValueError(
+            f"{exc}; the estimator needs an integer number of samples per period "
+            "(resample the data, e.g. with scipy.signal.resample, so that "
+            "period/dt is an integer)") from None
+    nu, ny = records[0][1].shape[0], records[0][2].shape[0]
+    for i, (t, u, y, _) in enumerate(records):
+        if u.shape[0] != nu or y.shape[0] != ny:
+            raise ControlDimension(f"data[{i}] has {u.shape[0]} inputs and {y.shape[0]} "
+                                   f"outputs, data[0] has {nu} and {ny}")
+    windows = []                                   # (record, start, stop)
+    for i, (t, _, _, _) in enumerate(records):
+        if segments is None:
+            windows.append((i, 0, t.size))
+            continue
+        for start, stop in segments:
+            if not 0 <= start < stop <= t.size:
+                raise ValueError(f"segments entry [{start}, {stop}) does not fit "
+                                 f"data[{i}] with {t.size} samples")
+            windows.append((i, start, stop))
+    nperiods = np.array([(stop - start) // nper for _, start, stop in windows])
+    if np.any(nperiods < 1):
+        raise ValueError(f"a record or segment is shorter than one period "
+                         f"({nper} samples of dt={dt}); period={period}")
+    L = int(nperiods.min())
+    if np.any(nperiods > L):
+        warnings.warn(f"windows hold between {L} and {nperiods.max()} periods; all are "
+                      f"cut to the common {L} periods (data discarded)",
+                      UserWarning, stacklevel=3)
+    ns = L * nper
+    if ns <= 2 * nharmonics * L:
+        raise ValueError(f"nharmonics={nharmonics} needs more than {2 * nharmonics} "
+                         f"samples per period, got {nper}")
+    omega = 2 * np.pi * np.fft.fftfreq(ns, dt)
+    U = np.empty((len(windows), nu, ns), complex)
+    Y = np.empty((len(windows), ny, ns), complex)
+    for w, (i, start, _) in enumerate(windows):
+        t, u, y, _ = records[i]
+        # X(ω_i) = dt Σ_n x(t_n) e^{-jω_i t_n}, t_n absolute (phase reference t = 0)
+        shift = np.exp(-1j * omega * t[start])
+        U[w] = dt * np.fft.fft(u[:, start:start + ns], axis=-1) * shift
+        Y[w] = dt * np.fft.fft(y[:, start:start + ns], axis=-1) * shift
+    return U, Y, L, dt
+
+
+def _output_bins(U, L, K, threshold):
+    """Output bins m >= 0 whose regressors U(m - kL), |k| <= K, are all excited."""
+    ns = U.shape[-1]
+    power = np.sum(np.abs(U) ** 2, axis=0)                      # (nu, Ns)
+    silent = np.nonzero(power.max(axis=1) == 0)[0]
+    if silent.size:
+        raise ValueError(f"input(s) {silent.tolist()} are identically zero in every "
+                         "window; nothing can be estimated for them")
+    excited = power >= threshold * power.max(axis=1, keepdims=True)
+    m = np.arange(ns // 2 - K * L) if ns // 2 > K * L else np.arange(0)
+    k = np.arange(-K, K + 1)
+    idx = m[:, None] - k[None, :] * L                           # (M, 2K+1)
+    ok = np.all(excited[:, idx % ns], axis=(0, 2))
+    return m, ok, excited
+
+
+def _regressor(U, bins, L, K):
+    """Φ_r(i) rows: (R, F, P) with column (k+K)·nu + j = U_{r,j}(i - kL)."""
+    ns = U.shape[-1]
+    k = np.arange(-K, K + 1)
+    idx = (bins[:, None] - k[None, :] * L) % ns                 # (F, 2K+1)
+    phi = U[:, :, idx]                                          # (R, nu, F, 2K+1)
+    return np.transpose(phi, (0, 2, 3, 1)).reshape(U.shape[0], bins.size, -1)
+
+
+# ------------------------------------------------------------- solvers
+def _solve_bins(phi, Yb):
+    """Per-frequency least squares (3.31): g, trace of the hat matrix, variances.
+
+    ``Φ_UU⁺`` (pseudo-inverse) gives the minimum-norm solution where Φ_UU is
+    singular; the caller warns about such frequencies.
+    """
+    puu = np.einsum('rfa,rfb->fab', phi.conj(), phi)
+    puy = np.einsum('rfa,rfo->fao', phi.conj(), Yb)
+    pinv = np.linalg.pinv(puu, rcond=1e-13, hermitian=True)
+    g = pinv @ puy
+    trace = float(np.real(np.einsum('fab,fba->', pinv, puu)))     # Σ_f rank Φ_UU(f)
+    var = np.real(np.diagonal(pinv, axis1=1, axis2=2))             # (F, P)
+    return g, trace, var
+
+
+def _penalty(nfreq, nunk):
+    """Curvature penalty D₂ᵀD₂ ⊗ I_P for frequency-major stacking (sparse)."""
+    d2 = sp.diags([np.ones(nfreq - 2), -2 * np.ones(nfreq - 2), np.ones(nfreq - 2)],
+                  [0, 1, 2], shape=(nfreq - 2, nfreq))
+    return sp.kron(d2.T @ d2, sp.identity(nunk), format='csc')
+
+
+def _factor_blocks(phi, puu):
+    """Per-bin square roots ``B_f = L_f L_fᴴ`` with min(R, P) columns."""
+    nrec, _, nunk = phi.shape
+    if nrec <= nunk:
+        return np.transpose(phi.conj(), (1, 2, 0))              # (F, P, R)
+    lam, vec = np.linalg.eigh(puu)
+    return vec * np.sqrt(np.clip(lam, 0, None))[:, None, :]
+
+
+def _solve_joint(phi, Yb, alpha, penalty, scale, want_var, max_entries=2 ** 22):
+    """Regularised joint solve (3.35); returns g, tr H and Var-diagonal or None."""
+    nrec, nfreq, nunk = phi.shape
+    puu = np.einsum('rfa,rfb->fab', phi.conj(), phi)
+    puy = np.einsum('rfa,rfo->fao', phi.conj(), Yb)
+    # blkdiag Φ_UU(f): entry (fP + a, fP + b)
+    rows = (np.arange(nfreq)[:, None, None] * nunk + np.arange(nunk)[None, :, None])
+    rows = np.broadcast_to(rows, puu.shape)
+    cols = np.swapaxes(rows, 1, 2)
+    blk = sp.coo_matrix((puu.ravel(), (rows.ravel(), cols.ravel())),
+                        shape=(nfreq * nunk,) * 2)
+    amat = (blk + alpha * scale * penalty).tocoo()
+    # banded upper storage ab[u + i - j, j] = A[i, j] (bandwidth u = 3P - 1)
+    upper = 3 * nunk - 1
+    keep = amat.row <= amat.col
+    ab = np.zeros((upper + 1, nfreq * nunk), complex)
+    np.add.at(ab, (upper + amat.row[keep] - amat.col[keep], amat.col[keep]),
+              amat.data[keep])
+    try:
+        chol = (scipy.linalg.cholesky_banded(ab), False)
+    except np.linalg.LinAlgError:
+        raise ValueError("the regularised normal equations are singular: the data "
+                         "do not determine the components; increase alpha or the "
+                         "excitation") from None
+
+    def solve(rhs):
+        return scipy.linalg.cho_solve_banded(chol, rhs)
+
+    g = solve(puy.reshape(nfreq * nunk, -1)).reshape(nfreq, nunk, -1)
+    # tr H = tr(A⁻¹ B) and diag(A⁻¹ B A⁻¹) with B = Σ_f L_f L_fᴴ, column by column
+    lf = _factor_blocks(phi, puu)                               # (F, P, c)
+    ncol = lf.shape[2]
+    per = max(1, max_entries // (nfreq * nunk * ncol))      # bins per dense block
+    trace, var = 0.0, np.zeros(nfreq * nunk)
+    for f0 in range(0, nfreq, per):
+        f1 = min(nfreq, f0 + per)
+        rhs = np.zeros((nfreq * nunk, (f1 - f0) * ncol), complex)
+        for f in range(f0, f1):
+            rhs[f * nunk:(f + 1) * nunk, (f - f0) * ncol:(f - f0 + 1) * ncol] = lf[f]
+        x = solve(rhs)
+        trace += float(np.real(np.vdot(rhs, x)))
+        if want_var:
+            var += np.sum(np.abs(x) ** 2, axis=1)
+    return g, trace, (var.reshape(nfreq, nunk) if want_var else None)
+
+
+def _residual(phi, Yb, g):
+    """Squared residual norm per output, Σ_{r,f} |Y_r - φ_rᵀ g|²."""
+    e = Yb - np.einsum('rfa,fao->rfo', phi, g)
+    return np.sum(np.abs(e) ** 2, axis=(0, 1))
+
+
+def _gcv_search(phi, Yb, penalty, scale, progress):
+    """Relative α minimising GCV(α) = n |Y - Ŷ_α|² / (n - tr H_α)²."""
+    n = phi.shape[0] * phi.shape[1]
+
+    def score(log_alpha):
+        g, tr, _ = _solve_joint(phi, Yb, 10.0 ** log_alpha, penalty, scale, False)
+        return n * _residual(phi, Yb, g).sum() / max(n - tr, 1e-12) ** 2
+
+    logs = np.log10(_GCV_GRID)
+    scores = np.array([score(a) for a in tqdm(logs, desc="GCV", leave=False,
+                                             disable=(not progress) or None)])
+    best = int(np.argmin(scores))
+    if best in (0, logs.size - 1):
+        warnings.warn(f"GCV minimum at the edge of the searched range "
+                      f"(alpha={_GCV_GRID[best]:.1e}); the estimate may be over- or "
+                      "under-smoothed", UserWarning, stacklevel=4)
+        return float(_GCV_GRID[best])
+    res = scipy.optimize.minimize_scalar(score, bounds=(logs[best - 1], logs[best + 1]),
+                                         method='bounded', options={'xatol': 0.02})
+    return float(10.0 ** (res.x if res.fun <= scores[best] else logs[best]))
+
+
+# ------------------------------------------------------------- public API
+def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
+              omega_limits=None, threshold=1e-2, progress=True):
+    """Core of `estimate_htf`; returns an `HTFEstimate`."""
+    period = check_period(period)
+    K = check_positive_int(nharmonics, "nharmonics", minimum=0)
+    records = _as_records(data)
+    if segments is not None:
+        segments = np.asarray(segments)
+        if segments.ndim != 2 or segments.shape[1] != 2 or segments.dtype.kind not in "iu":
+            raise ControlDimension(f"segments must be an integer array of shape "
+                                   f"(nseg, 2), got {segments.shape} {segments.dtype}")
+    threshold = float(real_array(threshold, "threshold", ndim=0))
+    if not 0 < threshold < 1:
+        raise ValueError(f"threshold must lie in (0, 1), got {threshold}")
+    if isinstance(alpha, str):
+        if alpha != 'gcv':
+            raise ValueError(f"alpha must be a non-negative number or 'gcv', got {alpha!r}")
+    else:
+        alpha = float(real_array(alpha, "alpha", ndim=0))
+        if alpha < 0:
+            raise ValueError(f"alpha must be >= 0, got {alpha}")
+
+    U, Y, L, dt = _spectra(records, period, K, segments)
+    nrec, nu, ns = U.shape
+    nunk = (2 * K + 1) * nu
+    wgrid = 2 * np.pi / (L * period)
+    m, ok, excited = _output_bins(U, L, K, threshold)
+    if omega_limits is not None:
+        lim = real_array(omega_limits, "omega_limits", ndim=1)
+        if lim.size != 2 or not 0 <= lim[0] < lim[1]:
+            raise ValueError(f"omega_limits must be (wmin, wmax) with 0 <= wmin < wmax, "
+                             f"got {lim}")
+        inside = (m * wgrid >= lim[0]) & (m * wgrid <= lim[1])
+        if np.any(inside & ~ok):
+            warnings.warn(f"{np.sum(inside & ~ok)} frequencies in omega_limits have "
+                          f"unexcited shifted inputs ω - kω_p (|k| <= {K}) and are "
+                          f"{'dropped' if alpha == 0 else 'interpolated'}",
+                          UserWarning, stacklevel=3)
+        m, ok = m[inside], ok[inside]
+    if not np.any(ok):
+        top = np.max(np.nonzero(excited.any(axis=0)[:ns // 2])[0], initial=0) * wgrid
+        raise ValueError(
+            f"nharmonics={K} is too large for the excited band: no output frequency "
+            f"has all shifted inputs ω - kω_p, |k| <= {K}, excited (input excited up to "
+            f"{top:.4g} rad/s, 2Kω_p = {2 * K * 2 * np.pi / period:.4g} rad/s); reduce "
+            "nharmonics, widen the excitation or lower threshold")
+    if alpha == 0:
+        if nrec < nunk:
+            raise ValueError(
+                f"alpha=0 needs at least (2K+1)·nu = {nunk} records or segments, got "
+                f"{nrec}; use phase-shifted replicas (chirp_replicas) or alpha > 0 / "
+                "alpha='gcv'")
+        bins = m[ok]
+    else:
+        # contiguous band: unexcited bins inside it are bridged by the penalty
+        first, last = m[ok][0], m[ok][-1]
+        bins = np.arange(first, last + 1)
+        if bins.size < 3:
+            raise ValueError("the curvature penalty needs at least 3 frequencies; "
+                             "lengthen the records or widen the band")
+
+    phi = _regressor(U, bins, L, K)
+    Yb = np.transpose(Y[:, :, bins], (0, 2, 1))                 # (R, F, ny)
+    puu = np.einsum('rfa,rfb->fab', phi.conj(), phi)
+    sv = np.linalg.svd(puu, compute_uv=False)
+    cond = np.divide(sv[:, 0], sv[:, -1], out=np.full(bins.size, np.inf),
+                     where=sv[:, -1] > 0)
+    n = nrec * bins.size
+    if alpha == 0:
+        if np.max(cond) > _COND_WARN:
+            bad = bins[cond > _COND_WARN] * wgrid
+            warnings.warn(
+                f"Φ_UU is ill-conditioned at {bad.size} frequencies (cond up to "
+                f"{np.max(cond):.2g}, e.g. ω = {bad[0]:.4g} rad/s): the records do not "
+                f"separate the {2 * K + 1} components; use >= {2 * K + 1} phase-shifted "
+                "replicas or alpha > 0", UserWarning, stacklevel=3)
+        g, trace, var = _solve_bins(phi, Yb)
+    else:
+        penalty = _penalty(bins.size, nunk)
+        scale = float(np.mean(np.real(np.trace(puu, axis1=1, axis2=2)))) / nunk
+        if alpha == 'gcv':
+            alpha = _gcv_search(phi, Yb, penalty, scale, progress)
+        g, trace, var = _solve_joint(phi, Yb, alpha, penalty, scale, True)
+    sq = _residual(phi, Yb, g)
+    dof = n - trace
+    has_dof = dof > 1e-6 * n
+    noise_var = sq / dof if has_dof else np.full(sq.shape, np.nan)
+    # Var Ĝ_k[o, j](ω_f) = σ_o² · var[f, (k+K)nu + j]
+    std = np.sqrt(var[None, :, :] * noise_var[:, None, None])   # (ny, F, P)
+    std = np.transpose(std.reshape(-1, bins.size, 2 * K + 1, nu), (2, 0, 3, 1))
+    comps = np.transpose(g.reshape(bins.size, 2 * K + 1, nu, -1), (1, 3, 2, 0))
+    labels = next((rec[3] for rec in records if rec[3]), {})
+    return HTFEstimate(
+        components=comps, omega=bins * wgrid, period=period, std=std, cond=cond,
+        residual=np.sqrt(sq / n), noise_var=noise_var, alpha=float(alpha),
+        dof=float(dof), gcv=float(n * sq.sum() / dof ** 2) if has_dof else np.inf,
+        nrecords=nrec, labels=labels)
+
+
+def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
+                 omega_limits=None, threshold=1e-2, progress=True, name=None,
+                 **kwargs):
+    """Estimate harmonic transfer functions from input-output data.
+
+    Nonparametric least-squares estimate of ``G_k(jω)``, k = -K..K, in
+    ``Y(jω) = Σ_k G_k(jω) U(jω - jkω_p)`` (thesis eqs. 3.27-3.35, Siddiqi's
+    estimator with curvature regularisation).
+
+    Parameters
+    ----------
+    data : TimeResponseData, tuple or list
+        One or more records: `control.TimeResponseData` objects (each trace
+        is a record) or tuples ``(t, u, y)`` with ``u`` of shape (nt,) or
+        (nu, nt) and ``y`` of shape (nt,) or (ny, nt).  Time must be
+        uniformly sampled with ``period/dt`` an integer; ``t = 0`` is the
+        phase reference of the periodic system.
+    period : float
+        Known period T of the system.
+    nharmonics : int
+        Number K of harmonics on each side (2K+1 components).
+    segments : array_like of int, shape (nseg, 2), optional
+        ``[start, stop)`` sample windows applied to every record, e.g. the
+        ``segments`` of `chirp_replicas`; default is the whole record.  Each
+        window is cut to the largest integer number of periods common to all
+        windows.
+    alpha : float or 'gcv', optional
+        Curvature weight relative to the mean diagonal of ``Φ_UU``.  0
+        (default) solves each frequency separately (eq. 3.31) and needs at
+        least ``(2K+1)·nu`` windows; ``alpha > 0`` solves eq. 3.35; ``'gcv'``
+        picks α by generalised cross-validation.
+    omega_limits : (float, float), optional
+        Output frequency range (rad/s).  Default: every frequency at which
+        all shifted inputs ``ω - kω_p`` are excited.
+    threshold : float, optional
+        Input power, relative to its maximum, below which a DFT bin counts
+        as unexcited (default 1e-2).
+    progress : bool, optional
+        Show a progress bar during the GCV search (default True; shown only
+        on terminals).
+    name : str, optional
+        Name of the returned HTF.
+
+    Returns
+    -------
+    HTF
+        Data HTF on the estimated grid, with ``std`` (standard deviation of
+        each component; None when the residual has no degrees of freedom,
+        e.g. exactly ``(2K+1)·nu`` windows) and ``diagnostics`` holding
+        ``cond`` (of ``Φ_UU`` per frequency), ``residual`` (RMS per output),
+        ``noise_var``, ``alpha``, ``dof``, ``gcv`` and ``nrecords``.
+
+    Warns
+    -----
+    UserWarning
+        Ill-conditioned ``Φ_UU`` with ``alpha=0``; windows of unequal length;
+        unexcited frequencies inside `omega_limits`; GCV minimum at the edge
+        of the searched range.
+
+    Notes
+    -----
+    Output noise is assumed white when estimating ``std``; bins and
+    windows are treated as independent.  The penalty acts on the grid
+    ``2π/(L T)``, so α depends on the record length.
+
+    Examples
+    --------
+    A memoryless periodic gain ``y = (1 + cos ω_p t) u`` has
+    ``G_0 = 1`` and ``G_{±1} = 1/2``:
+
+    >>> T, dt = 1.0, 0.01
+    >>> exc = ltp.chirp_replicas(T, 3, 8.0, 0.1, 20.0, dt=dt)
+    >>> y = (1 + np.cos(2 * np.pi * exc.time / T)) * exc.inputs
+    >>> H = ltp.estimate_htf((exc.time, exc.inputs, y), T, 1,
+    ...                      segments=exc.segments)
+    >>> w, G = H.components()
+    >>> np.round(G[:, 0, 0, 10].real, 6).tolist()
+    [0.5, 1.0, 0.5]
+    """
+    check_kwargs(kwargs, "estimate_htf")
+    est = _estimate(data, period, nharmonics, segments=segments, alpha=alpha,
+                    omega_limits=omega_limits, threshold=threshold, progress=progress)
+    diagnostics = {"cond": est.cond, "residual": est.residual,
+                   "noise_var": est.noise_var, "alpha": est.alpha, "dof": est.dof,
+                   "gcv": est.gcv, "nrecords": est.nrecords}
+    std = est.std if np.all(np.isfinite(est.std)) else None
+    return HTF(est.components, est.omega, est.period, std=std,
+               diagnostics=diagnostics, name=name,
+               inputs=est.labels.get("inputs"), outputs=est.labels.get("outputs"))

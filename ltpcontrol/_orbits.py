@@ -1,0 +1,481 @@
+"""Periodic orbits of clock-driven plants and their LTP linearisation.
+
+A plant forced with period T (a continuous-time `control.NonlinearIOSystem`
+whose update function depends periodically on t, or a `HybridPlant`) has a
+T-periodic steady state ``x̄(t)``: a fixed point of the period map
+``P: x(0) -> x(T)``.  `periodic_orbit` finds it by Newton's method on
+``P(x) − x = 0`` (shooting), with the exact Jacobian of ``P`` from the
+variational equations and saltation matrices at the events, falling back to
+forward simulation when Newton does not converge.  `linearize_orbit` turns
+the orbit into the LTP model of thesis eqs. (3.2)-(3.4), or for hybrid
+plants the time-switching approximation of eqs. (3.6)-(3.9).
+"""
+
+import numbers
+import warnings
+
+import numpy as np
+from control import NonlinearIOSystem
+from control.exception import ControlArgument, ControlDimension
+
+from ._hybrid import (HybridMode, HybridPlant, _central_jacobian, _constant_input,
+                      _Flow, _params, _solver_options)
+from ._periodic_matrix import PeriodicMatrix
+from ._validation import check_kwargs, check_period, check_positive_int, real_array
+
+__all__ = ['PeriodicOrbit', 'periodic_orbit', 'period_map', 'linearize_orbit']
+
+
+class PeriodicOrbit:
+    """T-periodic steady state of a forced (hybrid) plant.
+
+    Returned by `periodic_orbit`; not meant to be built directly.  Calling
+    the object, ``orbit(t)``, evaluates ``x̄(t mod T)`` from the solver's
+    dense output (shape ``(n,)`` for scalar t, ``(n, len(t))`` otherwise).
+
+    Attributes
+    ----------
+    period : float
+        The period T.
+    x0 : ndarray
+        Orbit state at t = 0.
+    mode0 : int
+        Mode active at t = 0.
+    time : ndarray, shape (npoints,)
+        Uniform grid ``k T / npoints`` over one period.
+    states : ndarray, shape (n, npoints)
+        Orbit states on `time`.
+    modes : ndarray of int, shape (npoints,)
+        Active mode on `time`.
+    switching_times : ndarray
+        Event times in ``(0, T)`` along the orbit.
+    mode_sequence : list of int
+        Modes active on ``[0, t_1), [t_1, t_2), ..., [t_M, T)``.
+    saltation_matrices : list of ndarray
+        Saltation matrix of each event.
+    monodromy : ndarray, shape (n, n)
+        Jacobian of the period map at ``x0``: the exact linearised return
+        map, including the saltation matrices of hybrid events.
+    multipliers : ndarray
+        Eigenvalues of `monodromy` (Floquet multipliers).
+    is_stable : bool
+        True when all multipliers lie strictly inside the unit circle.
+    residual : float
+        Final relative residual ``‖P(x0) − x0‖∞ / (1 + ‖x0‖∞)``.
+    iterations : int
+        Newton iterations of the successful attempt.
+    periods_simulated : int
+        Periods of forward simulation used before convergence.
+    plant : HybridPlant
+        The plant as a hybrid plant (a smooth system becomes one mode).
+    params : dict
+        Parameters used.
+    u0 : ndarray
+        Constant input along the orbit.
+    """
+
+    def __init__(self, plant, period, flow, x0, mode0, npoints, params, u0,
+                 residual, iterations, periods):
+        self.plant, self.period, self._flow = plant, period, flow
+        self.x0, self.mode0, self.params, self.u0 = np.array(x0), mode0, params, u0
+        self.time = np.arange(npoints) * period / npoints
+        self.states, self.modes = flow.evaluate(self.time)
+        self.switching_times = np.array([e[0] for e in flow.events])
+        self.mode_sequence = [mode0] + [e[2] for e in flow.events]
+        self.saltation_matrices = list(flow.saltations)
+        self.monodromy = flow.phi
+        self.multipliers = np.linalg.eigvals(self.monodromy)
+        self.is_stable = bool(np.all(np.abs(self.multipliers) < 1))
+        self.residual, self.iterations, self.periods_simulated = residual, iterations, periods
+
+    def __call__(self, t):
+        tarr = real_array(t, 't', ndim=(0, 1))
+        states, _ = self._flow.evaluate(np.mod(np.atleast_1d(tarr), self.period))
+        return states[:, 0] if tarr.ndim == 0 else states
+
+    def __repr__(self):
+        mags = ', '.join(f'{abs(m):.4g}' for m in self.multipliers)
+        return (f"<PeriodicOrbit period={self.period:g}, {len(self.switching_times)} events, "
+                f"|multipliers|=[{mags}], stable={self.is_stable}>")
+
+
+def _as_hybrid(plant, jacobian):
+    """A `HybridPlant` view of `plant` (a smooth system becomes one mode)."""
+    if jacobian is not None and not callable(jacobian):
+        raise ControlArgument(f"jacobian must be callable, got {type(jacobian).__name__}")
+    if isinstance(plant, HybridPlant):
+        if jacobian is not None:
+            raise ValueError("jacobian applies to NonlinearIOSystem plants; give each "
+                             "HybridMode its own jacobian")
+        return plant
+    if not isinstance(plant, NonlinearIOSystem):
+        raise ControlArgument("plant must be a control.NonlinearIOSystem or a HybridPlant, "
+                              f"got {type(plant).__name__}")
+    if plant.dt != 0:
+        raise ValueError(f"plant must be a continuous-time system, got dt={plant.dt}")
+    if plant.outfcn is None and plant.noutputs != plant.nstates:
+        raise ControlDimension("plant has no output function but its outputs are not the states")
+    mode = HybridMode(plant.updfcn, name=plant.name, jacobian=jacobian)
+    return HybridPlant([mode], plant.outfcn, states=plant.state_labels,
+                       inputs=plant.input_labels, outputs=plant.output_labels,
+                       params=plant.params, name=plant.name)
+
+
+def _check_periodicity(plant, period, x0, u0, params):
+    """Raise when a vector field or guard is not T-periodic in t."""
+    probes = period * np.array([0.1234567, 0.5, 0.8765432])
+    bumps = np.linspace(-1.0, 1.0, plant.nstates) * 0.1 * (1 + np.abs(x0))
+    for i, mode in enumerate(plant.modes):
+        checks = [('updfcn', lambda t, x: plant._f(i, t, x, u0, params))]
+        if mode.guard is not None:
+            checks.append(('guard', lambda t, x: plant._g(i, t, x, u0, params)))
+        for label, func in checks:
+            for t in probes:
+                for x in (x0, x0 + bumps):
+                    a, b = np.asarray(func(t, x)), np.asarray(func(t + period, x))
+                    if not np.allclose(a, b, rtol=1e-8, atol=1e-10 * (1 + np.abs(a).max())):
+                        raise ValueError(
+                            f"plant is not periodic with period={period:g}: {label} of mode "
+                            f"{plant.mode_names[i]!r} differs between t={t:.6g} and t+T "
+                            f"(max difference {np.abs(a - b).max():.3g})")
+
+
+def _prepare(plant, period, x0, mode0, u0, params, jacobian):
+    hp = _as_hybrid(plant, jacobian)
+    period = check_period(period)
+    x0 = real_array(x0, 'x0', ndim=(0, 1)).reshape(-1)
+    if x0.size != hp.nstates:
+        raise ControlDimension(f"x0 must have {hp.nstates} entries, got {x0.size}")
+    mode0 = hp.mode_index(mode0, 'mode0')
+    u0 = _constant_input(hp, u0, 'u0')
+    return hp, period, x0, mode0, u0, _params(hp, params)
+
+
+def period_map(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=False, **kwargs):
+    """Stroboscopic period map ``x(0) -> x(T)`` of a forced (hybrid) plant.
+
+    Parameters
+    ----------
+    plant : control.NonlinearIOSystem or HybridPlant
+        Continuous-time plant.
+    period : float
+        Period T.
+    x0 : array_like
+        State at t = 0.
+    mode0 : int or str, optional
+        Mode at t = 0 (hybrid plants).
+    u0 : array_like, optional
+        Constant input (zero by default).
+    params : dict, optional
+        Parameters overriding the plant's defaults.
+    jacobian : bool, optional
+        Also return the Jacobian of the map from the variational equations
+        and saltation matrices.
+    rtol, atol, method, max_events : optional
+        Integration settings, as in `simulate_hybrid`.
+
+    Returns
+    -------
+    x_T : ndarray
+        State at t = T.
+    mode_T : int
+        Mode at t = T.
+    jac : ndarray, shape (n, n)
+        Jacobian ``∂x(T)/∂x(0)`` (only with ``jacobian=True``).
+
+    Examples
+    --------
+    For ``dx/dt = -x + cos t`` the period map over 2π is affine with slope
+    ``e^{-2π}``:
+
+    >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t), None, states=1, inputs=0)
+    >>> xT, mode, J = ltp.period_map(sys, 2 * np.pi, [0.0], jacobian=True)
+    >>> bool(np.isclose(J[0, 0], np.exp(-2 * np.pi)))
+    True
+    """
+    opts = _solver_options(kwargs, 'period_map')
+    check_kwargs(kwargs, 'period_map')
+    if not isinstance(jacobian, (bool, np.bool_)):
+        raise ControlArgument(f"jacobian must be True or False, got {jacobian!r}")
+    hp, period, x0, mode0, u0, params = _prepare(plant, period, x0, mode0, u0, params, None)
+    flow = _Flow(hp, 0.0, period, x0, mode0, lambda t: u0, params,
+                 variational=bool(jacobian), **opts)
+    if jacobian:
+        return flow.x_final, flow.mode_final, flow.phi
+    return flow.x_final, flow.mode_final
+
+
+def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=None,
+                   warmup=0, tol=1e-10, max_iter=20, max_periods=200, npoints=200,
+                   **kwargs):
+    """T-periodic steady state (limit cycle) of a periodically forced plant.
+
+    Solves ``P(x) = x`` for the period map ``P`` by Newton's method
+    (shooting) with the exact Jacobian: variational equations
+    ``dΦ/dt = ∂f/∂x Φ`` within each mode and saltation matrices at events.
+    When Newton fails (divergence, a change of the mode sequence, no
+    progress) the plant is simulated forward in blocks of 10 periods
+    and Newton is retried from the new state, up to `max_periods` periods.
+    Newton converges to the orbit nearest the guess, stable or not; to land
+    on the attracting orbit reached from a given initial condition, first
+    simulate `warmup` periods.  Forward simulation only supplies starting
+    guesses and uses tolerances of at most 1e-8 (relative) and 1e-10
+    (absolute); the final orbit is computed with the given ones.
+
+    Parameters
+    ----------
+    plant : control.NonlinearIOSystem or HybridPlant
+        Continuous-time plant whose vector fields (and guards) are
+        T-periodic in t; checked at sample points.
+    period : float
+        Forcing period T.
+    x0 : array_like
+        Initial guess of the orbit state at t = 0.
+    mode0 : int or str, optional
+        Mode of `x0` (hybrid plants).
+    u0 : array_like, optional
+        Constant input held along the orbit (zero by default).
+    params : dict, optional
+        Parameters overriding the plant's defaults.
+    jacobian : callable, optional
+        ``jacobian(t, x, u, params) -> ∂f/∂x`` for a `NonlinearIOSystem`
+        plant (central differences otherwise).  Hybrid plants carry it in
+        each `HybridMode`.
+    warmup : int, optional
+        Periods simulated forward before shooting starts (default 0).
+    tol : float, optional
+        Convergence threshold on ``‖P(x) − x‖∞ / (1 + ‖x‖∞)`` (1e-10).
+    max_iter : int, optional
+        Newton iterations per attempt (20).
+    max_periods : int, optional
+        Budget of forward-simulated periods after a failed Newton attempt
+        (200).
+    npoints : int, optional
+        Number of grid points of the stored orbit (200).
+    rtol, atol, method, max_events : optional
+        Integration settings, as in `simulate_hybrid`.
+
+    Returns
+    -------
+    PeriodicOrbit
+
+    Raises
+    ------
+    ValueError
+        If the plant is not T-periodic.
+    RuntimeError
+        If neither Newton nor forward simulation converges; the message
+        lists what was tried.
+
+    Warns
+    -----
+    UserWarning
+        If a hybrid plant with guards never leaves its mode on the orbit.
+
+    Examples
+    --------
+    Forced linear oscillator ``ẍ + ẋ + x = cos t`` with the steady state
+    ``x̄ = sin t``:
+
+    >>> def f(t, x, u, p):
+    ...     return [x[1], -x[0] - x[1] + np.cos(t)]
+    >>> sys = ct.nlsys(f, None, states=2, inputs=0)
+    >>> orbit = ltp.periodic_orbit(sys, 2 * np.pi, [0.0, 0.0])
+    >>> bool(np.allclose(orbit.x0, [0.0, 1.0], atol=1e-9)), orbit.is_stable
+    (True, True)
+    """
+    opts = _solver_options(kwargs, 'periodic_orbit')
+    check_kwargs(kwargs, 'periodic_orbit')
+    hp, period, x0, mode0, u0, params = _prepare(plant, period, x0, mode0, u0, params, jacobian)
+    if not isinstance(tol, numbers.Real) or not 0 < tol < 1:
+        raise ValueError(f"tol must be a number in (0, 1), got {tol!r}")
+    max_iter = check_positive_int(max_iter, 'max_iter')
+    max_periods = check_positive_int(max_periods, 'max_periods', minimum=0)
+    warmup = check_positive_int(warmup, 'warmup', minimum=0)
+    npoints = check_positive_int(npoints, 'npoints', minimum=2)
+    _check_periodicity(hp, period, x0, u0, params)
+
+    def flow(x, mode, variational, options=opts):
+        return _Flow(hp, 0.0, period, x, mode, lambda t: u0, params,
+                     variational=variational, **options)
+
+    def relres(x, xT):
+        return np.max(np.abs(xT - x)) / (1 + np.max(np.abs(x)))
+
+    # forward simulation only supplies starting guesses: moderate tolerances
+    loose = dict(opts, rtol=max(opts['rtol'], 1e-8), atol=max(opts['atol'], 1e-10))
+
+    def simulate(x, mode, nper):
+        res = np.inf
+        for _ in range(nper):
+            fl = flow(x, mode, False, loose)
+            res = relres(x, fl.x_final) if fl.mode_final == mode else np.inf
+            x, mode = fl.x_final, fl.mode_final
+        return x, mode, res
+
+    tried = []
+    x, mode, periods = x0.copy(), mode0, warmup
+    if warmup:
+        x, mode, res = simulate(x, mode, warmup)
+        tried.append(f"warm-up simulation to t={warmup}T: residual {res:.3g}")
+    sim_x, sim_mode = x, mode
+    while True:
+        # Newton on P(x) − x = 0: (∂P/∂x − I) δ = −(P(x) − x)
+        last, stalled = np.inf, 0
+        for it in range(max_iter + 1):
+            fl = flow(x, mode, True)
+            if fl.mode_final != mode:
+                tried.append(f"Newton from t={periods}T: the period ends in mode "
+                             f"{hp.mode_names[fl.mode_final]!r}, not {hp.mode_names[mode]!r}")
+                break
+            res = relres(x, fl.x_final)
+            if res <= tol:
+                return _finish(hp, period, fl, x, mode, npoints, params, u0, res, it, periods)
+            stalled = stalled + 1 if res > 0.9 * last else 0
+            if res > 1e3 * last or stalled >= 3 or it == max_iter:
+                tried.append(f"Newton from t={periods}T: residual {res:.3g} after {it} "
+                             "iterations" + (" (no progress)" if stalled >= 3 else ""))
+                break
+            last = res
+            # least squares handles neutral directions (multipliers equal to 1)
+            step, _, rank, _ = np.linalg.lstsq(fl.phi - np.eye(hp.nstates), x - fl.x_final,
+                                               rcond=None)
+            if rank == 0:
+                tried.append(f"Newton from t={periods}T: the period map is the identity "
+                             "to first order (all multipliers 1)")
+                break
+            if np.max(np.abs(step)) > 10 * (1 + np.max(np.abs(x))):
+                tried.append(f"Newton from t={periods}T: step of size "
+                             f"{np.max(np.abs(step)):.3g} rejected (divergence)")
+                break
+            x = x + step
+        if periods >= warmup + max_periods:
+            break
+        # fall back to forward simulation towards an attracting orbit
+        nper = min(10, warmup + max_periods - periods)
+        sim_x, sim_mode, res = simulate(sim_x, sim_mode, nper)
+        x, mode, periods = sim_x, sim_mode, periods + nper
+        tried.append(f"forward simulation to t={periods}T: residual {res:.3g}")
+    raise RuntimeError("periodic_orbit did not converge to a T-periodic orbit "
+                       f"(tol={tol:g}); tried: " + "; ".join(tried) +
+                       ". The response may be unbounded, quasi-periodic, chaotic or periodic "
+                       "with a multiple of the period; try another x0, a warm-up or a larger "
+                       "max_periods.")
+
+
+def _finish(hp, period, fl, x, mode, npoints, params, u0, res, iterations, periods):
+    has_guards = any(m.guard is not None for m in hp.modes)
+    if has_guards and not fl.events:
+        warnings.warn(f"no guard is crossed on the periodic orbit: it stays in mode "
+                      f"{hp.mode_names[mode]!r} for the whole period", UserWarning, stacklevel=3)
+    return PeriodicOrbit(hp, period, fl, x, mode, npoints, params, u0, res, iterations, periods)
+
+
+def _along_orbit(orbit, func):
+    """Callable ``t -> func(mode, t, x̄(t))`` accepting scalar or 1D array t."""
+    def along(t):
+        tarr = np.atleast_1d(np.asarray(t, float))
+        states, modes = orbit._flow.evaluate(np.mod(tarr, orbit.period))
+        values = np.array([func(modes[k], tk, states[:, k]) for k, tk in enumerate(tarr)])
+        return values if np.ndim(t) else values[0]
+    return along
+
+
+def _segment_average(func, a, b):
+    """Mean of ``func`` over ``[a, b]`` by 20-point Gauss-Legendre quadrature."""
+    nodes, weights = np.polynomial.legendre.leggauss(20)
+    t = 0.5 * (a + b) + 0.5 * (b - a) * nodes
+    return np.einsum('k,kij->ij', weights, func(t)) / 2
+
+
+def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, name=None):
+    """LTP model of a plant linearised about its periodic orbit.
+
+    ``A(t) = ∂f/∂x``, ``B(t) = ∂f/∂u``, ``C(t) = ∂h/∂x``, ``D(t) = ∂h/∂u``
+    evaluated on the orbit (thesis eqs. 3.2-3.4), analytic where the plant
+    provides Jacobians and by central differences otherwise.  For a hybrid
+    orbit the mode switches are frozen at the orbit's switching times, giving
+    the switching LTP model of eqs. (3.6)-(3.7); with
+    ``piecewise_constant=True`` each mode's matrices are replaced by their
+    average over its interval (the piecewise LTI model 3.8-3.9).
+
+    The time-switching model ignores the state dependence of the switching
+    instants and the reset maps; its monodromy matrix therefore differs from
+    the exact return-map Jacobian `PeriodicOrbit.monodromy` when events
+    have jumps or discontinuous vector fields.
+
+    Parameters
+    ----------
+    plant : control.NonlinearIOSystem or HybridPlant
+        The plant the orbit was computed for.
+    orbit : PeriodicOrbit
+        Result of `periodic_orbit`.
+    piecewise_constant : bool, optional
+        Average the matrices over each mode interval (3.8-3.9).
+    jacobian : callable, optional
+        ``∂f/∂x`` of a `NonlinearIOSystem` plant, as in `periodic_orbit`.
+    name : str, optional
+        Name of the LTP system (default: the plant's name + ``'$lin'``).
+
+    Returns
+    -------
+    LTPStateSpace
+        Continuous-time LTP model with the orbit's period, in deviation
+        coordinates ``x − x̄(t)``, ``u − u0``, ``y − ȳ(t)``.
+
+    Examples
+    --------
+    >>> def f(t, x, u, p):
+    ...     return [x[1], -(1 + 0.1 * np.cos(t)) * x[0] - x[1] + np.cos(t) + u[0]]
+    >>> sys = ct.nlsys(f, None, states=2, inputs=1)
+    >>> orbit = ltp.periodic_orbit(sys, 2 * np.pi, [0.0, 0.0])
+    >>> lin = ltp.linearize_orbit(sys, orbit)
+    >>> bool(np.allclose(np.sort(np.abs(lin.floquet_multipliers())),
+    ...                  np.sort(np.abs(orbit.multipliers)), rtol=1e-6))
+    True
+    """
+    from ._ltpsys import ltpss
+
+    hp = _as_hybrid(plant, jacobian)
+    if not isinstance(orbit, PeriodicOrbit):
+        raise ControlArgument(f"orbit must be a PeriodicOrbit, got {type(orbit).__name__}")
+    if orbit.plant.nstates != hp.nstates or orbit.plant.mode_names != hp.mode_names:
+        raise ValueError("orbit was computed for a plant with different states or modes")
+    if hp.ninputs == 0:
+        raise ValueError("plant has no inputs: an LTP model needs at least one input")
+    if not isinstance(piecewise_constant, (bool, np.bool_)):
+        raise ControlArgument(f"piecewise_constant must be True or False, "
+                              f"got {piecewise_constant!r}")
+    if name is not None and not isinstance(name, str):
+        raise ControlArgument(f"name must be a string, got {name!r}")
+    params, u0, T = orbit.params, orbit.u0, orbit.period
+
+    def h_of(t, x, u):
+        return hp._h(t, x, u, params)
+
+    derivatives = {
+        'A': lambda i, t, x: hp._dfdx(i, t, x, u0, params),
+        'B': lambda i, t, x: hp._dfdu(i, t, x, u0, params),
+        'C': lambda i, t, x: _central_jacobian(lambda z: h_of(t, z, u0), x),
+        'D': lambda i, t, x: _central_jacobian(lambda v: h_of(t, x, v), u0),
+    }
+    times = np.concatenate([[0.0], orbit.switching_times])
+    ends = np.append(times[1:], T)
+    mats = {}
+    for key, deriv in derivatives.items():
+        func = _along_orbit(orbit, deriv)
+        if key in 'CD' and hp.outfcn is None:
+            # y = x: C = I, D = 0
+            value = np.eye(hp.nstates) if key == 'C' else np.zeros((hp.nstates, hp.ninputs))
+            mats[key] = PeriodicMatrix.constant(value, T)
+        elif piecewise_constant:
+            mats[key] = PeriodicMatrix.switching(
+                [_segment_average(func, a, b) for a, b in zip(times, ends)], times, T)
+        elif len(times) == 1:
+            mats[key] = PeriodicMatrix.from_function(func, T)
+        else:
+            mats[key] = PeriodicMatrix.switching([func] * len(times), times, T)
+    return ltpss(mats['A'], mats['B'], mats['C'], mats['D'], T,
+                 name=name if name is not None else f'{hp.name}$lin',
+                 inputs=hp.input_labels, outputs=hp.output_labels, states=hp.state_labels)
+

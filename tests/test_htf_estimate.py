@@ -1,0 +1,340 @@
+"""Tests of the nonparametric HTF estimator against an independent LTP simulator.
+
+Truth: the scalar LTP system ``ẋ = a(t) x + b(t)·u, y = c(t) x`` with
+``a = a0 + a1 cos ω_p t``, ``b_j = b0 + b1 sin ω_p t``, ``c_o = c0 + c1 cos ω_p t``
+is simulated exactly between samples (state transition ``exp ∫a`` and
+Gauss-Legendre quadrature of the continuous input), and its HTF comes from
+the truncated harmonic-balance formula ``C_T [sI - (A_T - N)]⁻¹ B_T`` with
+K = 20 (central block row, ``G_k = H_{0,-k}``).
+"""
+
+import numpy as np
+import pytest
+from control.exception import ControlArgument, ControlDimension
+
+from ltpcontrol._excitation import chirp_replicas
+from ltpcontrol._htf import HTF
+from ltpcontrol._htf_estimate import HTFEstimate, _estimate, estimate_htf
+from ltpcontrol._metrics import e_rms, nrmse
+
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
+
+
+class ScalarLTP:
+    """Scalar-state LTP system with first-harmonic coefficients."""
+
+    def __init__(self, period=1.0, a0=-2.0, a1=0.8, b=((1.0, 0.4),), c=((1.0, 0.3),)):
+        self.period = period
+        self.wp = 2 * np.pi / period
+        self.a0, self.a1 = a0, a1
+        self.b = np.array(b, float)          # rows (b0, b1) per input
+        self.c = np.array(c, float)          # rows (c0, c1) per output
+
+    def _int_a(self, t):                     # ∫_0^t a(s) ds
+        return self.a0 * t + self.a1 / self.wp * np.sin(self.wp * t)
+
+    def simulate(self, signal, t):
+        """Output samples (ny, nt) for the continuous input ``signal(t)``."""
+        h = t[1] - t[0]
+        nodes = t[:-1, None] + (_GL_X[None, :] + 1) * h / 2
+        u = np.atleast_2d(signal(nodes.ravel())).reshape(-1, *nodes.shape)
+        b = self.b[:, :1, None] + self.b[:, 1:, None] * np.sin(self.wp * nodes)[None]
+        # x_{n+1} = e^{∫_{t_n}^{t_{n+1}} a} x_n + ∫ e^{∫_τ^{t_{n+1}} a} b(τ)·u(τ) dτ
+        kern = np.exp(self._int_a(t[1:])[:, None] - self._int_a(nodes))
+        q = (np.sum(b * u, axis=0) * kern) @ _GL_W * h / 2
+        phi = np.exp(self._int_a(t[1:]) - self._int_a(t[:-1]))
+        x = np.zeros(t.size)
+        for n in range(t.size - 1):
+            x[n + 1] = phi[n] * x[n] + q[n]
+        return (self.c[:, :1] + self.c[:, 1:] * np.cos(self.wp * t)) * x
+
+    def htf(self, omega, K, ktrue=20):
+        """True ``G_k(jω)``, k = -K..K, shape (2K+1, ny, nu, F)."""
+        n = 2 * ktrue + 1
+        harm = np.arange(-ktrue, ktrue + 1)
+
+        def toeplitz(c0, cplus, cminus):     # block (n, m) = coefficient_{n-m}
+            return (np.diag(np.full(n, c0 + 0j)) + np.diag(np.full(n - 1, cplus), -1)
+                    + np.diag(np.full(n - 1, cminus), 1))
+
+        a_t = toeplitz(self.a0, self.a1 / 2, self.a1 / 2)
+        omega = np.asarray(omega, float)
+        res = np.linalg.inv(1j * omega[:, None, None] * np.eye(n)
+                            - (a_t - np.diag(1j * harm * self.wp)))      # (F, n, n)
+        b_t = np.stack([toeplitz(b0, b1 / 2j, -b1 / 2j) for b0, b1 in self.b])
+        c_t = np.stack([toeplitz(c0, c1 / 2, c1 / 2)[ktrue] for c0, c1 in self.c])
+        # central block row: H_{0,m} = c_T[0,:] R B_T[:, m];  G_k = H_{0,-k}
+        h0 = np.einsum('on,fnp,jpm->fojm', c_t, res, b_t)
+        cols = ktrue - np.arange(-K, K + 1)
+        return np.transpose(h0[..., cols], (3, 1, 2, 0))
+
+
+@pytest.fixture(scope="module")
+def replica_data():
+    """Seven phase-shifted chirp replicas (0-4 Hz, 20 s, 8 s gaps), T = 1 s."""
+    system = ScalarLTP()
+    exc = chirp_replicas(1.0, 7, 20.0, 0.0, 4.0, dt=0.01, gap=8.0)
+    y = system.simulate(exc.signal, exc.time)[0]
+    return system, exc, y
+
+
+@pytest.fixture(scope="module")
+def single_record():
+    """One 60-s chirp in an 80-s record with output noise (σ = 0.002)."""
+    system = ScalarLTP()
+    exc = chirp_replicas(1.0, 1, 60.0, 0.0, 4.0, dt=0.01, gap=20.0)
+    y = system.simulate(exc.signal, exc.time)[0]
+    noise = 0.002 * np.random.default_rng(0).standard_normal(y.size)
+    return system, exc, y + noise
+
+
+def test_simulator_matches_harmonic_balance():
+    # steady-state response to cos(ωt): DFT line at ω + nω_p equals G_n(ω + nω_p)/2
+    system = ScalarLTP(a1=1.5, b=((1.0, 0.7),), c=((1.0, 0.4),))
+    t = np.arange(0, 40, 0.01)
+    w = 2 * np.pi * 0.25
+    y = system.simulate(lambda s: np.cos(w * s), t)[0]
+    keep = t >= 12                                    # 28 s: whole periods of both
+    for n in range(-2, 3):
+        line = 2 * np.mean(y[keep] * np.exp(-1j * (w + n * system.wp) * t[keep]))
+        true = system.htf([w + n * system.wp], 2)[n + 2, 0, 0, 0]
+        assert abs(line - true) < 1e-9
+
+
+def test_replicas_noise_free_match_truth(replica_data):
+    system, exc, y = replica_data
+    est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments)
+    assert isinstance(est, HTFEstimate)
+    assert est.components.shape == (5, 1, 1, est.omega.size)
+    assert est.omega[0] == 0 and est.omega[-1] > 2 * np.pi * 2.5
+    true = system.htf(est.omega, 2)
+    err = np.abs(est.components - true)
+    # ≤ 1 % of each component's magnitude over the band (k = -1, 0, 1) ...
+    assert np.max(err[1:4] / np.abs(true[1:4])) < 0.01
+    # ... and ≤ 1 % of its peak for the small second harmonics
+    assert np.all(np.max(err, axis=-1) < 0.01 * np.max(np.abs(true), axis=-1))
+    assert np.max(est.cond) < 200                     # replicas decouple Φ_UU
+
+
+def test_reported_std_covers_errors(replica_data):
+    system, exc, y = replica_data
+    rng = np.random.default_rng(7)
+    sigma = 0.01
+    noisy = y + sigma * rng.standard_normal(y.size)
+    est = _estimate((exc.time, exc.inputs, noisy), 1.0, 2, segments=exc.segments)
+    # noise variance of one DFT coefficient: dt · T_w · σ²
+    assert est.noise_var[0] == pytest.approx(0.01 * 29 * sigma ** 2, rel=0.2)
+    z = np.abs(est.components - system.htf(est.omega, 2)) / est.std
+    # complex Gaussian errors: P(|e| < σ) = 1 - e^{-1}, P(|e| < 2σ) = 1 - e^{-4}
+    assert 0.55 < np.mean(z < 1) < 0.72
+    assert np.mean(z < 2) > 0.95
+
+
+def test_too_few_replicas_warns_ill_conditioned(replica_data):
+    system, exc, y = replica_data
+    # five copies of one window (same cycle phase) cannot separate five components
+    with pytest.warns(UserWarning, match="ill-conditioned"):
+        est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments[[0] * 5])
+    assert np.min(est.cond) > 1e8 and np.all(np.isfinite(est.components))
+
+
+def test_large_alpha_gives_straight_lines(single_record):
+    system, exc, y = single_record
+    lim = (2 * np.pi * 1.5, 2 * np.pi * 2.5)
+    est = _estimate((exc.time, exc.inputs, y), 1.0, 1, alpha=1e10, omega_limits=lim)
+    g = est.components[:, 0, 0]
+    assert np.max(np.abs(np.diff(g, 2, axis=-1))) < 1e-8 * np.max(np.abs(g))
+    # independent truth: least squares over affine components a_k + b_k ω
+    U = np.fft.fft(exc.inputs) * 0.01
+    Y = np.fft.fft(y) * 0.01
+    ns, L = U.size, 80
+    m = np.round(est.omega / (2 * np.pi / L)).astype(int)
+    reg = np.stack([U[(m - k * L) % ns] for k in (-1, 0, 1)], axis=1)   # (F, 3)
+    design = np.concatenate([reg, reg * est.omega[:, None]], axis=1)
+    coef = np.linalg.lstsq(design, Y[m], rcond=None)[0]
+    affine = coef[:3, None] + coef[3:, None] * est.omega[None, :]
+    assert np.allclose(g, affine, rtol=0, atol=1e-5 * np.max(np.abs(affine)))
+
+
+def test_gcv_beats_unregularised_single_record(single_record):
+    system, exc, y = single_record
+    lim = (2 * np.pi * 1.2, 2 * np.pi * 2.8)
+    data = (exc.time, exc.inputs, y)
+    raw = _estimate(data, 1.0, 1, alpha=1e-9, omega_limits=lim)
+    gcv = _estimate(data, 1.0, 1, alpha='gcv', omega_limits=lim, progress=False)
+    assert 1e-6 < gcv.alpha < 1e6
+    true = system.htf(gcv.omega, 1)
+    err_raw = np.median(np.abs(raw.components - true) / np.abs(true), axis=-1)
+    err_gcv = np.median(np.abs(gcv.components - true) / np.abs(true), axis=-1)
+    assert np.all(err_gcv < 0.5 * err_raw)
+    assert np.all(err_gcv < 0.03)
+    assert np.isfinite(gcv.gcv) and gcv.dof > 0
+    assert np.all(np.isfinite(gcv.std)) and np.all(gcv.std > 0)
+
+
+def test_mimo_two_inputs_two_outputs():
+    system = ScalarLTP(b=((1.0, 0.4), (0.5, -0.6)), c=((1.0, 0.3), (0.2, 0.5)))
+    exc = chirp_replicas(1.0, 7, 12.0, 0.0, 3.0, dt=0.02, gap=8.0)
+    # second input: the same replicas delayed by half a record (uncorrelated)
+    nseg = exc.segments.shape[0]
+    rec_len = exc.segments[0, 1] * 0.02
+    u2 = lambda t: exc.signal(t - rec_len * nseg)
+    t = np.arange(2 * exc.time.size) * 0.02
+    sig = lambda s: np.stack([exc.signal(s), u2(s)])
+    y = system.simulate(sig, t)
+    segs = np.vstack([exc.segments, exc.segments + exc.time.size])
+    est = _estimate((t, sig(t), y), 1.0, 1, segments=segs)
+    assert est.components.shape[:3] == (3, 2, 2)
+    true = system.htf(est.omega, 1)
+    assert np.max(np.abs(est.components - true)) < 0.01 * np.max(np.abs(true))
+
+
+def test_time_response_data_input(replica_data):
+    import control as ct
+    system, exc, y = replica_data
+    resp = ct.TimeResponseData(exc.time, y, inputs=exc.inputs)
+    a = _estimate(resp, 1.0, 1, segments=exc.segments)
+    b = _estimate([(exc.time, exc.inputs, y)], 1.0, 1, segments=exc.segments)
+    assert np.allclose(a.components, b.components)
+
+
+def test_time_origin_is_phase_reference(replica_data):
+    # relabelling time t -> t + τ shifts the cycle phase: G'_k = G_k e^{-jkω_p τ}
+    system, exc, y = replica_data
+    tau = 0.3
+    est = _estimate((exc.time + tau, exc.inputs, y), 1.0, 2, segments=exc.segments)
+    k = np.arange(-2, 3)[:, None, None, None]
+    true = system.htf(est.omega, 2) * np.exp(-1j * k * system.wp * tau)
+    assert np.max(np.abs(est.components[1:4] - true[1:4]) / np.abs(true[1:4])) < 0.01
+
+
+def test_unequal_windows_are_cut_with_warning(replica_data):
+    system, exc, y = replica_data
+    segs = exc.segments.copy()
+    segs[-1, 1] -= 150                                 # last window: 27 periods
+    with pytest.warns(UserWarning, match="cut to the common 27 periods"):
+        est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=segs)
+    true = system.htf(est.omega, 2)
+    assert np.max(np.abs(est.components[1:4] - true[1:4]) / np.abs(true[1:4])) < 0.01
+
+
+def test_returns_htf_that_predicts_new_inputs(replica_data):
+    system, exc, y = replica_data
+    H = estimate_htf((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
+                     name='hop')
+    assert isinstance(H, HTF) and H.name == 'hop' and H.nharmonics == 2
+    est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments)
+    w, G = H.components()
+    assert np.array_equal(w, est.omega) and np.allclose(G, est.components)
+    assert H.std.shape == G.shape
+    assert set(H.diagnostics) >= {"cond", "residual", "alpha", "dof", "gcv"}
+    # validation on an input not used for training: steady-state response to a
+    # sum of two sines whose output lines all lie in the estimated band
+    t = np.arange(0, 60, 0.01)
+    u = lambda s: 0.5 * np.cos(2 * np.pi * 0.3 * s) + np.sin(2 * np.pi * 0.45 * s)
+    yv = system.simulate(u, t)[0]
+    keep = t >= 40                                    # 20 periods of T and of u
+    y_hat = H.predict(u(t[keep]), t[keep])
+    assert e_rms(yv[keep], y_hat) < 0.5
+
+
+def test_no_residual_dof_gives_no_std(replica_data):
+    system, exc, y = replica_data
+    H = estimate_htf((exc.time, exc.inputs, y), 1.0, 3, segments=exc.segments)
+    assert H.std is None and H.diagnostics["dof"] == pytest.approx(0, abs=1e-6)
+
+
+# ----------------------------------------------------------------- bad input
+def test_record_shorter_than_one_period():
+    t = np.arange(50) * 0.01
+    with pytest.raises(ValueError, match="shorter than one period"):
+        _estimate((t, np.sin(t), np.cos(t)), 1.0, 1, alpha=1.0)
+
+
+def test_period_not_commensurate_with_sampling():
+    t = np.arange(1000) * 0.01
+    with pytest.raises(ValueError, match="integer number of samples per period"):
+        _estimate((t, np.sin(t), np.cos(t)), 1.005, 1, alpha=1.0)
+
+
+def test_nan_in_data(replica_data):
+    _, exc, y = replica_data
+    bad = y.copy()
+    bad[10] = np.nan
+    with pytest.raises(ValueError, match="outputs contains NaN"):
+        _estimate((exc.time, exc.inputs, bad), 1.0, 1, segments=exc.segments)
+
+
+def test_nharmonics_too_large_for_band(replica_data):
+    _, exc, y = replica_data
+    with pytest.raises(ValueError, match="too large for the excited band"):
+        _estimate((exc.time, exc.inputs, y), 1.0, 5, segments=exc.segments)
+
+
+def test_zero_input_rejected():
+    t = np.arange(500) * 0.01
+    with pytest.raises(ValueError, match="identically zero"):
+        _estimate((t, np.zeros(500), np.sin(t)), 1.0, 1, alpha=1.0)
+
+
+def test_gcv_on_pure_noise_warns_at_range_edge(single_record):
+    # output unrelated to the input: the smoothest fit (affine, ≈ 0) wins
+    _, exc, _ = single_record
+    y = 0.01 * np.random.default_rng(5).standard_normal(exc.time.size)
+    with pytest.warns(UserWarning, match="edge of the searched range"):
+        est = _estimate((exc.time, exc.inputs, y), 1.0, 1, alpha='gcv', progress=False,
+                        omega_limits=(2 * np.pi * 1.2, 2 * np.pi * 2.8))
+    assert est.alpha == pytest.approx(1e6)
+
+
+def test_alpha_zero_needs_enough_records(single_record):
+    _, exc, y = single_record
+    with pytest.raises(ValueError, match="at least"):
+        _estimate((exc.time, exc.inputs, y), 1.0, 1)
+
+
+def test_unexcited_frequencies_in_limits_warn(replica_data):
+    _, exc, y = replica_data
+    with pytest.warns(UserWarning, match="unexcited"):
+        est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
+                        omega_limits=(0.0, 2 * np.pi * 4))
+    assert est.omega[-1] < 2 * np.pi * 2.6
+
+
+@pytest.mark.parametrize("kwargs, exc_type, match", [
+    ({"alpha": -1.0}, ValueError, "alpha"),
+    ({"alpha": "lcurve"}, ValueError, "alpha"),
+    ({"threshold": 2.0}, ValueError, "threshold"),
+    ({"segments": [[0.5, 3]]}, ControlDimension, "segments"),
+    ({"omega_limits": (3.0, 1.0)}, ValueError, "omega_limits"),
+    ({"bogus": 1}, TypeError, "bogus"),
+])
+def test_argument_errors(replica_data, kwargs, exc_type, match):
+    _, exc, y = replica_data
+    with pytest.raises(exc_type, match=match):
+        estimate_htf((exc.time, exc.inputs, y), 1.0, 1, **kwargs)
+
+
+def test_data_type_errors():
+    t = np.arange(200) * 0.01
+    with pytest.raises(ControlArgument, match="data"):
+        _estimate("abc", 1.0, 1)
+    with pytest.raises(ControlArgument, match=r"data\[0\]"):
+        _estimate([np.ones(3)], 1.0, 1)
+    with pytest.raises(ControlDimension, match="time axis"):
+        _estimate((t, np.ones(199), np.ones(200)), 1.0, 1)
+    with pytest.raises(ValueError, match="uniformly"):
+        _estimate((t ** 2, np.ones(200), np.ones(200)), 1.0, 1)
+    with pytest.raises(ValueError, match="period"):
+        _estimate((t, np.ones(200), np.ones(200)), -1.0, 1)
+
+
+def test_metrics():
+    y = np.sin(np.linspace(0, 10, 500))
+    assert e_rms(y, y) == 0
+    assert e_rms(y, 0.9 * y) == pytest.approx(10.0)
+    assert nrmse(y, 0.9 * y) == pytest.approx(0.1)
+    with pytest.raises(ControlDimension, match="y_hat"):
+        nrmse(y, y[:-1])
+    with pytest.raises(ValueError, match="y "):
+        nrmse(np.zeros(5), np.ones(5))
