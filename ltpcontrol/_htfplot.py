@@ -10,6 +10,7 @@ image, the second view of an HTF.
 
 import numpy as np
 import control as ct
+import matplotlib.axes
 import matplotlib.pyplot as plt
 from control.exception import ControlArgument
 
@@ -49,7 +50,7 @@ def htf_response(htfs, omega=None, harmonics=(-1, 0, 1), *, omega_limits=None,
     (3, (2,))
     """
     htfs = _htf_list(htfs)
-    harmonics = list(harmonics)
+    harmonics = _harmonic_list(harmonics)
     out = []
     for H in htfs:
         for k in harmonics:
@@ -108,6 +109,7 @@ def bode_htf(htfs, omega=None, *fmt, harmonics=(-1, 0, 1), omega_limits=None,
     'ControlPlot'
     """
     htfs = _htf_list(htfs)
+    harmonics = _harmonic_list(harmonics)
     resp = htf_response(htfs, omega, harmonics, omega_limits=omega_limits,
                         omega_num=omega_num)
     frds, labels = [], []
@@ -168,6 +170,8 @@ def htf_map_plot(htf, omega, *, dB=True, ax=None, title=None, cmap='viridis'):
         M[~np.isfinite(M)] = np.nan
     if ax is None:
         fig, ax = plt.subplots()
+    elif not isinstance(ax, matplotlib.axes.Axes):
+        raise ControlArgument(f"ax must be a matplotlib Axes, got {type(ax).__name__}")
     fig = ax.figure
     K = htf.nharmonics
     ext = (-K - 0.5, K + 0.5, K + 0.5, -K - 0.5)
@@ -177,6 +181,12 @@ def htf_map_plot(htf, omega, *, dB=True, ax=None, title=None, cmap='viridis'):
     fig.colorbar(image, ax=ax, label="|H_{n,m}| [dB]" if dB else "|H_{n,m}|")
     ax.set_title(title or f"{htf.name}: |H(jω)| at ω = {omega:g} rad/s")
     return ct.ControlPlot(np.array([[[image]]], dtype=object), np.array([[ax]]), fig)
+
+
+def _harmonic_list(harmonics):
+    if isinstance(harmonics, (int, np.integer)) or not np.iterable(harmonics):
+        raise ControlArgument(f"harmonics must be a sequence of integers, got {harmonics!r}")
+    return list(harmonics)
 
 
 def _htf_list(htfs):

@@ -298,6 +298,9 @@ class LTPStateSpace(NonlinearIOSystem):
         return feedback(self, other, sign)
 
     def __getitem__(self, key):
+        if not isinstance(key, tuple) or len(key) != 2:
+            raise ControlArgument("index a system as sys[outputs, inputs], got "
+                                  f"{key!r}")
         rows, cols = key
         outs = _index_list(rows, self.output_labels, 'output')
         ins = _index_list(cols, self.input_labels, 'input')

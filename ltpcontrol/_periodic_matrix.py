@@ -255,6 +255,9 @@ class PeriodicMatrix:
         """
         period = check_period(period)
         times = real_array(times, 'times', ndim=1)
+        if not isinstance(pieces, (list, tuple)):
+            raise TypeError("pieces must be a list of matrices, PeriodicMatrix objects "
+                            f"or callables, got {type(pieces).__name__}")
         if len(pieces) != len(times) or len(times) == 0:
             raise ValueError(f"pieces ({len(pieces)}) and times ({len(times)}) "
                              "must have the same non-zero length")
@@ -265,7 +268,11 @@ class PeriodicMatrix:
         mats = []
         for i, piece in enumerate(pieces):
             if isinstance(piece, PeriodicMatrix):
-                mats.append(piece)
+                try:
+                    mats.append(piece.with_period(period))
+                except ValueError:
+                    raise ValueError(f"pieces[{i}] has period {piece.period}, which does "
+                                     f"not divide the period {period}") from None
             elif callable(piece):
                 mats.append(cls._new(period, _as_matrix(piece(times[i]), f'pieces[{i}]').shape,
                                      func=piece))
@@ -579,6 +586,14 @@ class PeriodicMatrix:
         (2, 2)
         """
         flat = [m for row in rows for m in row]
+        shapes = [[m.shape if isinstance(m, PeriodicMatrix) else _as_matrix(m, 'block').shape
+                   for m in row] for row in rows]
+        for i, row in enumerate(shapes):
+            if len({sh[0] for sh in row}) != 1:
+                raise ValueError(f"block: the matrices of row {i} have different heights "
+                                 f"{[sh[0] for sh in row]}")
+            if [sh[1] for sh in row] != [sh[1] for sh in shapes[0]]:
+                raise ValueError(f"block: the column widths of row {i} do not match row 0")
         periods = [m.period for m in flat if isinstance(m, PeriodicMatrix)]
         if not periods:
             return PeriodicMatrix.constant(np.block([[_as_matrix(m, 'block') for m in r]
@@ -612,7 +627,10 @@ def as_periodic(value, period, name, shape=None):
             raise ValueError(f"{name} has period {value.period}, which does not "
                              f"divide the system period {period}") from None
     elif callable(value):
-        value = PeriodicMatrix.from_function(value, period)
+        try:
+            value = PeriodicMatrix.from_function(value, period)
+        except (ValueError, TypeError) as exc:
+            raise type(exc)(f"{name}: {exc}") from None
     else:
         value = PeriodicMatrix.constant(_as_matrix(value, name), period)
     if shape is not None and value.shape != tuple(shape):

@@ -83,6 +83,7 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
         raise ValueError(f"method must be 'transition' or 'solve_ivp', got {method!r}")
     if input_hold not in ('foh', 'zoh'):
         raise ValueError(f"input_hold must be 'foh' or 'zoh', got {input_hold!r}")
+    rtol = _check_rtol(rtol)
     t = _time_vector(sys, timepts)
     u, ntraces = _input_array(sys, inputs, len(t))
     x0 = _initial_state(sys, initial_state, ntraces)
@@ -442,6 +443,14 @@ def _initial_state(sys, x0, ntraces):
     return x0.copy()
 
 
+def _check_rtol(rtol):
+    if isinstance(rtol, bool) or not isinstance(rtol, (int, float, np.floating)):
+        raise ControlArgument(f"rtol must be a positive number, got {rtol!r}")
+    if not 0 < rtol < 1:
+        raise ValueError(f"rtol must lie in (0, 1), got {rtol}")
+    return float(rtol)
+
+
 def _indices(spec, count, name):
     if spec is None:
         return list(range(count))
@@ -456,7 +465,7 @@ def _trace_response(sys, t, u, x0, ins, outs, trace_type, title, return_states,
                     squeeze, transpose, kwargs):
     method = kwargs.pop('method', 'transition')
     hold = kwargs.pop('input_hold', 'foh')
-    rtol = kwargs.pop('rtol', 1e-12)
+    rtol = _check_rtol(kwargs.pop('rtol', 1e-12))
     check_kwargs(kwargs, title.split()[0].lower() + '_response')
     if sys.isdtime():
         x = _march_discrete(sys, t, u, x0)

@@ -1,0 +1,42 @@
+"""The quick gallery scripts run top to bottom and write their figures."""
+
+import os
+import runpy
+import sys
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parents[1] / 'examples'
+
+
+@pytest.mark.parametrize("script, figure", [
+    ('plot_mathieu_htf.py', 'mathieu_htf.png'),
+    ('plot_hopper_htf.py', 'hopper_htf.png'),
+])
+def test_gallery_script_runs(script, figure, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, 'path', [str(EXAMPLES)] + sys.path)
+    monkeypatch.setenv('LTP_EXAMPLES_QUICK', '1')
+    runpy.run_path(str(EXAMPLES / script), run_name='__main__')
+    assert (tmp_path / figure).stat().st_size > 10_000
+    out = capsys.readouterr().out
+    assert 'HTF' in out
+
+
+def test_mathieu_gallery_prediction_agrees():
+    """The printed check of plot_mathieu_htf: HTF lines equal simulated lines."""
+    import io
+    import contextlib
+    buf = io.StringIO()
+    cwd = os.getcwd()
+    with contextlib.redirect_stdout(buf):
+        try:
+            os.chdir(Path(__file__).parent)
+            runpy.run_path(str(EXAMPLES / 'plot_mathieu_htf.py'), run_name='__main__')
+        finally:
+            os.chdir(cwd)
+            (Path(__file__).parent / 'mathieu_htf.png').unlink(missing_ok=True)
+    rel = [float(line.rsplit(' ', 1)[1]) for line in buf.getvalue().splitlines()
+           if 'relative difference' in line]
+    assert len(rel) == 3 and max(rel) < 1e-8
