@@ -18,6 +18,7 @@ growing or decaying exponential is ever multiplied out, which keeps the
 transform accurate for stiff systems.
 """
 
+import numbers
 import warnings
 
 import numpy as np
@@ -35,6 +36,8 @@ __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
 
 # largest condition number accepted for the matrix of Floquet vectors
 _COND_MAX = 1e10
+# degree of the Chebyshev interpolant of P(t) on each grid interval
+_CHEB_DEG = 24
 
 
 def monodromy(sys, nsteps=None):
@@ -106,10 +109,10 @@ def floquet_multipliers(sys, nsteps=None):
     True
     """
     logmod, arg = _log_multipliers(sys, nsteps)
-    with np.errstate(under='ignore'):
+    with np.errstate(under='ignore', over='ignore', invalid='ignore'):
         mu = np.exp(logmod) * np.exp(1j * arg)
-    real = (arg == 0) | (arg == np.pi)
-    mu[real] = np.where(arg[real] == 0, 1.0, -1.0) * np.exp(logmod[real])
+        real = (arg == 0) | (arg == np.pi)
+        mu[real] = np.where(arg[real] == 0, 1.0, -1.0) * np.exp(logmod[real])
     return mu
 
 
@@ -155,7 +158,7 @@ def floquet_exponents(sys, nsteps=None):
     logmod, arg = _log_multipliers(sys, nsteps)
     if sys.dt:
         nper = steps_per_period(sys.period, sys.dt)
-        with np.errstate(under='ignore'):
+        with np.errstate(under='ignore', over='ignore'):
             return np.exp((logmod + 1j * arg) / nper)
     return (logmod + 1j * arg) / sys.period
 
@@ -184,7 +187,8 @@ def is_stable(sys, tol=1e-10, nsteps=None):
     >>> ltp.is_stable(ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=np.pi))
     True
     """
-    if isinstance(tol, bool) or not np.isscalar(tol) or not 0 <= tol < 1:
+    if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, numbers.Real) \
+            or not 0 <= tol < 1:
         raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
     logmod, _ = _log_multipliers(sys, nsteps)
     return bool(logmod.size == 0 or np.max(logmod) < np.log1p(-tol))
@@ -213,7 +217,11 @@ def floquet_transform(sys, real=True, nsteps=None, **kwargs):
     monodromy is defective or has repeated multipliers it falls back to
     ``F = logm(Φ(T, 0))/T`` and ``P(t) = Φ(t, 0) e^{-Ft}``, which is
     accurate only when the multipliers span a moderate range (a warning is
-    issued otherwise).
+    issued otherwise).  Every Floquet transformation has ``det P(t) =
+    exp(∫_0^t tr A - t tr F)``, which can be tiny inside the period (e^{-20}
+    at t = π for the stiff example of `floquet_exponents`); then
+    ``P^{-1}(t) B(t)`` is huge, simulating the Floquet form loses accuracy,
+    and a warning reports the condition number of P(t).
 
     Parameters
     ----------
@@ -245,19 +253,26 @@ def floquet_transform(sys, real=True, nsteps=None, **kwargs):
 
     Examples
     --------
-    The damped Mathieu equation (thesis eq. 4.24) in Floquet form:
+    The damped Mathieu equation (thesis eq. 4.24, ζ = 0.3, β = 0.1,
+    ω_p = 2ω_n) lies in the principal resonance region: its multipliers are
+    negative, so the real Floquet form has period 2T = 1:
 
+    >>> import warnings
     >>> wn, wp = 2 * np.pi, 4 * np.pi
     >>> A = lambda t: np.array([[0.0, 1.0],
     ...                         [-(1 + 0.2 * np.cos(wp * t)) * wn**2, -0.6 * wn]])
     >>> sys = ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=0.5)
-    >>> sysF, P = ltp.floquet_transform(sys)
-    >>> sysF.is_floquet_form
-    True
+    >>> ltp.floquet_multipliers(sys).real
+    array([-0.4195..., -0.3618...])
+    >>> with warnings.catch_warnings(record=True):
+    ...     sysF, P = ltp.floquet_transform(sys)
+    >>> sysF.period, sysF.is_floquet_form
+    (1.0, True)
     >>> F = sysF.A(0.0)
-    >>> np.allclose(np.linalg.eigvals(F * 0.5), np.log(ltp.floquet_multipliers(sys)))
+    >>> np.allclose(np.sort(np.linalg.eigvals(F).real),
+    ...             np.sort(ltp.floquet_exponents(sys).real))
     True
-    >>> np.allclose(P(0.0), np.eye(2)), np.allclose(P(0.5), np.eye(2))
+    >>> np.allclose(P(0.0), np.eye(2)), np.allclose(P(1.0), np.eye(2))
     (True, True)
     """
     check_kwargs(kwargs, 'floquet_transform')
@@ -301,7 +316,7 @@ def floquet_transform(sys, real=True, nsteps=None, **kwargs):
         grid_vals, E, R = _logm_form(grid, factors, logmod, dtime)
     else:
         grid_vals, E, R = modal
-    return _assemble(sys, grid, grid_vals, E, R, double)
+    return _assemble(sys, grid, grid_vals, E, R)
 
 
 #
@@ -322,17 +337,20 @@ def _factors(sys, nsteps):
     _check_sys(sys)
     A, T = sys.A, sys.period
     n = A.shape[0]
+    if nsteps is not None:
+        nsteps = check_positive_int(nsteps, 'nsteps')
     if sys.dt:
         if nsteps is not None:
             raise ControlArgument("nsteps applies to continuous-time systems only; a "
                                   "discrete-time system has N = period/dt steps")
         nper = steps_per_period(T, sys.dt)
         return np.arange(nper + 1) * sys.dt, A.sample(nper)
+    if n == 0:
+        return np.array([0.0, T]), np.zeros((1, 0, 0))
     if nsteps is None:
         probe = np.concatenate([np.arange(256) * T / 256, A.breakpoints])
         norm = np.max(np.linalg.norm(A(probe), ord=2, axis=(1, 2)), initial=0.0)
         nsteps = int(np.clip(np.ceil(T * norm), 16, 4096))
-    nsteps = check_positive_int(nsteps, 'nsteps')
     grid = np.union1d(np.linspace(0, T, nsteps + 1), A.breakpoints)
     # drop grid points that nearly coincide with a switching instant
     keep = np.concatenate([[True], np.diff(grid) > 1e-9 * T / nsteps])
@@ -417,7 +435,8 @@ def _floquet_vectors(grid, factors, rate, flip, dtime):
     For each exponent solve the cyclic problem ``c_k p_{k+1} = Φ_k p_k``,
     ``p_M = p_0`` with ``c_k = e^{λ h_k}`` (continuous) or ``c_k = ρ``
     (discrete), normalised by a border row.  Returns ``(G, Λ_r, Pm_0^{-1})``
-    with ``P(t_k) = G_k Pm_0^{-1}``, or None when the vectors are not a
+    with ``P(t_k) = G_k Pm_0^{-1}`` and ``F = Pm_0 Λ_r Pm_0^{-1}`` (Λ_r: the
+    exponents in real block form), or None when the vectors are not a
     well-conditioned basis (defective or repeated multipliers).
     """
     nsteps, n = factors.shape[0], factors.shape[1]
@@ -493,7 +512,7 @@ def _logm_form(grid, factors, logmod, dtime):
     return G, E, np.eye(factors.shape[1])
 
 
-def _assemble(sys, grid, G, E, R, double):
+def _assemble(sys, grid, G, E, R):
     """Build P(t) and the Floquet-form system from the grid values."""
     from ._ltpsys import ltpss
     period = grid[-1]
@@ -507,35 +526,75 @@ def _assemble(sys, grid, G, E, R, double):
     if sys.dt:
         # discrete time: P[k] = G_k R, B_F[k] = P[k+1]^{-1} B[k], C_F[k] = C[k] P[k]
         nw = len(G)
+        nper = steps_per_period(sys.period, sys.dt)
         Pk = G @ R
-        Bk = sys.B.with_period(period).sample(nw)
-        Ck = sys.C.with_period(period).sample(nw)
-        Dk = sys.D.with_period(period).sample(nw)
+        Bk, Ck, Dk = (np.tile(M.sample(nper), (nw // nper, 1, 1)) for M in (sys.B, sys.C, sys.D))
         BF = np.linalg.solve(np.roll(Pk, -1, axis=0), Bk)
         sysF = ltpss(np.linalg.solve(R, E @ R), BF, Ck @ Pk, Dk, period, dt=sys.dt,
                      **labels)
         return sysF, PeriodicMatrix.from_samples(Pk, period, kind='hold')
-    A = sys.A
-    zero = PeriodicMatrix.constant(np.zeros((n, 0)), A.period)
-    starts = grid[:-1]
-
-    def transform(t):
-        # P(t) = Φ(t, t_k) G_k e^{-E (t - t_k)} R for t_k <= t < t_{k+1}
-        t = np.atleast_1d(np.asarray(t, float))
-        tau = np.mod(t, period)
-        k = np.clip(np.searchsorted(starts, tau, side='right') - 1, 0, len(starts) - 1)
-        d = tau - starts[k]
-        phi, _, _ = step_transitions(A, zero, starts[k], d)
-        return phi @ G[k] @ expm_batch(-E[None] * d[:, None, None]) @ R
-
+    transform = _chebyshev_transform(sys.A, grid, G, E, R)
     breaks = np.concatenate([M.with_period(period).breakpoints
                              for M in (sys.A, sys.B, sys.C)])
     P = PeriodicMatrix._new(period, (n, n), func=transform, breakpoints=breaks)
-    B, C = sys.B.with_period(period), sys.C.with_period(period)
+    B, C = sys.B, sys.C
     BF = PeriodicMatrix._new(period, B.shape, breakpoints=breaks,
                              func=lambda t: np.linalg.solve(transform(t), B(t)))
     CF = PeriodicMatrix._new(period, C.shape, breakpoints=breaks,
                              func=lambda t: C(t) @ transform(t))
-    sysF = ltpss(np.linalg.solve(R, E @ R), BF, CF, sys.D.with_period(period),
-                 period, **labels)
+    # F = R^{-1} E R (E = Λ_r for Floquet vectors, R = Pm_0^{-1})
+    sysF = ltpss(np.linalg.solve(R, E @ R), BF, CF, sys.D, period, **labels)
     return sysF, P
+
+
+def _chebyshev_transform(A, grid, G, E, R):
+    """Callable P(t) interpolating exact values on every grid interval.
+
+    On ``[t_k, t_{k+1}]`` the values ``P(s) = Φ(s, t_k) G_k e^{-E (s - t_k)} R``
+    at Chebyshev points ``s_j = t_k + h_k (1 - cos(jπ/D))/2`` are computed
+    exactly and P is evaluated by barycentric interpolation.
+    """
+    n = G.shape[1]
+    period, starts, h = grid[-1], grid[:-1], np.diff(grid)
+    cheb = 0.5 * (1 - np.cos(np.pi * np.arange(_CHEB_DEG + 1) / _CHEB_DEG))
+    bary = (-1.0) ** np.arange(_CHEB_DEG + 1)
+    bary[[0, -1]] *= 0.5
+    zero = PeriodicMatrix.constant(np.zeros((n, 0)), A.period)
+    nodes = starts[:, None] + h[:, None] * cheb                        # (M, D+1)
+    # Φ(s_j, t_k) = Φ(s_j, s_{j-1}) ... Φ(s_1, s_0): short steps, chained
+    steps, _, _ = step_transitions(A, zero, nodes[:, :-1].ravel(), np.diff(nodes, axis=1).ravel())
+    steps = steps.reshape(len(starts), _CHEB_DEG, n, n)
+    phi = np.empty((len(starts), _CHEB_DEG + 1, n, n))
+    phi[:, 0] = np.eye(n)
+    for j in range(_CHEB_DEG):
+        phi[:, j + 1] = steps[:, j] @ phi[:, j]
+    offsets = (nodes - starts[:, None]).ravel()
+    values = (phi @ G[:, None]).reshape(-1, n, n) @ expm_batch(-E[None] * offsets[:, None, None])
+    values = (values @ R).reshape(len(starts), _CHEB_DEG + 1, n, n)
+    # det P(t) = exp(∫_0^t tr A - t tr F) may get tiny: P^{-1} B is then huge
+    cond = np.linalg.cond(values.reshape(-1, n, n)).max()
+    if cond > 1e8:
+        warnings.warn(f"the Floquet transformation P(t) is ill-conditioned (condition "
+                      f"number up to {cond:.1e}): B_F = P^{{-1}} B is large and the "
+                      "Floquet form amplifies rounding errors", UserWarning, stacklevel=4)
+
+    def transform(t):
+        tau = np.mod(np.atleast_1d(np.asarray(t, float)), period)
+        k = np.clip(np.searchsorted(starts, tau, side='right') - 1, 0, len(starts) - 1)
+        xi = np.clip((tau - starts[k]) / h[k], 0.0, 1.0)
+        diff = xi[:, None] - cheb[None, :]
+        hit = diff == 0
+        with np.errstate(divide='ignore'):
+            weights = np.where(hit.any(axis=1, keepdims=True), hit.astype(float), bary / diff)
+        weights /= weights.sum(axis=1, keepdims=True)
+        return np.einsum('sj,sjab->sab', weights, values[k])
+
+    # check the interpolant against exact values inside every interval
+    probe = starts + 0.3717 * h
+    exact, _, _ = step_transitions(A, zero, starts, probe - starts)
+    exact = exact @ G @ expm_batch(-E[None] * (probe - starts)[:, None, None]) @ R
+    err = np.abs(transform(probe) - exact).max()
+    if err > 1e-9 * max(1.0, np.abs(exact).max()):
+        warnings.warn(f"the interpolated Floquet transformation P(t) has errors up to "
+                      f"{err:.1e}; increase nsteps", UserWarning, stacklevel=4)
+    return transform

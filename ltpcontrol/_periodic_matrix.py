@@ -342,8 +342,12 @@ class PeriodicMatrix:
         if self._func is not None:
             return _call_vectorised(self._func, t, self.shape)
         if self._pieces is not None:
+            # t mod T, snapped onto a switching instant within rounding (so that
+            # t = t_i + jT selects the piece starting at t_i for every j)
+            eps = 1e-12 * self.period
             tau = np.mod(t, self.period)
-            idx = np.searchsorted(self._times, tau, side='right') - 1
+            tau[tau >= self.period - eps] -= self.period
+            idx = np.maximum(np.searchsorted(self._times, tau + eps, side='right') - 1, 0)
             out = np.empty((len(t),) + self.shape)
             for i, piece in enumerate(self._pieces):
                 mask = idx == i

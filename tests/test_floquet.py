@@ -23,6 +23,15 @@ from ltpcontrol._periodic_matrix import PeriodicMatrix
 from ltpcontrol._timeresp import forced_response
 
 
+def _vectorised(entries):
+    """Callable A(t) accepting scalar or 1D t from a nested list of expressions."""
+    def A(t):
+        t = np.asarray(t, float)
+        arr = np.array([[np.broadcast_to(e, t.shape) for e in row] for row in entries(t)])
+        return np.moveaxis(arr, (0, 1), (-2, -1))
+    return A
+
+
 def _smooth_A(rng, n, period, shift=-1.0, scale=1.0):
     A0, A1, A2 = scale * rng.standard_normal((3, n, n))
     A0 = A0 + shift * np.eye(n)
@@ -46,14 +55,17 @@ def _sorted(z):
     return z[np.lexsort((np.round(z.imag, 8), np.round(z.real, 8)))]
 
 
+_STIFF_A = _vectorised(lambda t: [[0.0, 1.0], [-10 * np.cos(t), -24 - 10 * np.sin(t)]])
+
+
 def _stiff():
-    A = lambda t: np.array([[0.0, 1.0], [-10 * np.cos(t), -24 - 10 * np.sin(t)]])
+    A = _STIFF_A
     return ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=2 * np.pi)
 
 
 def _zhou_hagiwara(period):
-    A = lambda t: np.array([[-1 - np.sin(2 * t) ** 2, 2 - 0.5 * np.sin(4 * t)],
-                            [-2 - 0.5 * np.sin(4 * t), -1 - np.cos(2 * t) ** 2]])
+    A = _vectorised(lambda t: [[-1 - np.sin(2 * t) ** 2, 2 - 0.5 * np.sin(4 * t)],
+                               [-2 - 0.5 * np.sin(4 * t), -1 - np.cos(2 * t) ** 2]])
     return ltpss(A, [[1.0], [0.5]], [[1.0, -1.0]], 0, period=period)
 
 
@@ -71,8 +83,8 @@ def _switching_sys():
 
 
 def _mathieu_4_24(zeta=0.3, beta=0.1, wn=2 * np.pi, wp=4 * np.pi):
-    A = lambda t: np.array([[0.0, 1.0],
-                            [-(1 + 2 * beta * np.cos(wp * t)) * wn ** 2, -2 * zeta * wn]])
+    A = _vectorised(lambda t: [[0.0, 1.0],
+                               [-(1 + 2 * beta * np.cos(wp * t)) * wn ** 2, -2 * zeta * wn]])
     return ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=2 * np.pi / wp), A
 
 
@@ -126,6 +138,9 @@ def test_lti_limit_continuous():
     assert np.allclose(_sorted(floquet_exponents(sys)), _sorted(poles), atol=1e-10)
     assert np.allclose(_sorted(floquet_exponents(sys)), _sorted(np.linalg.eigvals(A)),
                        atol=1e-10)
+    sysF, P = floquet_transform(sys)
+    assert np.allclose(sysF.A(0.0), A, atol=1e-9)
+    assert np.allclose(P(np.linspace(0, period, 5)), np.eye(5), atol=1e-9)
 
 
 def test_lti_limit_discrete():
@@ -191,8 +206,8 @@ def test_switching_damped_mathieu_table_4_1():
     wn, wp, T = 2 * np.pi, 4 * np.pi, 0.5
 
     def piece(zeta, beta):
-        return lambda t: np.array([[0.0, 1.0], [-(1 + 2 * beta * np.cos(wp * t)) * wn ** 2,
-                                                -2 * zeta * wn]])
+        return _vectorised(lambda t: [[0.0, 1.0], [-(1 + 2 * beta * np.cos(wp * t)) * wn ** 2,
+                                                   -2 * zeta * wn]])
     pieces = [piece(0.3, 0.1), piece(0.1, 0.2)]
     A = PeriodicMatrix.switching(pieces, [0.0, T / 2], T)
     sys = ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=T)
@@ -247,15 +262,27 @@ def test_transform_random_smooth():
 
 def test_transform_stiff():
     sys = _stiff()
-    sysF, P = floquet_transform(sys)
-    assert np.allclose(np.sort(np.linalg.eigvals(sysF.A(0.0)).real), [-24, 0], atol=1e-8)
-    assert np.abs(P(np.linspace(0, 2 * np.pi, 50))).max() < 10       # bounded P(t)
-    _io_check(sys, sysF, P, 2 * np.pi, np.array([1.0, -2.0]), npts=201)
+    with pytest.warns(UserWarning, match="ill-conditioned"):
+        sysF, P = floquet_transform(sys)
+    F = sysF.A(0.0)
+    assert np.allclose(np.sort(np.linalg.eigvals(F).real), [-24, 0], atol=1e-8)
+    t = np.linspace(0, 2 * np.pi, 50)
+    assert np.abs(P(t)).max() < 10                                    # bounded P(t)
+    # Liouville: det P(t) = exp(∫_0^t tr A - t tr F) = exp(-10 (1 - cos t))
+    assert np.allclose(np.linalg.det(P(t)), np.exp(-10 * (1 - np.cos(t))), rtol=1e-7, atol=0)
+    # Φ(t, 0) = P(t) e^{Ft}
+    A = _STIFF_A
+    sol = solve_ivp(lambda t, y: (A(t) @ y.reshape(2, 2)).ravel(), (0, 2.0), np.eye(2).ravel(),
+                    method='DOP853', rtol=1e-12, atol=1e-14)
+    assert np.allclose(sol.y[:, -1].reshape(2, 2), P(2.0) @ la.expm(F * 2.0), atol=1e-9)
+    # away from t = π, where det P(t) = e^{-20}, the Floquet form simulates accurately
+    _io_check(sys, sysF, P, 1.0, np.array([1.0, -2.0]), npts=101)
 
 
 def test_transform_switching():
     sys, truth = _switching_sys()
-    sysF, P = floquet_transform(sys)
+    sysF, P = floquet_transform(sys, real=False)
+    assert sysF.period == 1.0
     assert np.allclose(la.expm(sysF.A(0.0) * 1.0), truth, atol=1e-10)
     assert np.all(np.isin(sys.A.breakpoints, P.breakpoints))
     _io_check(sys, sysF, P, 2.0, np.array([0.5, 1.0]), npts=201)
