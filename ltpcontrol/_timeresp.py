@@ -79,20 +79,10 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
     """
     check_kwargs(kwargs, 'forced_response')
     sys = _check_system(sys)
-    if method not in ('transition', 'solve_ivp'):
-        raise ValueError(f"method must be 'transition' or 'solve_ivp', got {method!r}")
-    if input_hold not in ('foh', 'zoh'):
-        raise ValueError(f"input_hold must be 'foh' or 'zoh', got {input_hold!r}")
-    rtol = _check_rtol(rtol)
     t = _time_vector(sys, timepts)
     u, ntraces = _input_array(sys, inputs, len(t))
     x0 = _initial_state(sys, initial_state, ntraces)
-    if sys.isdtime():
-        x = _march_discrete(sys, t, u, x0)
-    elif method == 'solve_ivp':
-        x = _solve_ivp(sys, t, u, x0, input_hold, rtol)
-    else:
-        x = _march_continuous(sys, t, u, x0, input_hold, rtol)
+    x = _simulate(sys, t, u, x0, method, input_hold, rtol)
     y = _outputs(sys, t, x, u)
     multi = u.shape[1] > 1 or np.ndim(inputs) == 3
     if not multi:
@@ -252,6 +242,20 @@ def impulse_response(sys, timepts=None, input_indices=None, output_indices=None,
 #
 # Simulation engines
 #
+
+def _simulate(sys, t, u, x0, method, hold, rtol):
+    """States (nstates, ntraces, len(t)) by the requested engine."""
+    if method not in ('transition', 'solve_ivp'):
+        raise ValueError(f"method must be 'transition' or 'solve_ivp', got {method!r}")
+    if hold not in ('foh', 'zoh'):
+        raise ValueError(f"input_hold must be 'foh' or 'zoh', got {hold!r}")
+    rtol = _check_rtol(rtol)
+    if sys.isdtime():
+        return _march_discrete(sys, t, u, x0)
+    if method == 'solve_ivp':
+        return _solve_ivp(sys, t, u, x0, hold, rtol)
+    return _march_continuous(sys, t, u, x0, hold, rtol)
+
 
 def _march_continuous(sys, t, u, x0, hold, rtol):
     h = np.diff(t)
@@ -465,16 +469,9 @@ def _trace_response(sys, t, u, x0, ins, outs, trace_type, title, return_states,
                     squeeze, transpose, kwargs):
     method = kwargs.pop('method', 'transition')
     hold = kwargs.pop('input_hold', 'foh')
-    rtol = _check_rtol(kwargs.pop('rtol', 1e-12))
+    rtol = kwargs.pop('rtol', 1e-12)
     check_kwargs(kwargs, title.split()[0].lower() + '_response')
-    if sys.isdtime():
-        x = _march_discrete(sys, t, u, x0)
-    elif method == 'solve_ivp':
-        x = _solve_ivp(sys, t, u, x0, hold, rtol)
-    elif method == 'transition':
-        x = _march_continuous(sys, t, u, x0, hold, rtol)
-    else:
-        raise ValueError(f"method must be 'transition' or 'solve_ivp', got {method!r}")
+    x = _simulate(sys, t, u, x0, method, hold, rtol)
     y = _outputs(sys, t, x, u)[outs]
     return ct.TimeResponseData(
         t, y, x, u, issiso=len(outs) == 1 and len(ins) == 1,
