@@ -19,11 +19,12 @@ output at the same frequencies, and neighbouring components cannot be
 separated with sinusoidal inputs.
 """
 
+import numbers
+import warnings
 from typing import Callable, NamedTuple
 
-import warnings
-
 import numpy as np
+from control.exception import ControlArgument
 
 from ._validation import (check_kwargs, check_period, check_positive_int,
                           real_array, steps_per_period)
@@ -228,6 +229,20 @@ def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitud
     return time, signal, segments
 
 
+def _check_seed(seed, name="seed"):
+    """Return a numpy Generator from `seed` (None, a non-negative int or a Generator)."""
+    if seed is None or isinstance(seed, (np.random.Generator, np.random.BitGenerator,
+                                         np.random.SeedSequence)):
+        return np.random.default_rng(seed)
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (numbers.Integral,
+                                                                   np.integer)):
+        raise ControlArgument(f"{name} must be None, a non-negative int or a "
+                              f"numpy.random.Generator, got {seed!r}")
+    if seed < 0:
+        raise ValueError(f"{name} must be a non-negative int, got {seed}")
+    return np.random.default_rng(int(seed))
+
+
 def _check_common(period, dt, nperiods, settle):
     period = check_period(period)
     dt = check_period(dt, "dt")
@@ -326,7 +341,9 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=1, settle=0,
         Line phases: Schroeder's low-crest-factor phases
         ``φ_l = -π l (l - 1) / F``, uniform random phases, or given values.
     seed : int or numpy.random.Generator, optional
-        Random source for ``phases='random'``.
+        Random source for ``phases='random'``: None (fresh entropy), a
+        non-negative int, or a `numpy.random.Generator` (a `BitGenerator`
+        or `SeedSequence` is accepted as well).
 
     Returns
     -------
@@ -346,6 +363,7 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=1, settle=0,
     period, dt, nperiods, settle = _check_common(period, dt, nperiods, settle)
     nexp = check_positive_int(nexperiments, "nexperiments")
     amplitude = float(real_array(amplitude, "amplitude", ndim=0))
+    rng = _check_seed(seed)
     window = nperiods * period
     if isinstance(frequencies, tuple) and len(frequencies) == 3 \
             and isinstance(frequencies[0], str):
@@ -371,7 +389,7 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=1, settle=0,
             ell = np.arange(1, nline + 1)
             phi = -np.pi * ell * (ell - 1) / nline
         elif phases == 'random':
-            phi = np.random.default_rng(seed).uniform(0, 2 * np.pi, nline)
+            phi = rng.uniform(0, 2 * np.pi, nline)
         else:
             raise ValueError(f"phases must be 'schroeder', 'random' or an array, "
                              f"got {phases!r}")

@@ -30,6 +30,11 @@ from ._validation import check_kwargs, real_array
 
 __all__ = ['fit_htf', 'estimate_delays', 'HTFFit', 'DelayEstimate']
 
+# largest number of total-delay grid points searched by `estimate_delays`
+_MAX_DELAY_GRID = 2 ** 18
+# frequencies x delays evaluated at once in that search
+_DELAY_CHUNK = 2 ** 20
+
 
 @dataclass
 class HTFFit:
@@ -217,6 +222,8 @@ def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
     w_fit = omega[keep]
     target = comps[ks + K][..., keep]
     p0 = real_array(p0, "p0", ndim=1)
+    if p0.size == 0:
+        raise ValueError("p0 must hold at least one initial parameter, got an empty array")
     if isinstance(weights, str):
         if weights != 'std':
             raise ValueError(f"weights must be None, 'std' or an array, got {weights!r}")
@@ -226,7 +233,13 @@ def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
     elif weights is None:
         wts = np.ones(target.shape)
     else:
-        wts = np.broadcast_to(real_array(weights, "weights"), target.shape)
+        wts = real_array(weights, "weights")
+        try:
+            wts = np.broadcast_to(wts, target.shape)
+        except ValueError:
+            raise ControlDimension(
+                f"weights of shape {wts.shape} cannot be broadcast to the fitted "
+                f"components' shape (nharm, ny, nu, F) = {target.shape}") from None
     if bounds is None:
         bounds = (-np.inf, np.inf)
     shape = target.shape[1:]
@@ -280,7 +293,9 @@ def estimate_delays(estimate, reference, *, harmonics=(-1, 0, 1), omega_limits=N
     omega_limits : (float, float), optional
         Frequency range used (rad/s).
     max_delay : float, optional
-        Largest total delay searched (s); default the period T.
+        Largest total delay searched (s); default the period T.  The search
+        grid is spaced ``2π / (8 max ω)``, and it may hold at most 2**18
+        points; a larger `max_delay` raises ValueError.
     input, output : int, optional
         Channel analysed (default 0, 0).
 
@@ -328,10 +343,23 @@ def estimate_delays(estimate, reference, *, harmonics=(-1, 0, 1), omega_limits=N
     tmax = period if max_delay is None else float(real_array(max_delay, "max_delay", ndim=0))
     if tmax <= 0:
         raise ValueError(f"max_delay must be positive, got {tmax}")
+    # the objective oscillates on the scale 2π/max(ω): sample the total delay
+    # 8 times per oscillation, on a grid of bounded size
+    spacing = 2 * np.pi / (8 * np.max(w))
+    if tmax / spacing > _MAX_DELAY_GRID - 2:
+        raise ValueError(
+            f"max_delay={tmax:.6g} s is too large for this frequency grid: the delay "
+            f"search would need {tmax / spacing:.3g} grid points (limit {_MAX_DELAY_GRID}); "
+            f"max_delay must be at most {(_MAX_DELAY_GRID - 2) * spacing:.6g} s")
     separable = bool(np.any(ks != 0))
     # S_k(τ_s) = Σ_ω |Ĥ_k|² e^{j(∠Ĥ_k - ∠G_k + ωτ_s)} ≈ A_k e^{jkω_p τ_u} at the true τ_s
-    tsums = np.linspace(0, tmax, int(np.ceil(8 * tmax * np.max(w) / (2 * np.pi))) + 2)
-    sums = np.einsum('kf,kf,fg->kg', weight ** 2, obs, np.exp(1j * np.outer(w, tsums)))
+    tsums = np.linspace(0, tmax, int(np.ceil(tmax / spacing)) + 2)
+    coef = weight ** 2 * obs
+    sums = np.empty((ks.size, tsums.size), complex)
+    chunk = max(1, _DELAY_CHUNK // w.size)         # bound the F x chunk work array
+    for start in range(0, tsums.size, chunk):
+        stop = start + chunk
+        sums[:, start:stop] = coef @ np.exp(1j * np.outer(w, tsums[start:stop]))
     best = int(np.argmax(np.abs(sums).sum(axis=0)))
     if separable:
         # τ_u maximising Re Σ_k S_k(τ_s) e^{-jkω_p τ_u} over [0, T)

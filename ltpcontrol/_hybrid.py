@@ -204,7 +204,21 @@ class HybridPlant:
         return dx
 
     def _g(self, i, t, x, u, params):
-        return float(np.squeeze(self.modes[i].guard(t, x, u, params)))
+        value = self.modes[i].guard(t, x, u, params)
+        where = f"guard of mode {self.mode_names[i]!r}"
+        try:
+            arr = np.asarray(value, float) if value is not None else None
+        except (TypeError, ValueError):
+            arr = None
+        if arr is None:
+            raise ControlArgument(f"{where} must return a real scalar, got {value!r}")
+        if arr.size != 1:
+            raise ControlArgument(f"{where} must return a real scalar, got an array of "
+                                  f"shape {arr.shape}")
+        value = float(arr.reshape(()))
+        if not np.isfinite(value):
+            raise ValueError(f"{where} returned {value} at t={t:.6g}")
+        return value
 
     def _r(self, i, t, x, u, params):
         if self.modes[i].reset is None:

@@ -233,7 +233,8 @@ def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, **kwargs):
     ValueError
         If `switching_times` are not increasing in ``[0, T)`` from 0, a record
         is not uniformly sampled or does not span whole periods, the data
-        contain NaN, or there are fewer equations than unknowns.
+        contain NaN, the input of a record is identically zero, or there are
+        fewer equations than unknowns.
     TypeError
         If an unknown keyword is given.
 
@@ -399,6 +400,9 @@ def _records(t, x, u, period):
                     f"{name}{where} has {arr.shape[1]} samples but t{where} has {L}")
         if L < 3:
             raise ValueError(f"t{where} must hold at least 3 samples, got {L}")
+        if not np.any(uj):
+            raise ValueError(f"u{where} is identically zero: the record has no "
+                             "excitation, so it carries no information on A(t) and B(t)")
         dt = (tj[-1] - tj[0]) / (L - 1)
         if dt <= 0 or np.max(np.abs(np.diff(tj) - dt)) > 1e-6 * dt:
             raise ValueError(f"t{where} must be increasing and uniformly spaced")

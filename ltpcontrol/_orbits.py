@@ -72,6 +72,20 @@ class PeriodicOrbit:
         Parameters used.
     u0 : ndarray
         Constant input along the orbit.
+
+    Examples
+    --------
+    The steady state of ``dx/dt = -x + cos t`` is ``x̄(t) = (cos t + sin t)/2``
+    with the single Floquet multiplier ``e^{-2π}``:
+
+    >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t), None, states=1, inputs=0)
+    >>> orbit = ltp.periodic_orbit(sys, 2 * np.pi, [0.0], npoints=8)
+    >>> orbit.states.shape, orbit.is_stable
+    ((1, 8), True)
+    >>> bool(np.allclose(orbit(np.pi / 2), [0.5], atol=1e-8))
+    True
+    >>> bool(np.isclose(orbit.multipliers[0].real, np.exp(-2 * np.pi)))
+    True
     """
 
     def __init__(self, plant, period, flow, x0, mode0, npoints, params, u0,
