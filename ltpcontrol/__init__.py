@@ -26,6 +26,9 @@ from ._htf_fit import HTFFit, DelayEstimate, fit_htf, estimate_delays
 from ._metrics import e_rms, nrmse
 from ._fdsubspace import fdsubspace, FDSubspaceInfo
 from ._hybrid_ls import hybrid_ls, HybridLSResult
+from ._realization import floquet_realization, FloquetRealization
+from ._canonical import to_canonical, matrix_errors, MatrixErrors
+from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
 
 __version__ = "0.1.0"
 
@@ -52,4 +55,6 @@ __all__ = [
     'estimate_htf', 'HTFFit', 'DelayEstimate', 'fit_htf', 'estimate_delays',
     'e_rms', 'nrmse',
     'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
+    'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
+    'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
 ]

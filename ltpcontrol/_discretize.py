@@ -184,10 +184,9 @@ def d2c(sysd, method='tustin', prewarp_frequency=None, interpolation='fourier',
     --------
     Round trip through the Tustin rule:
 
-    >>> from ltpcontrol._discretize import d2c
     >>> B = lambda t: np.array([[0.0], [1 + 0.4 * np.cos(2 * np.pi * t)]])
     >>> sys = ltp.ltpss([[0.0, 1.0], [-4.0, -0.4]], B, [[1.0, 0.0]], 0, period=1.0)
-    >>> sysc = d2c(sys.sample(0.05, 'tustin'))
+    >>> sysc = ltp.d2c(sys.sample(0.05, 'tustin'))
     >>> sysc.is_floquet_form, np.allclose(sysc.A(0.0), sys.A(0.0))
     (True, True)
     >>> np.allclose(sysc.B(0.3), sys.B(0.3))

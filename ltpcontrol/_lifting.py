@@ -94,13 +94,12 @@ def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, **kwar
 
     Examples
     --------
-    >>> from ltpcontrol._lifting import lift
     >>> B = np.array([[[1.0]], [[0.5]], [[0.0]], [[0.5]]])     # N = 4
     >>> sysd = ltp.ltpss([[0.5]], B, [[1.0]], 0, period=1.0, dt=0.25, name='p')
-    >>> L = lift(sysd)
+    >>> L = ltp.lift(sysd)
     >>> L.nstates, L.dt, L.input_labels
     (4, 0.25, ['u[0]_c0', 'u[0]_c1', 'u[0]_s1', 'u[0]_c2'])
-    >>> Lt = lift(sysd, method='time')
+    >>> Lt = ltp.lift(sysd, method='time')
     >>> Lt.shape, Lt.dt
     ((4, 4), 1.0)
     """

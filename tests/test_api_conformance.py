@@ -43,6 +43,12 @@ T = 1.0
 BP = ltp.PeriodicMatrix([[[0.25]], [[1.0]], [[0.25]]], T)
 SYS = ltp.ltpss([[-1.0]], BP, [[1.0]], 0, period=T, name='plant')
 SYSD = SYS.sample(0.1)
+# a small set of sine experiments on a first-order LTP plant (lifting data)
+_SINE_PLANT = ltp.ltpss([[-2.0]], lambda t: np.array([[1 + 0.5 * np.cos(4 * np.pi * t)]]),
+                        [[1.0]], 0, 0.5)
+_SINE_EXC = ltp.sine_experiments(np.pi / 2 * np.array([k for k in range(1, 16) if k % 4]),
+                                 0.5, dt=0.0125, nperiods=8, settle=12)
+_SINE_RESPONSE = ltp.forced_response(_SINE_PLANT, _SINE_EXC.time, _SINE_EXC.inputs[None])
 H = ltp.htf(SYS, 1)
 OMEGA = np.linspace(0.5, 10.0, 20)
 G_DATA = np.zeros((3, 1, 1, OMEGA.size), complex)
@@ -83,6 +89,14 @@ KWARG_CALLS = {
     'sample_system': lambda **kw: ltp.sample_system(SYS, 0.1, **kw),
     'c2d': lambda **kw: ltp.c2d(SYS, 0.1, **kw),
     'd2c': lambda **kw: ltp.d2c(SYSD, **kw),
+    'floquet_realization': lambda **kw: ltp.floquet_realization(
+        ltp.lift(SYSD, nharmonics=1), 1, SYSD.nsteps, **kw),
+    'to_canonical': lambda **kw: ltp.to_canonical(SYS, **kw),
+    'matrix_errors': lambda **kw: ltp.matrix_errors(SYS, SYS, **kw),
+    'lifted_frequency_response': lambda **kw: ltp.lifted_frequency_response(
+        _SINE_RESPONSE, 0.5, 1, transient=6.0, **kw),
+    'identify_ltp': lambda **kw: ltp.identify_ltp(
+        _SINE_RESPONSE, 0.5, 1, q=10, transient=6.0, input_hold='foh', **kw),
     'lift': lambda **kw: ltp.lift(SYSD, **kw),
     'simulate_hybrid': lambda **kw: ltp.simulate_hybrid(BALL, [0, 0.1], [1.0, 0.0], **kw),
     'periodic_orbit': lambda **kw: ltp.periodic_orbit(FORCED, T, [0.0], npoints=4, **kw),
@@ -168,7 +182,7 @@ def test_unknown_keyword_is_rejected(name):
 
 # result containers document their fields under Attributes, not Parameters
 _RESULT_CLASSES = {'Excitation', 'HTFFit', 'DelayEstimate', 'FDSubspaceInfo',
-                   'PeriodicOrbit'}
+                   'PeriodicOrbit', 'FloquetRealization', 'MatrixErrors', 'LTPSubspaceInfo'}
 
 DOC_DEFECTS = {}
 

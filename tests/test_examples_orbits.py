@@ -90,12 +90,15 @@ class TestHopper:
             hopper.hopper_plant(spring=3)
 
 
+@pytest.fixture(scope='module')
+def vorbit():
+    """The VHOP plant and its limit cycle, shared by the VHOP tests."""
+    plant = vhop.vhop_plant()
+    return plant, vhop.vhop_orbit(plant)
+
+
 @pytest.mark.slow
 class TestVhop:
-    @pytest.fixture(scope='class')
-    def vorbit(self):
-        plant = vhop.vhop_plant()
-        return plant, vhop.vhop_orbit(plant)
 
     def test_limit_cycle_from_release(self, vorbit):
         plant, orbit = vorbit

@@ -1,0 +1,208 @@
+"""Canonical form and matrix errors for comparing LTP realizations.
+
+An identified LTP is known only up to a state transformation.  For a
+system in Floquet form (constant A) the thesis compares realizations in
+controllable canonical form (eqs. 4.122-4.124): with the period average
+``b = B̄_0`` of the input column and the characteristic polynomial
+``s^n + a_1 s^{n-1} + ... + a_n`` of A, the constant change of state
+``x = Q z``, ``Q = [b, Ab, ..., A^{n-1}b] W``, with the Hankel matrix
+
+    W = [[a_{n-1}, a_{n-2}, ..., a_1, 1],
+         [a_{n-2}, ...,       1,   0],
+         ...
+         [1,       0,  ...,        0]],
+
+gives ``Q^{-1} A Q`` the companion form with last row ``[-a_n, ..., -a_1]``
+and ``Q^{-1} b = e_n``; ``B(t) -> Q^{-1} B(t)``, ``C(t) -> C(t) Q``.
+
+The errors of eq. (4.125) are normalised norms: ``‖A - Â‖_2 / ‖A‖_2``
+(spectral norm) for constant A, and for periodic matrices the signal norm
+``‖M‖ = (mean over one period of ‖M(t)‖_F^2)^{1/2}``.
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+from control.exception import ControlArgument, ControlDimension
+
+from ._ltpsys import LTPStateSpace, ltpss
+from ._validation import check_kwargs, check_positive_int
+
+__all__ = ['to_canonical', 'matrix_errors', 'MatrixErrors']
+
+# Controllability matrices with a larger condition number are treated as singular.
+_COND_MAX = 1e12
+
+
+def to_canonical(sys, input=0, name=None, **kwargs):
+    """Controllable canonical form of an LTP system in Floquet form.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        Continuous- or discrete-time LTP with constant A.
+    input : int
+        Input whose period-averaged column ``B̄_0`` defines the form
+        (default 0).
+    name : str, optional
+        Name of the result (default: name of `sys` with '$canonical').
+
+    Returns
+    -------
+    LTPStateSpace
+        Same system with ``A`` in companion form (last row ``[-a_n, ...,
+        -a_1]``), ``B̄_0[:, input] = e_n``, ``B(t) = Q^{-1} B(t)`` and
+        ``C(t) = C(t) Q`` (module notes), as in thesis eqs. (4.122)-(4.124).
+
+    Raises
+    ------
+    ControlArgument
+        If `sys` is not an `LTPStateSpace` or `input` is not an integer.
+    ValueError
+        If A is not constant, `input` is out of range, or ``(A, B̄_0)`` is
+        not controllable.
+    TypeError
+        For unknown keyword arguments.
+
+    Examples
+    --------
+    >>> B = ltp.PeriodicMatrix([[[0.0], [0.2]], [[0.0], [1.0]], [[0.0], [0.2]]], 1.0)
+    >>> sys = ltp.ltpss([[-1.0, 2.0], [0.0, -3.0]], B, [[1.0, 0.0]], 0, period=1.0)
+    >>> can = to_canonical(sys)
+    >>> np.round(can.A(0), 10) + 0.0
+    array([[ 0.,  1.],
+           [-3., -4.]])
+    >>> np.round(can.B.fourier(0)[0].real, 10) + 0.0
+    array([[0.],
+           [1.]])
+    """
+    check_kwargs(kwargs, 'to_canonical')
+    if not isinstance(sys, LTPStateSpace):
+        raise ControlArgument(f"sys must be an LTPStateSpace, got {type(sys).__name__}")
+    if not sys.is_floquet_form:
+        raise ValueError("sys must be in Floquet form (constant A); apply "
+                         "ltpcontrol.floquet_transform first")
+    if isinstance(input, (bool, np.bool_)) or not isinstance(input, (int, np.integer)):
+        raise ControlArgument(f"input must be an integer, got {input!r}")
+    if not 0 <= input < sys.ninputs:
+        raise ValueError(f"input must be in 0..{sys.ninputs - 1}, got {input}")
+    n = sys.nstates
+    A = sys.A(0.0)
+    b = _mean(sys.B, sys)[:, input]
+    # Q = [b, Ab, ..., A^{n-1} b] W,  char poly s^n + a_1 s^{n-1} + ... + a_n
+    ctrb = np.column_stack([np.linalg.matrix_power(A, k) @ b for k in range(n)])
+    if np.linalg.cond(ctrb) > _COND_MAX:
+        raise ValueError(f"(A, mean B[:, {input}]) of sys is not controllable; the "
+                         "controllable canonical form does not exist")
+    a = np.poly(A).real
+    W = np.zeros((n, n))
+    for i in range(n):
+        W[i, :n - i] = a[n - 1 - i::-1][:n - i]          # a_{n-1-i}, ..., a_1, 1
+    Q = ctrb @ W
+    Qinv = np.linalg.inv(Q)
+    if sys.isdtime(strict=True):
+        N = sys.nsteps
+        Bn, Cn = Qinv @ sys.B.sample(N), sys.C.sample(N) @ Q
+        D = sys.D.sample(N)
+    else:
+        Bn, Cn, D = Qinv @ sys.B, sys.C @ Q, sys.D
+    return ltpss(Qinv @ A @ Q, Bn, Cn, D, period=sys.period, dt=sys.dt,
+                 name=sys.name + '$canonical' if name is None else name,
+                 inputs=sys.input_labels, outputs=sys.output_labels)
+
+
+class MatrixErrors(NamedTuple):
+    """Normalised matrix errors of `matrix_errors` (thesis eq. 4.125).
+
+    Attributes
+    ----------
+    A, B, C, D : float
+        ``‖M_est - M_true‖ / ‖M_true‖`` for each system matrix (absolute
+        error when ``‖M_true‖ = 0``).
+
+    Examples
+    --------
+    >>> MatrixErrors(0.1, 0.0, 0.0, 0.0).A
+    0.1
+    """
+
+    A: float
+    B: float
+    C: float
+    D: float
+
+
+def matrix_errors(est, true, nsamples=512, **kwargs):
+    """Normalised errors between the matrices of two LTP systems (eq. 4.125).
+
+    Parameters
+    ----------
+    est, true : LTPStateSpace
+        Estimated and true systems, in the same state coordinates (e.g.
+        both from `to_canonical`), with equal sizes, periods and timebases.
+    nsamples : int
+        Continuous time only: samples per period for the signal norms
+        (default 512).  Discrete time uses the N steps of the period.
+
+    Returns
+    -------
+    MatrixErrors
+        ``‖A - Â‖_2/‖A‖_2`` (spectral norm) when both A are constant, and
+        for the other matrices ``‖ΔM‖/‖M‖`` with the signal norm
+        ``‖M‖ = (mean_t ‖M(t)‖_F^2)^{1/2}`` over one period.  When the true
+        matrix vanishes the absolute error is returned.
+
+    Raises
+    ------
+    ControlArgument
+        If `est` or `true` is not an `LTPStateSpace`.
+    ControlDimension
+        If the sizes differ.
+    ValueError
+        If the periods or timebases differ.
+    TypeError
+        For unknown keyword arguments.
+
+    Examples
+    --------
+    >>> B = ltp.PeriodicMatrix([[[0.4]], [[1.0]], [[0.4]]], 1.0)
+    >>> true = ltp.ltpss([[-2.0]], B, [[1.0]], 0, period=1.0)
+    >>> est = ltp.ltpss([[-2.2]], B, [[1.0]], 0, period=1.0)
+    >>> err = matrix_errors(est, true)
+    >>> round(err.A, 6), err.B, err.C
+    (0.1, 0.0, 0.0)
+    """
+    check_kwargs(kwargs, 'matrix_errors')
+    for label, s in (('est', est), ('true', true)):
+        if not isinstance(s, LTPStateSpace):
+            raise ControlArgument(f"{label} must be an LTPStateSpace, got {type(s).__name__}")
+    if (est.nstates, est.ninputs, est.noutputs) != (true.nstates, true.ninputs, true.noutputs):
+        raise ControlDimension(
+            f"est has (states, inputs, outputs) = {(est.nstates, est.ninputs, est.noutputs)} "
+            f"but true has {(true.nstates, true.ninputs, true.noutputs)}")
+    if not np.isclose(est.period, true.period, rtol=1e-9, atol=0):
+        raise ValueError(f"est and true have different periods ({est.period} and {true.period})")
+    if est.isdtime(strict=True) != true.isdtime(strict=True) or (
+            est.isdtime(strict=True) and not np.isclose(est.dt, true.dt, rtol=1e-9, atol=0)):
+        raise ValueError(f"est and true have different timebases (dt={est.dt} and {true.dt})")
+    nsamples = true.nsteps if true.isdtime(strict=True) else \
+        check_positive_int(nsamples, 'nsamples')
+    errors = []
+    for key in 'ABCD':
+        Me, Mt = getattr(est, key), getattr(true, key)
+        if key == 'A' and Me.is_constant and Mt.is_constant:
+            num = np.linalg.norm(Me(0.0) - Mt(0.0), 2)
+            den = np.linalg.norm(Mt(0.0), 2)
+        else:
+            Se, St = Me.sample(nsamples), Mt.sample(nsamples)
+            num = np.sqrt(np.mean(np.sum((Se - St) ** 2, axis=(1, 2))))
+            den = np.sqrt(np.mean(np.sum(St ** 2, axis=(1, 2))))
+        errors.append(float(num / den) if den > 0 else float(num))
+    return MatrixErrors(*errors)
+
+
+def _mean(P, sys):
+    """Period average of a periodic matrix (mean of the N steps in discrete time)."""
+    if sys.isdtime(strict=True):
+        return P.sample(sys.nsteps).mean(axis=0)
+    return P.fourier(0)[0].real

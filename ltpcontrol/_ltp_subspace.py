@@ -1,0 +1,709 @@
+"""Frequency-domain subspace identification of LTP systems (thesis §4.2).
+
+Pipeline
+--------
+1. *Lifted frequency response* (eqs. 4.54-4.58, 4.74-4.79, errata).  For a
+   real input line ``u = a cos(Ωt + φ)`` the input coefficient is
+   ``U(Ω) = (1/L) Σ_k u[k] e^{-jΩ t_k} = a e^{jφ}/2`` and the output holds the
+   harmonics ``Y_n = (1/L) Σ_k y[k] e^{-j(Ω + nω_p) t_k}`` (DFT over an integer
+   number of periods of the steady state).  The lifted response to the
+   ``U_0`` input column is ``G_n(e^{jΩTs}) = Y_n / U(Ω)``, which for a unit
+   cosine is twice the DFT coefficient (errata).  The real form is
+   ``V^H [G_{-K}; ...; G_K]`` with the unitary V of `ltpcontrol.lift`, so the
+   data are the frequency response of the real lifted LTI system from its
+   ``c0`` input to all its outputs.
+2. *Subspace step* (eqs. 4.80-4.98): `ltpcontrol.fdsubspace` with order
+   ``(2K+1) n_p`` (Remark 8) and ``q`` block rows.
+3. *Floquet realization* (eqs. 4.99-4.112): a similarity that gives the
+   lifted model the parametric structure of a Floquet-form DT LTP system
+   (`ltpcontrol.floquet_realization`).
+4. *Continuous time*: inverse Tustin (eq. 4.104), the matrix logarithm of the
+   exactly sampled ``A_d`` (``A = log(A_d)/Ts``), or that ``A`` followed by a
+   least-squares refit of ``B(t), C(t), D(t)`` on the continuous harmonic
+   response (see `identify_ltp`).
+
+Sampled data of a continuous system identify the exactly sampled Floquet
+multipliers ``e^{λ Ts}``, so inverse Tustin biases ``A`` by about
+``λ² Ts²/12`` (thesis-errata page); the refit route removes this bias.
+"""
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import control as ct
+from control.exception import ControlArgument, ControlDimension
+from tqdm.auto import tqdm
+
+from ._discretize import d2c
+from ._fdsubspace import fdsubspace, FDSubspaceInfo
+from ._lifting import _harmonic_labels, _real_basis
+from ._ltpsys import LTPStateSpace
+from ._periodic_matrix import PeriodicMatrix
+from ._realization import FloquetRealization, floquet_realization
+from ._validation import (check_kwargs, check_period, check_positive_int,
+                          real_array, steps_per_period)
+
+__all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
+
+# Input lines are DFT bins whose magnitude exceeds this fraction of the largest.
+_LINE_RTOL = 1e-3
+# Energy outside the detected lines (relative) above which leakage is reported.
+_LEAKAGE_RTOL = 1e-8
+_HOLDS = (None, 'foh', 'zoh')
+_CONVERSIONS = ('refit', 'log', 'tustin')
+
+
+def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
+                              transient=0.0, input_hold=None, hold_step=None, real=True,
+                              batch_size=64, progress=False, name=None, **kwargs):
+    r"""Lifted frequency response of an LTP system from sine experiments.
+
+    Each experiment applies one real sinusoid (single sine) or a sum of
+    sinusoids (multisine) to a single-input LTP system of known period T.
+    After discarding a transient, the last whole periods of every record
+    are Fourier analysed at the input lines ``Ω`` and at the output
+    harmonics ``Ω + nω_p``, n = -K..K.  The result is the frequency
+    response of the real lifted LTI system (`ltpcontrol.lift`) from its
+    ``c0`` input, i.e. the data of thesis eqs. (4.78)-(4.79).
+
+    Parameters
+    ----------
+    response : control.TimeResponseData or tuple
+        The experiments: a response of `ltpcontrol.forced_response` with
+        several traces, or a tuple ``(timepts, inputs, outputs)`` with
+        ``inputs`` of shape ``(nexp, L)`` or ``(1, nexp, L)`` and
+        ``outputs`` of shape ``(nexp, L)`` (single output) or
+        ``(noutputs, nexp, L)``.  ``timepts`` (length L, uniform step
+        ``Ts``) are absolute times: ``t = 0`` is the phase reference of the
+        period.
+    period : float
+        Period T of the system; ``N = T/Ts`` must be an integer.
+    nharmonics : int
+        Number K of output harmonics kept (``2K+1 <= N``).
+    frequencies : array_like, optional
+        Input lines in rad/s, shape ``(nexp,)`` (one sine per experiment)
+        or ``(nexp, nlines)``.  By default the lines are the DFT bins of
+        each input window whose magnitude exceeds ``1e-3`` of the largest.
+    transient : float, optional
+        Time (s) discarded at the start of every record (default 0).  The
+        analysis window is the largest integer number of periods at the
+        end of the remaining record.
+    input_hold : {None, 'foh', 'zoh'}, optional
+        How the applied input relates to its samples.  None (default): the
+        samples are those of the continuous input.  'foh'/'zoh': the input
+        was interpolated linearly / held between samples (as
+        `ltpcontrol.forced_response` does with ``input_hold``); the input
+        coefficient is then that of the interpolated signal,
+        ``U sinc²(ΩTs/2)`` or ``U sinc(ΩTs/2) e^{-jΩTs/2}``, which removes the
+        hold's gain and phase from the response (its spectral images remain
+        as a small error).
+    hold_step : float, optional
+        Step (s) of the input hold; default the step ``Ts`` of `timepts`.
+        Give it when the records were decimated from a finer simulation
+        (for example ``Ts/4``) or the input is updated faster than sampled.
+    real : bool, optional
+        True (default): real lifted coordinates ``V^H G`` with output
+        labels ``'<y>_c0', '<y>_c1', '<y>_s1', ...`` as in `ltpcontrol.lift`.
+        False: the complex harmonics ``G_n``, n = -K..K (labels
+        ``'<y>_h<n>'``).
+    batch_size : int, optional
+        Number of input lines (experiments, for single sines) analysed at
+        once; bounds the memory use (default 64).
+    progress : bool, optional
+        Show a progress bar over the batches.
+    name : str, optional
+        Name of the result.
+
+    Returns
+    -------
+    control.FrequencyResponseData
+        Discrete-time (``dt = Ts``) response of shape ``((2K+1) noutputs,
+        1, M)`` on the M distinct lines ``Ω`` (increasing, rad/s).  Lines
+        excited in several experiments are averaged.
+
+    Raises
+    ------
+    ValueError
+        If ``T/Ts`` is not an integer, the time points are not uniform, the
+        window is shorter than one period, the lines of an input window
+        are not on its DFT grid and `frequencies` is not given, a line lies within one DFT bin
+        of a multiple of ``ω_p/2`` (the responses to ``±Ω`` then share
+        their output frequencies), two lines of one experiment produce
+        overlapping harmonics, a line is not below the Nyquist frequency,
+        or an input has no line.
+    ControlDimension
+        If inputs, outputs, time points or frequencies have inconsistent
+        shapes (experiment counts or lengths).
+    ControlArgument
+        For a response of the wrong type or more than one input.
+
+    Warns
+    -----
+    UserWarning
+        If a given frequency is off the DFT grid of the window: leakage
+        biases the response.
+
+    Notes
+    -----
+    With ``U(Ω)`` and ``Y_n`` as in the module notes, ``G_n = Y_n/U(Ω)``.
+    For ``u = cos(Ωt)``, ``U = 1/2`` and ``G_n`` is twice the DFT
+    coefficient of the output at ``Ω + nω_p`` (thesis-errata page).  The
+    real form uses the unitary ``V`` with columns ``c_0 = e_0``, ``c_n =
+    (e_n + e_{-n})/√2``, ``s_n = j(e_n - e_{-n})/√2`` (errata items 3-4).
+
+    Examples
+    --------
+    Two unit cosines through a static gain ``1 + cos(ω_p t)``:
+
+    >>> sys = ltp.ltpss(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)),
+    ...                 lambda t: np.array([[1 + np.cos(4 * np.pi * t)]]), 0.5)
+    >>> exc = ltp.sine_experiments([1.0, 3.0], 0.5, dt=0.05, nperiods=8)
+    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
+    >>> G = ltp.lifted_frequency_response(resp, 0.5, 1, real=False)
+    >>> np.round(G.frdata[:, 0, 0].real, 6)            # G_{-1}, G_0, G_1
+    array([0.5, 1. , 0.5])
+    >>> G.output_labels[:2]
+    ['y[0]_h-1', 'y[0]_h0']
+    """
+    check_kwargs(kwargs, 'lifted_frequency_response')
+    period = check_period(period)
+    t, u, y, ylabels, ulabel = _parse_response(response)
+    dt = _uniform_step(t)
+    N = steps_per_period(period, dt, 'the time step of timepts')
+    K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
+    if 2 * K + 1 > N:
+        raise ValueError(f"nharmonics={K} needs 2K+1 <= N = {N} samples per period")
+    if input_hold not in _HOLDS:
+        raise ValueError(f"input_hold must be None, 'foh' or 'zoh', got {input_hold!r}")
+    if not isinstance(real, (bool, np.bool_)):
+        raise ControlArgument(f"real must be True or False, got {real!r}")
+    hold_step = dt if hold_step is None else check_period(hold_step, 'hold_step')
+    batch_size = check_positive_int(batch_size, 'batch_size')
+    transient = float(real_array(transient, 'transient', ndim=0))
+    if transient < 0:
+        raise ValueError(f"transient must be >= 0, got {transient}")
+
+    # Window: the last P whole periods after the transient.
+    nexp, L = u.shape
+    skip = int(np.ceil(transient / dt - 1e-9))
+    P = (L - skip) // N
+    if P < 1:
+        raise ValueError(f"the records ({L} samples) hold no whole period ({N} samples) "
+                         f"after the transient of {transient} s")
+    start = L - P * N
+    tw, uw, yw = t[start:], u[:, start:], y[:, :, start:]
+    window = P * period
+    lines = _lines(uw, frequencies, nexp, window, dt, period)
+
+    # Output harmonics: Y_n = (1/L) Σ_k y[k] e^{-jΩt_k} e^{-jnω_p t_k}, where the
+    # second factor repeats every period (N samples).
+    wp = 2 * np.pi / period
+    harm = np.arange(-K, K + 1)
+    tper = tw[:N]
+    Eh = np.exp(-1j * wp * harm[:, None] * tper[None, :])          # (2K+1, N)
+    ny = y.shape[0]
+    # one (experiment, line) pair per data point
+    exp_index = np.concatenate([np.full(Om.size, e) for e, Om in enumerate(lines)])
+    line_omega = np.concatenate(lines)
+    values = []
+    npair, Lw = line_omega.size, uw.shape[1]
+    for b0 in tqdm(range(0, npair, batch_size), desc="lifted FR", leave=False,
+                   disable=(not progress) or None):
+        Om, ex = line_omega[b0:b0 + batch_size], exp_index[b0:b0 + batch_size]
+        Ein = np.exp(-1j * Om[:, None] * tw[None, :])               # (b, Lw)
+        U = np.einsum('bk,bk->b', Ein, uw[ex]) / Lw
+        # Σ over periods of y e^{-jΩt}, then the periodic harmonic factor.
+        Z = (yw[:, ex] * Ein).reshape(ny, Om.size, P, N).sum(2)   # (ny, b, N)
+        Y = np.einsum('obk,hk->hob', Z, Eh) / Lw                   # (2K+1, ny, b)
+        values.append(Y / (U * _hold_factor(Om, hold_step, input_hold)))
+    omega = line_omega
+    G = np.concatenate(values, axis=2).reshape((2 * K + 1) * ny, -1)
+    # Average lines excited by several experiments; sort by frequency.
+    omega, inverse = np.unique(np.round(omega * window / (2 * np.pi), 6), return_inverse=True)
+    omega = omega * 2 * np.pi / window
+    counts = np.bincount(inverse)
+    Gm = np.zeros((G.shape[0], omega.size), complex)
+    np.add.at(Gm.T, inverse, G.T)
+    Gm /= counts
+    if real:
+        V, tags = _real_basis(harm, N)
+        Gm = np.kron(V, np.eye(ny)).conj().T @ Gm
+        outputs = _harmonic_labels(ylabels, tags)
+        inputs = [f'{ulabel}_c0']
+    else:
+        outputs = _harmonic_labels(ylabels, [f'h{n}' for n in harm])
+        inputs = [f'{ulabel}_h0']
+    return ct.frd(Gm[:, None, :], omega, dt, name=name, inputs=inputs, outputs=outputs)
+
+
+@dataclass(frozen=True)
+class LTPSubspaceInfo:
+    """Diagnostics returned by `identify_ltp` with ``return_info=True``.
+
+    Attributes
+    ----------
+    data : control.FrequencyResponseData
+        Real lifted frequency response used for identification.
+    lifted : control.StateSpace
+        Identified real lifted LTI model (discrete time, order ``(2K+1) n_p``).
+    subspace : FDSubspaceInfo
+        Diagnostics of the subspace step (singular values, q, residual).
+    realization : FloquetRealization
+        Result of `ltpcontrol.floquet_realization` on `lifted`: the
+        discrete-time Floquet-form system ``realization.sys``, the
+        structure distance (eq. 4.105) and the ``success`` flag.
+    conversion : str
+        Continuous-time conversion used ('refit', 'log' or 'tustin').
+    relative_residual : float
+        ``‖G - Ĝ‖ / ‖G‖`` of the continuous-time model on the continuous
+        harmonic response ``G_n(jΩ)`` (all lines, harmonics -K..K).
+
+    Examples
+    --------
+    >>> LTPSubspaceInfo.__dataclass_fields__.keys() >= {'lifted', 'realization'}
+    True
+    """
+
+    data: ct.FrequencyResponseData
+    lifted: ct.StateSpace
+    subspace: FDSubspaceInfo
+    realization: FloquetRealization
+    conversion: str
+    relative_residual: float
+
+
+def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
+                 realization='direct', realization_options=None, refit_a=True,
+                 estimate_d=True,
+                 seed=None, progress=False,
+                 return_info=False, name=None, **kwargs):
+    r"""Identify a continuous-time LTP model from sine experiments (thesis §4.2).
+
+    Runs the whole frequency-domain subspace pipeline: lifted frequency
+    response → LTI subspace model of order ``(2K+1) n_p`` (Remark 8) →
+    Floquet realization → continuous-time LTP system in Floquet form
+    (constant A).
+
+    Parameters
+    ----------
+    data : control.FrequencyResponseData, control.TimeResponseData or tuple
+        Either the real lifted response of `lifted_frequency_response`
+        (with ``2K+1`` harmonics per output) or the experiments themselves
+        (anything `lifted_frequency_response` accepts; its keywords
+        `frequencies`, `transient`, `input_hold`, `hold_step` and `batch_size` may be
+        given here).
+    period : float
+        Period T of the system.
+    nstates : int
+        Number ``n_p`` of states of the LTP system.
+    nharmonics : int, optional
+        Number K of harmonics of the lifting (default 1).
+    q : int, optional
+        Block rows of the subspace data matrices (eq. 4.80), ``q > (2K+1)
+        n_p``.  It matters: ``q ≈ 20`` reproduces the thesis's accuracy on
+        its Mathieu example, larger values average better (thesis-errata
+        page).  Default: that of `ltpcontrol.fdsubspace`.
+    conversion : {'refit', 'log', 'tustin'}, optional
+        Continuous-time model from the discrete realization
+        ``(A_d, B_d[k], C_d[k], D_d[k])``:
+
+        * 'tustin': inverse bilinear map, eq. (4.104) (the thesis route);
+        * 'log': ``A = log(A_d)/Ts`` (sampled data identify the exactly
+          sampled multipliers ``e^{λ Ts}``) and ``B``, ``C``, ``D`` by
+          inverting a zero-order hold (`ltpcontrol.d2c` with 'log');
+        * 'refit' (default): the 'log' ``A`` and a Gauss-Newton
+          least-squares refit of the Fourier coefficients of ``B(t)``
+          (harmonics -K..K), ``C(t)`` (-2K..2K) and ``D(t)`` (-K..K) to the
+          continuous harmonic response (see Notes), started from 'log'.
+
+        'refit' is the default because it is the most accurate on the
+        thesis example (see the Mathieu gallery example): inverse Tustin
+        leaves an ``O(λ² Ts²)`` bias, 'log' an ``O(ω Ts)`` one in B and C.
+    realization : {'direct', 'pso'}, optional
+        Method of `ltpcontrol.floquet_realization` (default 'direct').
+    realization_options : dict, optional
+        Further keywords of `ltpcontrol.floquet_realization` (``tol``,
+        ``ladder_tol``, ``distance``, ``pso_options``, ...).
+    refit_a : bool, optional
+        With ``conversion='refit'``, refit the constant ``A`` together with
+        ``B``, ``C``, ``D`` (default True, which makes the result independent
+        of `q`); False keeps the 'log' ``A`` and refits ``B``, ``C``, ``D``
+        given ``A`` only.
+    estimate_d : bool, optional
+        Estimate a feedthrough (default True); False forces ``D = 0``.
+    seed : int, optional
+        Seed of the 'pso' realization search (reproducibility).
+    progress : bool, optional
+        Show progress bars (experiment batches, realization).
+    return_info : bool, optional
+        Also return an `LTPSubspaceInfo`.
+    name : str, optional
+        Name of the identified system (default ``'ltp_subspace'``).
+
+    Returns
+    -------
+    sys : LTPStateSpace
+        Continuous-time model in Floquet form (constant A), one input and
+        the outputs of the data.
+    info : LTPSubspaceInfo
+        Only with ``return_info=True``.
+
+    Raises
+    ------
+    ValueError
+        If there are too few frequencies for the order ``(2K+1) n_p`` and
+        `q`, the data do not have ``2K+1`` harmonics per output, or an
+        option is unknown (and for the data errors of
+        `lifted_frequency_response`).
+    ControlArgument
+        If `data` has the wrong type or is not discrete-time.
+    TypeError
+        For unknown keyword arguments.
+
+    Warns
+    -----
+    UserWarning
+        If the realization does not find the Floquet structure (the model
+        is then returned but is not trustworthy), or if the refit stops
+        before converging.
+
+    Notes
+    -----
+    With ``R_m(Ω) = (j(Ω + mω_p) I - A)^{-1}``, the continuous harmonic
+    response of a Floquet-form model to the input harmonic 0 is
+
+    .. math::
+
+        G_n(jΩ) = \sum_{m=-K}^{K} C_{n-m} R_m(Ω) B_m + D_n,
+        \qquad n = -K..K,
+
+    bilinear in (B, C) and linear in D.  'refit' minimises
+    ``Σ |G_n - Ĝ_n|²`` over all lines and harmonics by Gauss-Newton steps
+    (minimum-norm steps absorb the similarity freedom left by a fixed A).
+    The identified model and the true system are related by a similarity:
+    compare them in a canonical form (`ltpcontrol.to_canonical`).
+
+    Examples
+    --------
+    A first-order system with a modulated input gain, identified from
+    single-sine experiments (lines off the multiples of ``ω_p/2``):
+
+    >>> sys = ltp.ltpss([[-2.0]], lambda t: np.array([[1 + 0.5 * np.cos(4 * np.pi * t)]]),
+    ...                 [[1.0]], 0, period=0.5)
+    >>> w = np.pi / 2 * np.array([k for k in range(1, 16) if k % 4])
+    >>> exc = ltp.sine_experiments(w, 0.5, dt=0.0125, nperiods=8, settle=12)
+    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
+    >>> model = ltp.identify_ltp(resp, 0.5, 1, q=10, transient=6.0, input_hold='foh')
+    >>> np.round(model.A(0.0), 4)
+    array([[-2.]])
+    >>> B = model.B.fourier(1)[:, 0, 0]           # B_1/B_0 = 0.25
+    >>> round(float((B[2] / B[1]).real), 4)
+    0.25
+    """
+    lfr_keys = ('frequencies', 'transient', 'input_hold', 'hold_step', 'batch_size')
+    lfr_kwargs = {key: kwargs.pop(key) for key in lfr_keys if key in kwargs}
+    check_kwargs(kwargs, 'identify_ltp')
+    period = check_period(period)
+    nstates = check_positive_int(nstates, 'nstates')
+    K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
+    if conversion not in _CONVERSIONS:
+        raise ValueError(f"conversion must be one of {_CONVERSIONS}, got {conversion!r}")
+    if isinstance(data, ct.FrequencyResponseData):
+        if lfr_kwargs:
+            raise TypeError(f"identify_ltp: {sorted(lfr_kwargs)} only apply to time "
+                            "records, not to frequency-response data")
+        G = data
+    else:
+        G = lifted_frequency_response(data, period, K, progress=progress, **lfr_kwargs)
+    H = 2 * K + 1
+    if not G.dt or G.dt is True:
+        raise ControlArgument("data must be discrete-time frequency-response data "
+                              "with a numeric sampling time (from "
+                              "lifted_frequency_response)")
+    if G.ninputs != 1 or G.noutputs % H:
+        raise ValueError(f"data must have one input and (2K+1) = {H} lifted outputs per "
+                         f"system output, got shape {G.frdata.shape[:2]}")
+    ny = G.noutputs // H
+    Ts = float(G.dt)
+    N = steps_per_period(period, Ts, 'the sampling time of data')
+    order = H * nstates
+    M = G.omega.size
+    # fdsubspace needs 2M >= q + order with q > order: at least order + 1 lines.
+    if 2 * M < 2 * order + 1 or (q is not None and 2 * M < q + order):
+        raise ValueError(
+            f"too few frequencies: {M} lines for the lifted order (2K+1)*nstates = "
+            f"{order}{'' if q is None else f' and q={q}'}; need at least "
+            f"{order + 1 if q is None else -(-(q + order) // 2)} distinct lines")
+
+    lifted, sinfo = fdsubspace(G, order=order, q=q, estimate_d=estimate_d,
+                               return_info=True)
+    real = floquet_realization(lifted, K, N, period=period, method=realization,
+                               input_harmonics='zero', seed=seed, progress=progress,
+                               **(realization_options or {}))
+    if real.sys is None:
+        raise ValueError(f"the Floquet realization failed: {real.message}")
+    if not real.success:
+        hint = ("the refit starts from it: check info.relative_residual"
+                if conversion == 'refit' else "the model is not trustworthy")
+        warnings.warn(f"{real.message}; {hint} (or try another realization method, "
+                      "seed or q)", UserWarning, stacklevel=2)
+    sysd = real.sys
+    name = 'ltp_subspace' if name is None else name
+    labels = dict(inputs=[G.input_labels[0].rsplit('_', 1)[0]],
+                  outputs=[lab.rsplit('_', 1)[0] for lab in G.output_labels[:ny]])
+    # Continuous harmonic data G_n(jΩ), n = -K..K (undo the real transform).
+    V, _ = _real_basis(np.arange(-K, K + 1), N)
+    Gc = (np.kron(V, np.eye(ny)) @ G.frdata[:, 0, :]).reshape(H, ny, M)
+    if conversion == 'tustin':
+        sysc = d2c(sysd, 'tustin', name=name, **labels)
+    else:
+        sysc = d2c(sysd, 'log', name=name, **labels)
+        if conversion == 'refit':
+            sysc = _refit(sysc, Gc, G.omega, K, estimate_d, refit_a, name, labels)
+    if not return_info:
+        return sysc
+    resid = _harmonic_response(sysc, G.omega, K) - Gc
+    info = LTPSubspaceInfo(data=G, lifted=lifted, subspace=sinfo, realization=real,
+                           conversion=conversion,
+                           relative_residual=float(np.linalg.norm(resid)
+                                                   / np.linalg.norm(Gc)))
+    return sysc, info
+
+
+#
+# Private helpers
+#
+
+def _parse_response(response):
+    """Return ``(t, u (nexp, L), y (ny, nexp, L), output labels, input label)``."""
+    if isinstance(response, ct.TimeResponseData):
+        t, u, y = response.time, response.u, response.y
+        ylabels = list(response.output_labels)
+        ulabel = response.input_labels[0] if response.ninputs else 'u[0]'
+        if u is None:
+            raise ControlArgument("response carries no inputs; pass (timepts, inputs, "
+                                  "outputs) instead")
+        if u.ndim == 2:                          # single trace
+            u, y = u[:, None, :], y[:, None, :]
+    elif isinstance(response, tuple) and len(response) == 3:
+        t, u, y = response
+        u = real_array(u, 'inputs', ndim=(1, 2, 3))
+        y = real_array(y, 'outputs', ndim=(1, 2, 3))
+        u = u.reshape((1,) * (3 - u.ndim) + u.shape)
+        y = y.reshape((1,) * (3 - y.ndim) + y.shape)
+        ylabels, ulabel = [f'y[{i}]' for i in range(y.shape[0])], 'u[0]'
+    else:
+        raise ControlArgument("response must be a control.TimeResponseData or a tuple "
+                              f"(timepts, inputs, outputs), got {type(response).__name__}")
+    t = real_array(t, 'timepts', ndim=1)
+    u = real_array(u, 'inputs', ndim=3)
+    y = real_array(y, 'outputs', ndim=3)
+    if u.shape[0] != 1:
+        raise ControlArgument(f"the experiments must have a single input, got {u.shape[0]}")
+    if u.shape[1:] != y.shape[1:]:
+        raise ControlDimension(
+            f"inputs (experiments, samples) = {u.shape[1:]} and outputs "
+            f"{y.shape[1:]} are inconsistent: every experiment needs one input and one "
+            "output record of the same length")
+    if u.shape[2] != t.size:
+        raise ControlDimension(f"the records have {u.shape[2]} samples but timepts has "
+                               f"{t.size}")
+    return t, u[0], y, ylabels, ulabel
+
+
+def _uniform_step(t):
+    """The step of uniformly spaced, increasing `t`."""
+    if t.size < 2:
+        raise ValueError("timepts must hold at least two samples")
+    d = np.diff(t)
+    dt = (t[-1] - t[0]) / (t.size - 1)
+    if dt <= 0 or np.max(np.abs(d - dt)) > 1e-9 * max(dt, np.abs(t).max()):
+        raise ValueError("timepts must be uniformly spaced and increasing")
+    return dt
+
+
+def _lines(uw, frequencies, nexp, window, dt, period):
+    """Input lines (rad/s) of every experiment, validated."""
+    bin_ = 2 * np.pi / window
+    Lw = uw.shape[1]
+    if frequencies is None:
+        spec = np.abs(np.fft.rfft(uw, axis=1)) / Lw
+        spec[:, 0] = 0.0                                  # DC is no line
+        if Lw % 2 == 0:
+            spec[:, -1] = 0.0                             # nor is Nyquist
+        peak = spec.max(axis=1)
+        if np.any(peak == 0):
+            raise ValueError(f"the input of experiment {int(np.argmin(peak))} has no "
+                             "spectral line in the analysis window")
+        on = spec >= _LINE_RTOL * peak[:, None]
+        lines = [np.flatnonzero(row) * bin_ for row in on]
+        total = np.sum(uw ** 2, axis=1)
+        inline = 2 * Lw ** 2 * np.sum(np.where(on, spec, 0.0) ** 2, axis=1) / Lw
+        if np.any(total - inline > _LEAKAGE_RTOL * total):
+            raise ValueError("an input window is not a sum of sinusoids on the DFT grid "
+                             "of the window (leakage), so its lines cannot be detected; "
+                             "choose the record length or pass frequencies=")
+    else:
+        f = real_array(frequencies, 'frequencies', ndim=(1, 2))
+        if f.shape[0] != nexp:
+            raise ControlDimension(f"frequencies has {f.shape[0]} rows for {nexp} "
+                                   "experiments")
+        f = f.reshape(nexp, -1)
+        off = np.abs(f / bin_ - np.round(f / bin_))
+        if np.any(off > 1e-6):
+            warnings.warn("some frequencies are not on the DFT grid 2π/window = "
+                          f"{bin_:.6g} rad/s of the analysis window: leakage biases "
+                          "the response", UserWarning, stacklevel=3)
+        lines = list(f)
+    half = np.pi / period                                 # ω_p / 2
+    for e, Om in enumerate(lines):
+        if np.any(Om <= 0) or np.any(Om >= np.pi / dt):
+            raise ValueError(f"frequencies of experiment {e} must lie in (0, π/Ts) = "
+                             f"(0, {np.pi / dt:.6g}) rad/s")
+        # ±Ω share output frequencies when 2Ω ≡ 0 (mod ω_p); lines l, l' when
+        # Ω_l ± Ω_l' ≡ 0 (mod ω_p).
+        dist = np.abs(Om - np.round(Om / half) * half)
+        if np.any(dist < 0.49 * bin_):
+            raise ValueError(
+                f"frequencies {np.round(Om[dist < 0.49 * bin_], 6).tolist()} rad/s of "
+                f"experiment {e} are multiples of omega_p/2 = {half:.6g} rad/s (within "
+                "one DFT bin): the responses to +Ω and -Ω fall on the same output "
+                "frequencies")
+        wp = 2 * half
+        for s in (-1, 1):
+            d = Om[:, None] + s * Om[None, :]
+            d = np.abs(d - np.round(d / wp) * wp)
+            np.fill_diagonal(d, np.inf)
+            if np.any(d < 0.49 * bin_):
+                raise ValueError(f"two lines of experiment {e} differ or sum to a "
+                                 "multiple of omega_p: their output harmonics overlap")
+    return lines
+
+
+def _hold_factor(omega, dt, hold):
+    """Gain of the input hold at ω: 1, sinc²(ωTs/2) or sinc(ωTs/2) e^{-jωTs/2}."""
+    if hold is None:
+        return np.ones_like(omega)
+    x = np.sinc(omega * dt / (2 * np.pi))                  # np.sinc(x) = sin(πx)/(πx)
+    return x ** 2 if hold == 'foh' else x * np.exp(-0.5j * omega * dt)
+
+
+def _resolvents(A, omega, wp, K):
+    """``R_m(Ω) = (j(Ω + mω_p) I - A)^{-1}``, shape (M, 2K+1, n, n)."""
+    n = A.shape[0]
+    s = 1j * (omega[:, None] + wp * np.arange(-K, K + 1)[None, :])
+    return np.linalg.inv(s[..., None, None] * np.eye(n) - A)
+
+
+def _model_response(R, Bc, Cc, Dc, K):
+    """``G_n = Σ_m C_{n-m} R_m B_m + D_n`` for n = -K..K, shape (2K+1, ny, M)."""
+    X = np.einsum('wmij,mj->wmi', R, Bc[:, :, 0])                 # R_m B_m
+    idx = np.arange(-K, K + 1)
+    Cnm = Cc[(idx[:, None] - idx[None, :]) + 2 * K]               # (n, m, ny, nx)
+    return np.einsum('nmoi,wmi->now', Cnm, X) + Dc[:, :, 0, None]
+
+
+def _harmonic_response(sys, omega, K):
+    """Continuous harmonic response G_n(jΩ), n = -K..K, of a Floquet-form model."""
+    wp = 2 * np.pi / sys.period
+    R = _resolvents(sys.A(0.0), omega, wp, K)
+    nb = max(K, sys.B.nharmonics or 0, 1)
+    nc = max(2 * K, sys.C.nharmonics or 0, 1)
+    Bc = _pad(sys.B.fourier(nb), K)
+    Cc = _pad(sys.C.fourier(nc), 2 * K)
+    Dc = _pad(sys.D.fourier(max(K, sys.D.nharmonics or 0)), K)
+    return _model_response(R, Bc, Cc, Dc, K)
+
+
+def _pad(coeffs, K):
+    """Central harmonics -K..K of a coefficient array (2J+1, ...)."""
+    J = coeffs.shape[0] // 2
+    return coeffs[J - K:J + K + 1]
+
+
+def _conj_map(H, size):
+    """Real parameters → complex coefficients ``P_h``, h = -H..H, P_{-h} = conj(P_h)."""
+    # real vector [Re P_0, Re P_1, Im P_1, ..., Re P_H, Im P_H] (each `size` long)
+    T = np.zeros(((2 * H + 1) * size, (2 * H + 1) * size), complex)
+    eye = np.eye(size)
+    T[H * size:(H + 1) * size, :size] = eye
+    for h in range(1, H + 1):
+        re, im = slice((2 * h - 1) * size, 2 * h * size), slice(2 * h * size, (2 * h + 1) * size)
+        for sign in (1, -1):
+            rows = slice((H + sign * h) * size, (H + sign * h + 1) * size)
+            T[rows, re] = eye
+            T[rows, im] = sign * 1j * eye
+    return T
+
+
+def _refit(sys, Gc, omega, K, estimate_d, refit_a, name, labels, maxiter=30,
+           tol=1e-13):
+    """Gauss-Newton refit of B_m, C_l, D_n (and A) (see `identify_ltp`)."""
+    A = sys.A(0.0)
+    nx, ny = A.shape[0], Gc.shape[1]
+    wp = 2 * np.pi / sys.period
+    idx = np.arange(-K, K + 1)
+    Tb, Tc, Td = _conj_map(K, nx), _conj_map(2 * K, ny * nx), _conj_map(K, ny)
+    T = np.zeros((Tb.shape[0] + Tc.shape[0] + Td.shape[0],) * 2, complex)
+    nb, nc = Tb.shape[0], Tc.shape[0]
+    T[:nb, :nb], T[nb:nb + nc, nb:nb + nc], T[nb + nc:, nb + nc:] = Tb, Tc, Td
+    keep = np.ones(T.shape[1], bool)
+    if not estimate_d:
+        keep[nb + nc:] = False
+    T = T[:, keep]
+    theta = np.linalg.lstsq(T, np.concatenate([
+        _pad(sys.B.fourier(max(K, sys.B.nharmonics or 0)), K).ravel(),
+        _pad(sys.C.fourier(max(2 * K, sys.C.nharmonics or 0)), 2 * K).ravel(),
+        _pad(sys.D.fourier(max(K, sys.D.nharmonics or 0)), K).ravel()
+        * float(estimate_d)]), rcond=None)[0].real
+
+    ncoef = theta.size
+    if refit_a:
+        theta = np.concatenate([theta, A.ravel()])
+
+    def unpack(th):
+        c = T @ th[:ncoef]
+        return (c[:nb].reshape(2 * K + 1, nx, 1), c[nb:nb + nc].reshape(4 * K + 1, ny, nx),
+                c[nb + nc:].reshape(2 * K + 1, ny, 1),
+                th[ncoef:].reshape(nx, nx) if refit_a else A)
+
+    M = omega.size
+    for _ in range(maxiter):
+        Bc, Cc, Dc, Ak = unpack(theta)
+        R = _resolvents(Ak, omega, wp, K)
+        r = (_model_response(R, Bc, Cc, Dc, K) - Gc).ravel()       # (n, o, w)
+        # Jacobian w.r.t. the complex coefficients, rows (n, o, w).
+        Cnm = Cc[(idx[:, None] - idx[None, :]) + 2 * K]            # (n, m, o, i)
+        CR = np.einsum('nmoi,wmij->nowmj', Cnm, R)                 # C_{n-m} R_m
+        JB = CR.reshape(-1, nb)
+        X = np.einsum('wmij,mj->wmi', R, Bc[:, :, 0])              # (w, m, i)
+        # dG_n = Σ_l dC_l X_{n-l}, |n-l| <= K
+        Xsel = np.zeros((2 * K + 1, 4 * K + 1, M, nx), complex)
+        for a, n in enumerate(idx):
+            Xsel[a, n - idx + 2 * K] = X.transpose(1, 0, 2)
+        eye = np.eye(ny)
+        JC = np.einsum('oq,nlwi->nowlqi', eye, Xsel).reshape(-1, nc)
+        JD = np.einsum('na,oq,w->nowaq', np.eye(2 * K + 1), eye,
+                       np.ones(M)).reshape(-1, Td.shape[0])
+        J = np.hstack([JB, JC, JD]) @ T
+        if refit_a:
+            # dR_m = R_m dA R_m:  dG_n = Σ_m C_{n-m} R_m dA R_m B_m
+            JA = np.einsum('nowmi,wmj->nowij', CR, X).reshape(-1, nx * nx)
+            J = np.hstack([J, JA])
+        Jr = np.vstack([J.real, J.imag])
+        scale = np.linalg.norm(Jr, axis=0)
+        scale[scale == 0] = 1.0
+        step = np.linalg.lstsq(Jr / scale, -np.concatenate([r.real, r.imag]),
+                               rcond=None)[0] / scale
+        theta = theta + step
+        if np.linalg.norm(step) <= tol * max(1.0, np.linalg.norm(theta)):
+            break
+    else:
+        warnings.warn(f"the least-squares refit did not converge in {maxiter} "
+                      "iterations", UserWarning, stacklevel=3)
+    Bc, Cc, Dc, A = unpack(theta)
+    period = sys.period
+    return LTPStateSpace(A, PeriodicMatrix(Bc, period), PeriodicMatrix(Cc, period),
+                         PeriodicMatrix(Dc, period), period, name=name,
+                         states=sys.state_labels, **labels)
