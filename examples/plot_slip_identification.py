@@ -16,8 +16,10 @@ Steps, as in Sections 2.4-2.5:
 3. leg stiffness and damping per spring and per predictor (SLIPD, AAS,
    SLIP, Geyer) on the cost (2.33), with k-fold cross-validation
    (Table 2.4);
-4. one stride against the AAS and Geyer predictions (Fig. 2.5);
-5. apex position error against the relative touchdown angle (Fig. 2.6).
+4. identification accuracy on clean data: the same pipeline on a robot
+   that is exactly the extended SLIP, with known ``k, d``;
+5. one stride against the AAS and Geyer predictions (Fig. 2.5);
+6. apex position error against the relative touchdown angle (Fig. 2.6).
 
 Set ``LTP_EXAMPLES_QUICK=1`` for a reduced run (fewer experiments and
 folds).
@@ -36,14 +38,14 @@ from joblib import Parallel, delayed  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from slip_data import MONOPOD, SPRINGS, generate_strides, spring_params  # noqa: E402
-from slip_identification import (cross_validate, format_table,  # noqa: E402
+from slip_data import CLEAN, MONOPOD, SPRINGS, generate_strides  # noqa: E402
+from slip_identification import (cross_validate, fit_leg, format_table,  # noqa: E402
                                  identify_flight_damping, identify_vertical,
                                  relative_angle_study)
 from slip_model import METHODS, stride_trajectory  # noqa: E402
 
 QUICK = os.environ.get("LTP_EXAMPLES_QUICK", "0") == "1"
-N_HOPS, N_STRIDES, FOLDS = (15, 40, 5) if QUICK else (50, 120, 30)
+N_HOPS, N_STRIDES, FOLDS, N_CLEAN = (15, 40, 5, 30) if QUICK else (50, 120, 30, 60)
 ORDER = ("hard", "medium", "soft", "softer")
 start = time.time()
 rng = np.random.default_rng(2017)
@@ -105,6 +107,54 @@ print(f"{'Vertical':<9}" + "".join(
     for s in ORDER))
 print(f"{'True':<9}" + "".join(f"{SPRINGS[s][0]:8.0f} / {SPRINGS[s][1]:5.1f}".rjust(18)
                                for s in ORDER))
+
+# %%
+# Identification accuracy on clean data
+# -------------------------------------
+# The study above mixes two things: how well the identification recovers
+# the leg and how a predictor copes with a robot that is not exactly the
+# extended SLIP (ringing boom, stride-to-stride variation).  Repeating the
+# whole pipeline (vertical hops, flight damping, leg fits) on a robot that
+# *is* the extended SLIP, measured with the same encoders, sampling and
+# filter, isolates the first: SLIPD recovers ``k, d`` within about 1 %; AAS
+# keeps a few percent of bias that grows as the spring softens (its stance
+# approximation error, not a fitting artefact: it is there on exact data
+# too); the lossless SLIP, starting from the same data, needs a stiffer leg
+# than the truth.  Geyer's approximation on its own fits softer springs
+# than the truth even on lossless data; the leg damping moves its fit up
+# by a few percent, far less than the +40-120 % of Table 2.5.
+
+clean_hops = {s: generate_strides(s, N_HOPS, rng, vertical=True, perturbations=CLEAN)
+              for s in ORDER}
+clean_runs = {s: generate_strides(s, N_CLEAN, rng, perturbations=CLEAN) for s in ORDER}
+clean_vertical = identify_vertical(clean_hops, 3.4, MONOPOD, manual)
+clean_d_h, clean_vy0 = identify_flight_damping([clean_runs[s] for s in ORDER])
+clean_vy0 = dict(zip(ORDER, clean_vy0))
+clean_model = MONOPOD.replace(m_b=clean_vertical["m_b"], m_l=clean_vertical["m_l"],
+                              d_v=clean_vertical["d_v"], d_h=clean_d_h)
+clean_fits = Parallel(n_jobs=-1)(
+    delayed(fit_leg)(clean_runs[s], clean_model.replace(k=clean_vertical["springs"][s][0],
+                                                        d=clean_vertical["springs"][s][1]),
+                     m, clean_vy0[s], max_nfev=100)
+    for s, m in jobs)
+clean_fits = dict(zip(jobs, clean_fits))
+print(f"\nClean data ({N_CLEAN} strides per spring): m_l = {clean_vertical['m_l']:.3f}, "
+      f"d_v = {clean_vertical['d_v']:.3f}, d_h = {clean_d_h:.3f}")
+print("fitted k (N/m) / d (Ns/m), deviation from the truth in %")
+print(f"{'':<9}" + "".join(f"{s:>30}" for s in ORDER))
+for m in METHODS:
+    cells = []
+    for s in ORDER:
+        k, d, _ = clean_fits[s, m]
+        k0, d0 = SPRINGS[s]
+        cells.append(f"{k:5.0f} ({100 * (k / k0 - 1):+5.1f}) / " + (
+            f"{d:4.1f} ({100 * (d / d0 - 1):+5.1f})" if m in ("SLIPD", "AAS") else "   –        "))
+    print(f"{m:<9}" + "".join(f"{c:>30}" for c in cells))
+cells = []
+for s in ORDER:
+    (k, d), (k0, d0) = clean_vertical["springs"][s], SPRINGS[s]
+    cells.append(f"{k:5.0f} ({100 * (k / k0 - 1):+5.1f}) / {d:4.1f} ({100 * (d / d0 - 1):+5.1f})")
+print(f"{'Vertical':<9}" + "".join(f"{c:>30}" for c in cells))
 
 # %%
 # One stride against the predictions (Fig. 2.5)

@@ -29,7 +29,8 @@ from slip_model import Event, SLIPParams, boom_gravity, neutral_touchdown_angle
 
 __all__ = ["MONOPOD", "SPRINGS", "Perturbations", "spring_params",
            "simulate_stride", "record_stride", "process_record",
-           "Record", "Transitions", "StrideSet", "generate_strides", "IDEAL"]
+           "Record", "Transitions", "StrideSet", "generate_strides", "IDEAL",
+           "CLEAN"]
 
 #: Monopod constants (Table 2.3, Section 2.4.2, eq. 2.24).
 MONOPOD = SLIPParams(m_b=3.21, m_l=0.19, d_h=0.3, d_v=0.06, rho0=0.22,
@@ -97,6 +98,13 @@ class Perturbations:
 #: Ideal measurements: exact samples, no unmodelled effects.
 IDEAL = Perturbations(resolution=0.0, boom_gain=0.0, stiffness_jitter=0.0,
                       damping_jitter=0.0, angle_jitter=0.0)
+
+#: Measurement only: encoder quantisation, 500 Hz sampling, filtering and
+#: differentiation, with a robot that is exactly the extended SLIP (no boom
+#: mode, constant leg parameters, touchdown angle as measured).  The fair
+#: setting for judging identification accuracy against known parameters.
+CLEAN = Perturbations(boom_gain=0.0, stiffness_jitter=0.0, damping_jitter=0.0,
+                      angle_jitter=0.0)
 
 
 def simulate_stride(apex, theta_td, params, rtol=1e-11, atol=1e-12):

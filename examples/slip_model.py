@@ -13,7 +13,11 @@ liftoff collision ``f_c`` (2.21) and one of four stance maps ``f_s``:
 
 ``"AAS"``
     approximate analytic stance solution with leg damping (2.11-2.19) and
-    the gravity correction of the angular momentum (2.20);
+    the gravity correction of the angular momentum (2.20).  (2.20) is the
+    stance average of a momentum growing linearly under the mean gravity
+    torque; the trajectory uses that average and the liftoff velocity the
+    momentum reached at liftoff, ``2 p_hat - p_td`` (the literal reading,
+    average up to liftoff, is ``liftoff_momentum="average"``);
 ``"Geyer"``
     Geyer's lossless approximation (closed-form stance time, no damping,
     no gravity correction);
@@ -539,9 +543,10 @@ def _stance_numeric(rhod0, theta0, p0, kappa, c, rtol=1e-10, atol=1e-12):
     return _Stance(t_b, t_lo, state)
 
 
-def _stance(method, rhod0, theta0, p0, kappa, c, rtol):
+def _stance(method, rhod0, theta0, p0, kappa, c, rtol, liftoff_momentum="final"):
     if method == "AAS":
-        return _stance_aas(rhod0, theta0, p0, kappa, c)
+        return _stance_aas(rhod0, theta0, p0, kappa, c,
+                           liftoff_momentum=liftoff_momentum)
     if method == "Geyer":
         return _stance_geyer(rhod0, theta0, p0, kappa)
     if method == "SLIP":
@@ -592,7 +597,7 @@ def _cartesian(rho, theta, rhod, thetad, y_toe, params):
             v * (rhod * s + rho * thetad * co), v * (rhod * co - rho * thetad * s))
 
 
-def _stride(apex, theta_td, params, method, rtol):
+def _stride(apex, theta_td, params, method, rtol, liftoff_momentum="final"):
     _check_method(method)
     y0, vy0, z0, theta_td = _prepare(apex, theta_td, params)
     P = params
@@ -601,7 +606,7 @@ def _stride(apex, theta_td, params, method, rtol):
     td, rhod0, p0, y_toe = _touchdown(y0, vy0, z0, theta_td, P)
     kappa = np.full(y0.shape, P.kappa)
     c = np.full(y0.shape, P.c)
-    stance = _stance(method, rhod0, theta_td, p0, kappa, c, rtol)
+    stance = _stance(method, rhod0, theta_td, p0, kappa, c, rtol, liftoff_momentum)
 
     def event_at(t_bar):
         y, z, vy, vz = _cartesian(*stance.state(t_bar), y_toe, P)
@@ -624,7 +629,8 @@ def _stride(apex, theta_td, params, method, rtol):
     return Stride(*events), (td, stance, y_toe, vy_c, vz_c)
 
 
-def predict_stride(apex, theta_td, params, method="AAS", rtol=1e-10):
+def predict_stride(apex, theta_td, params, method="AAS", rtol=1e-10,
+                   liftoff_momentum="final"):
     """Predict one stride of the extended SLIP, eq. (2.3).
 
     Parameters
@@ -639,6 +645,11 @@ def predict_stride(apex, theta_td, params, method="AAS", rtol=1e-10):
         Stance map, see the module description.
     rtol : float, optional
         Relative tolerance of the numerical stance integration.
+    liftoff_momentum : {"final", "average"}, optional
+        AAS only: angular momentum in the angular rate (2.14), see
+        :func:`_stance_aas`.  ``"final"`` lifts off with the momentum the
+        gravity torque has built up by liftoff; ``"average"`` keeps the
+        stance average (2.20) up to liftoff.
 
     Returns
     -------
@@ -655,7 +666,7 @@ def predict_stride(apex, theta_td, params, method="AAS", rtol=1e-10):
     >>> bool(0.2 < s.apex.z < 0.35 and s.apex.t > s.liftoff.t > s.bottom.t)
     True
     """
-    return _stride(apex, theta_td, params, method, rtol)[0]
+    return _stride(apex, theta_td, params, method, rtol, liftoff_momentum)[0]
 
 
 def stride_trajectory(apex, theta_td, params, method, t, rtol=1e-10):

@@ -1,6 +1,5 @@
 """Tests of the SLIP example plants (examples/slip_*.py), thesis Chapter 2."""
 
-import dataclasses
 import doctest
 import os
 import sys
@@ -16,8 +15,6 @@ import slip_identification as sid  # noqa: E402
 import slip_model as sm  # noqa: E402
 
 LOSSLESS = sm.SLIPParams(m_l=0.0, d=0.0, d_h=0.0, d_v=0.0)
-MEASURED_ONLY = dataclasses.replace(slip_data.Perturbations(), stiffness_jitter=0.0,
-                                    damping_jitter=0.0, angle_jitter=0.0)
 
 
 def _throws(n, params, seed, spread=0.0, method="SLIP", speed=(0.3, 2.5)):
@@ -184,47 +181,123 @@ def test_flight_damping_regression():
 
 
 def test_vertical_identification_recovers_masses():
+    """Vertical hops (2.25) on clean measured data recover masses and legs.
+
+    The leg mass (liftoff collision) and the vertical flight damping both
+    take energy out of the ascent, so their estimates trade off and scatter
+    by a few percent with 15 hops per spring; the fit is unbiased on
+    clean data (stride-to-stride parameter variation and the boom mode,
+    left out here, belong to the realism study of the gallery example).
+    """
     rng = np.random.default_rng(8)
-    hops = {s: slip_data.generate_strides(s, 10, rng, vertical=True,
-                                          perturbations=slip_data.IDEAL)
+    hops = {s: slip_data.generate_strides(s, 15, rng, vertical=True,
+                                          perturbations=slip_data.CLEAN)
             for s in ("soft", "hard")}
     est = sid.identify_vertical(hops, 3.4, slip_data.MONOPOD,
                                 {"soft": 2915.0, "hard": 6282.0})
-    assert est["m_l"] == pytest.approx(0.19, rel=0.05)
-    assert est["d_v"] == pytest.approx(0.06, abs=0.02)
+    assert est["m_l"] == pytest.approx(0.19, rel=0.06)
+    assert est["d_v"] == pytest.approx(0.06, abs=0.015)
     for s in hops:
         k, d = est["springs"][s]
         assert k == pytest.approx(slip_data.SPRINGS[s][0], rel=0.01)
         assert d == pytest.approx(slip_data.SPRINGS[s][1], rel=0.03)
 
 
+def _exact_set(spring, n, seed, params=None):
+    """Strides predicted by SLIPD with the true parameters: exact data."""
+    params = slip_data.spring_params(spring) if params is None else params
+    apex, theta = _throws(n, slip_data.spring_params(spring), seed, spread=0.12,
+                          method="AAS")
+    pred = sm.predict_stride(apex, theta, params, "SLIPD")
+    ok = np.isfinite(pred.apex.t) & (pred.apex.vy > 0.3)
+    a1 = np.column_stack([pred.apex.t, pred.apex.y, pred.apex.z, pred.apex.vy])
+    b = np.column_stack([pred.bottom.t, pred.bottom.y, pred.bottom.z])
+    return slip_data.StrideSet(spring, theta[ok], apex[ok], a1[ok], b[ok], [])
+
+
+def test_aas_liftoff_momentum():
+    """AAS against SLIPD with the true parameters on damped, asymmetric strides.
+
+    (2.20) averages a momentum that grows linearly from touchdown to
+    liftoff, so the liftoff momentum is ``2 p_hat - p_td``; lifting off with
+    it ("final") rather than with the average (literal reading) removes most
+    of the apex velocity error.  What remains is in line with the AAS-SLIPD
+    differences of thesis ref. [9] (0.75 % position, 1.4 % velocity).
+    """
+    data = _exact_set("hard", 40, 11)
+    params = slip_data.spring_params("hard")
+    final = sid.prediction_errors(data, params, "AAS").mean(axis=0)
+    pred = sm.predict_stride(data.apex0, data.theta_td, params, "AAS",
+                             liftoff_momentum="average")
+    average = 100 * np.abs(pred.apex.vy - data.apex1[:, 3]) / data.apex1[:, 3]
+    assert final[0] < 1.0 and final[1] < 1.5
+    assert final[1] < 0.6 * average.mean()
+    with pytest.raises(ValueError, match="liftoff_momentum"):
+        sm.predict_stride(data.apex0, data.theta_td, params, "AAS", liftoff_momentum="mean")
+
+
 @pytest.fixture(scope="module")
-def hard_measured():
+def hard_clean():
     return slip_data.generate_strides("hard", 30, np.random.default_rng(9),
-                                      perturbations=MEASURED_ONLY)
+                                      perturbations=slip_data.CLEAN)
 
 
-def test_leg_identification_recovers_truth(hard_measured):
+def test_leg_identification_recovers_truth(hard_clean):
+    """Leg fits on clean synthetic data with known k, d (hard spring).
+
+    The data are sampled, quantised, filtered and differentiated like the
+    robot's, but the robot is exactly the extended SLIP.  SLIPD, whose
+    stance map is exact, must recover k and d within 2 %.  AAS cannot: its
+    stance approximation (cos(theta) ~ 1 along the leg, linearised
+    centrifugal term) leaves prediction errors of about 0.7 % in position
+    and 1 % in velocity even with the true parameters, and the fit trades
+    them against k and d.  The resulting bias is -1.5 to -4.5 % in k and
+    -2 to -5 % in d for the hard spring, depending on the mix of strides,
+    on exact data as well, and grows as the spring softens; the bounds
+    below check that it stays this small.  The lossless
+    numerical SLIP compensates the missing damping with a stiffer leg.
+    """
     truth = slip_data.spring_params("hard")
     start = truth.replace(k=1.1 * truth.k, d=0.8 * truth.d)
-    k, d, _ = sid.fit_leg(hard_measured, start, "SLIPD")
+    k, d, _ = sid.fit_leg(hard_clean, start, "SLIPD")
     assert k == pytest.approx(truth.k, rel=0.02) and d == pytest.approx(truth.d, rel=0.02)
-    # AAS trades a few percent of stiffness and damping for its approximation error
-    k_aas, d_aas, _ = sid.fit_leg(hard_measured, start, "AAS")
-    assert k_aas == pytest.approx(truth.k, rel=0.1) and d_aas == pytest.approx(truth.d, rel=0.15)
-    # the lossless numerical SLIP compensates the missing damping with a stiffer leg
-    k_slip, _, _ = sid.fit_leg(hard_measured, start, "SLIP")
-    assert k_slip > 1.03 * truth.k
+    k_aas, d_aas, _ = sid.fit_leg(hard_clean, start, "AAS")
+    assert k_aas == pytest.approx(truth.k, rel=0.05) and d_aas == pytest.approx(truth.d, rel=0.07)
+    assert k_aas < k and d_aas < d
+    k_slip, _, _ = sid.fit_leg(hard_clean, start, "SLIP")
+    assert k_slip > 1.05 * truth.k
+
+
+def test_lossless_fits_stiffen_with_leg_damping():
+    """Leg damping in the data pushes the lossless fits to stiffer legs.
+
+    A lossless leg returns all the stance energy, so with damped data it
+    over-predicts the apex energy and the fit stiffens the leg.  For the
+    numerical SLIP this gives k above the truth.  Geyer's approximation is
+    biased soft on its own (about -10 % on exact lossless SLIP strides, from
+    its small-angle, constant-momentum stance), so its damped fit stays
+    below the truth here: the thesis's +75 % (Table 2.5) is not reproduced
+    by this synthetic robot, only the direction of the damping effect.
+    """
+    params = slip_data.spring_params("hard")
+    lossless = params.replace(d=0.0)
+    damped, undamped = _exact_set("hard", 30, 12), _exact_set("hard", 30, 12, lossless)
+    for method in ("SLIP", "Geyer"):
+        k_damped, _, _ = sid.fit_leg(damped, params, method)
+        k_lossless, _, _ = sid.fit_leg(undamped, lossless, method)
+        assert k_damped > 1.02 * k_lossless
+    assert k_lossless < 0.95 * params.k      # Geyer's own bias
+    assert k_damped < params.k
 
 
 def test_cross_validation_ordering():
     rng = np.random.default_rng(10)
     e_ap = {}
     for spring in ("hard", "softer"):
-        data = slip_data.generate_strides(spring, 24, rng)
+        data = slip_data.generate_strides(spring, 16, rng)
         params = slip_data.spring_params(spring)
         for method in sm.METHODS:
-            res = sid.cross_validate(data, params, method, folds=3, fold_nfev=3)
+            res = sid.cross_validate(data, params, method, folds=3, fold_nfev=2)
             assert res.test.shape == (3, 3) and res.k.shape == (3,)
             assert np.isfinite(res.stride_test).mean() > 0.9
             e_ap[spring, method] = res.test[:, 0].mean()
