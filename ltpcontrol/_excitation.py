@@ -218,10 +218,13 @@ def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitud
 
     def signal(t):
         t = np.asarray(t, dtype=float)
-        # u_r(t) = Σ_l a cos(ω_l (t - τ_r) + φ_l)
-        arg = omega[None, :, None] * (t[None, None, :] - delays[:, None, None]) \
-            + phases[None, :, None]
-        return amplitude * np.cos(arg).sum(axis=1)
+        # u_r(t) = Σ_l a cos(ω_l (t - τ_r) + φ_l), accumulated line by line so
+        # that memory stays (experiments x samples)
+        shifted = t[None, :] - delays[:, None]
+        out = np.zeros(shifted.shape)
+        for w, phi in zip(omega, phases):
+            out += np.cos(w * shifted + phi)
+        return amplitude * out
 
     nsamp = (settle + nperiods) * nper
     time = np.arange(nsamp) * dt

@@ -25,6 +25,7 @@ import warnings
 
 import numpy as np
 import control as ct
+from scipy import sparse
 from control.exception import ControlArgument, ControlDimension
 
 from ._validation import check_kwargs, check_period, check_positive_int, real_array
@@ -442,6 +443,7 @@ class _HarmonicStateSpace:
         self.K, self.Ki, self.ny, self.nu = K, Ki, ny, nu
         self.exact = exact
         self.modal = None
+        self._residues = {}
         if floquet_A is not None and method in ('auto', 'modal'):
             # Floquet form: F = blkdiag(A - jnω_p I) has eigenvalues λ_i - jnω_p
             # and eigenvectors blkdiag(W) from ONE eigendecomposition A = W Λ W^{-1}
@@ -518,13 +520,24 @@ class _HarmonicStateSpace:
         self._ensure_modal(len(x))
         if self.modal is not None:
             lam, HV, VG = self.modal
-            HV, VG = HV[r], VG[:, c]
             gap = x[:, None] - lam[None, :]
             if np.any(np.abs(gap) <= 1e-13 * np.maximum(1.0, np.abs(lam))):
                 raise ValueError("the HTF is not defined at a Floquet exponent "
                                  "(evaluation point is a pole)")
-            res = 1.0 / gap
-            return np.einsum('iq,sq,qj->sij', HV, res, VG, optimize=True) + J
+            # H(x)_{ij} = Σ_q HV_iq VG_qj / (x - λ_q): one matrix product with
+            # the residue matrix R_{q,(ij)} = HV_iq VG_qj, formed once
+            key = (None if rows is None else tuple(rows), None if cols is None else tuple(cols))
+            if key not in self._residues:
+                self._residues[key] = _residue_matrix(HV[r], VG[:, c])
+            flat, shape = self._residues[key]
+            if sparse.issparse(flat):
+                out = (flat.T @ (1.0 / gap).T).T
+            else:
+                out = (1.0 / gap) @ flat
+            out = out.reshape((len(x),) + shape)
+            if J.any():
+                out += J
+            return out
         ident = np.eye(self.F.shape[0])
         M = x[:, None, None] * ident - self.F
         try:
@@ -538,6 +551,19 @@ class _HarmonicStateSpace:
 #
 # Helpers
 #
+
+def _residue_matrix(HV, VG):
+    """Residues ``R_{q,(ij)} = HV_iq VG_qj`` of the modal form, sparse when mostly zero.
+
+    In Floquet form with band-limited B and C most residues vanish, and the
+    evaluation ``H(x) = (1/(x - λ)) R`` is then a sparse product.
+    """
+    flat = (HV.T[:, :, None] * VG[:, None, :]).reshape(HV.shape[1], -1)
+    big = np.abs(flat) > 1e-15 * np.abs(flat).max(initial=0.0)
+    if np.count_nonzero(big) < 0.2 * flat.size:
+        flat = sparse.csr_matrix(np.where(big, flat, 0))
+    return flat, (HV.shape[0], VG.shape[1])
+
 
 def _toeplitz(coeffs, Ki):
     """Block Toeplitz ``[P_{n-m}]``, n, m = -Ki..Ki, from coefficients -2Ki..2Ki."""
