@@ -50,7 +50,8 @@ class HTFFit:
     std : ndarray
         Standard deviations ``sqrt(diag cov)``.
     components : ndarray, shape (2K+1, ny, nu, F)
-        Model components at the fitted parameters on the estimate's grid.
+        Model components at the fitted parameters on the estimate's grid
+        (zero for harmonics beyond those the model returns).
     omega : ndarray
         Frequency grid (rad/s) of the fit.
     cost : float
@@ -165,6 +166,15 @@ def _model_components(model, params, omega, K, ks, shape):
     return out[ks + kmod]
 
 
+def _model_harmonics(model, params, omega):
+    """Number K' of harmonics that `model` returns."""
+    out = model(params, omega[:1])
+    if hasattr(out, "components"):
+        out = out.components(omega[:1])
+        out = out[1] if isinstance(out, tuple) else out
+    return np.asarray(out).shape[0] // 2
+
+
 def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
             magnitude_only=False, weights=None, bounds=None, **kwargs):
     """Fit a parameterised model family to an estimated HTF.
@@ -259,8 +269,16 @@ def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
         cov = np.linalg.pinv(jtj) * (2 * res.cost / (nres - npar))
     else:
         cov = np.full((npar, npar), np.nan)
-    fitted = _model_components(model, res.x, omega, K, np.arange(-K, K + 1),
-                               comps.shape[1:3] + (omega.size,))
+    # fitted model on the estimate's grid: the harmonics -K..K that the model
+    # provides (a model of fewer harmonics leaves the others at zero)
+    full = _model_components(model, res.x, omega, K, ks, comps.shape[1:3] + (omega.size,))
+    fitted = np.zeros(comps.shape, complex)
+    fitted[ks + K] = full
+    provided = _model_harmonics(model, res.x, omega)
+    extra = np.setdiff1d(np.arange(-min(K, provided), min(K, provided) + 1), ks)
+    if extra.size:
+        fitted[extra + K] = _model_components(model, res.x, omega, K, extra,
+                                              comps.shape[1:3] + (omega.size,))
     return HTFFit(params=res.x, cov=cov, std=np.sqrt(np.abs(np.diag(cov))),
                   components=fitted, omega=omega, cost=float(res.cost),
                   success=bool(res.success), message=str(res.message))
