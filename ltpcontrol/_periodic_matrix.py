@@ -623,7 +623,14 @@ class PeriodicMatrix:
 
 
 def as_periodic(value, period, name, shape=None):
-    """Convert an array, callable or PeriodicMatrix to a PeriodicMatrix of `period`."""
+    """Convert an array, callable or PeriodicMatrix to a PeriodicMatrix of `period`.
+
+    Examples
+    --------
+    >>> from ltpcontrol._periodic_matrix import as_periodic
+    >>> as_periodic([[1.0, 0.0]], 2.0, 'C').shape
+    (1, 2)
+    """
     if isinstance(value, PeriodicMatrix):
         try:
             value = value.with_period(period)

@@ -43,6 +43,15 @@ def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=4096):
     -------
     Phi : ndarray, shape (S, n, n)
     Gamma0, Gamma1 : ndarray, shape (S, n, m)
+
+    Examples
+    --------
+    >>> from ltpcontrol._transition import step_transitions
+    >>> A = ltp.PeriodicMatrix.constant([[-1.0]], 1.0)
+    >>> B = ltp.PeriodicMatrix.constant([[1.0]], 1.0)
+    >>> Phi, G0, G1 = step_transitions(A, B, np.array([0.0]), 0.5)
+    >>> bool(np.isclose(Phi[0, 0, 0], np.exp(-0.5)))
+    True
     """
     t0 = np.asarray(t0, float)
     h = np.broadcast_to(np.asarray(h, float), t0.shape)
@@ -146,6 +155,14 @@ def expm_batch(X):
 
     Scaling and squaring with the [13/13] Padé approximant, vectorised over
     the stack: ``e^X = (r13(X / 2^s))^{2^s}`` with ``‖X‖₁ / 2^s <= θ13``.
+
+    Examples
+    --------
+    >>> from ltpcontrol._transition import expm_batch
+    >>> E = expm_batch(np.array([[[0.0, 1.0], [0.0, 0.0]]]))
+    >>> E[0]
+    array([[1., 1.],
+           [0., 1.]])
     """
     d = X.shape[-1]
     norms = np.abs(X).sum(axis=-2).max(axis=-1)

@@ -14,13 +14,29 @@ __all__ = []
 
 
 def check_kwargs(kwargs, where):
-    """Reject leftover keyword arguments, as python-control does."""
+    """Reject leftover keyword arguments, as python-control does.
+
+    Examples
+    --------
+    >>> from ltpcontrol._validation import check_kwargs
+    >>> check_kwargs({'colour': 1}, 'plot')
+    Traceback (most recent call last):
+    ...
+    TypeError: plot: unrecognized keyword(s): ['colour']
+    """
     if kwargs:
         raise TypeError(f"{where}: unrecognized keyword(s): {sorted(kwargs)}")
 
 
 def check_period(period, name="period"):
-    """Return `period` as a positive finite float."""
+    """Return `period` as a positive finite float.
+
+    Examples
+    --------
+    >>> from ltpcontrol._validation import check_period
+    >>> check_period(2)
+    2.0
+    """
     if isinstance(period, (bool, np.bool_)) or not isinstance(
             period, (numbers.Real, np.floating, np.integer)):
         raise ControlArgument(f"{name} must be a real number, got {period!r}")
@@ -31,7 +47,14 @@ def check_period(period, name="period"):
 
 
 def check_positive_int(value, name, minimum=1):
-    """Return `value` as an int >= `minimum`."""
+    """Return `value` as an int >= `minimum`.
+
+    Examples
+    --------
+    >>> from ltpcontrol._validation import check_positive_int
+    >>> check_positive_int(3.0, 'nharmonics', minimum=0)
+    3
+    """
     if isinstance(value, (bool, np.bool_)) or not isinstance(
             value, (numbers.Integral, np.integer)):
         if isinstance(value, (float, np.floating)) and float(value).is_integer():
@@ -57,6 +80,12 @@ def real_array(data, name, ndim=None, allow_complex=False):
         Allowed numbers of dimensions.
     allow_complex : bool
         Keep complex data instead of rejecting it.
+
+    Examples
+    --------
+    >>> from ltpcontrol._validation import real_array
+    >>> real_array([[1, 2]], 'B', ndim=2)
+    array([[1., 2.]])
     """
     try:
         arr = np.asarray(data)
@@ -85,7 +114,14 @@ def real_array(data, name, ndim=None, allow_complex=False):
 
 
 def commensurate(a, b, rtol=1e-9):
-    """Return the common period of `a` and `b` if one is an integer multiple of the other."""
+    """Return the common period of `a` and `b` if one is an integer multiple of the other.
+
+    Examples
+    --------
+    >>> from ltpcontrol._validation import commensurate
+    >>> commensurate(0.5, 1.5)
+    1.5
+    """
     big, small = max(a, b), min(a, b)
     ratio = big / small
     if abs(ratio - round(ratio)) <= rtol * ratio:
@@ -95,7 +131,14 @@ def commensurate(a, b, rtol=1e-9):
 
 
 def steps_per_period(period, dt, name="dt"):
-    """Return ``N = period/dt`` as an int, or raise if it is not an integer."""
+    """Return ``N = period/dt`` as an int, or raise if it is not an integer.
+
+    Examples
+    --------
+    >>> from ltpcontrol._validation import steps_per_period
+    >>> steps_per_period(0.5, 0.01)
+    50
+    """
     ratio = period / dt
     nsteps = int(round(ratio))
     if nsteps < 1 or abs(ratio - nsteps) > 1e-9 * max(1.0, ratio):

@@ -337,7 +337,8 @@ def test_transient_records_warn():
 def test_no_warning_on_steady_state_full_rank(mathieu100):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        hybrid_ls(*mathieu100, T_M, [0, T_M / 2], 1)
+        res = hybrid_ls(*mathieu100, T_M, [0, T_M / 2], 1)
+    assert res.rank == res.nunknowns
 
 
 @pytest.mark.parametrize("tsw, match", [

@@ -50,7 +50,7 @@ def frd(data):
 
 
 @pytest.fixture(scope='module')
-def tests_inputs(truth):
+def table42_inputs(truth):
     """Table 4.2 inputs of period π, responses of the true system from x(0) = 0."""
     t = np.arange(0, 40, TS)
     u = {'sine': np.sin(2 * t), 'square': np.sign(np.sin(2 * t)),
@@ -59,8 +59,8 @@ def tests_inputs(truth):
     return t, u, y
 
 
-def _nrmse(model, tests_inputs):
-    t, u, y = tests_inputs
+def _nrmse(model, table42_inputs):
+    t, u, y = table42_inputs
     return {k: ltp.nrmse(y[k], ltp.forced_response(model, t, u[k]).outputs) for k in u}
 
 
@@ -138,7 +138,7 @@ def test_multisine_experiment_identifies(truth):
 # Whole pipeline, thesis §4.2.9
 #
 
-def test_default_route_beats_thesis(truth, frd, tests_inputs):
+def test_default_route_beats_thesis(truth, frd, table42_inputs):
     model, info = identify_ltp(frd, T, 2, 1, q=50, return_info=True)
     assert info.conversion == 'refit' and info.realization.success
     assert info.lifted.nstates == 6 and info.subspace.q == 50
@@ -146,7 +146,7 @@ def test_default_route_beats_thesis(truth, frd, tests_inputs):
     err = _errors(model, truth)
     for key, thesis in THESIS_ERRORS.items():
         assert getattr(err, key) <= min(thesis, 1e-4)
-    for key, value in _nrmse(model, tests_inputs).items():
+    for key, value in _nrmse(model, table42_inputs).items():
         assert value <= min(THESIS_NRMSE[key], 1e-3)
     assert info.relative_residual < 1e-5
 
@@ -159,7 +159,7 @@ def test_refit_does_not_need_a_large_q(truth, frd):
     assert max(_errors(model, truth)[:3]) < 1e-4
 
 
-def test_tustin_route_has_sampling_bias(truth, frd, tests_inputs):
+def test_tustin_route_has_sampling_bias(truth, frd, table42_inputs):
     """Inverse Tustin of exactly sampled poles: A biased by ~λ²Ts²/12 (errata)."""
     tustin = identify_ltp(frd, T, 2, 1, q=50, conversion='tustin')
     log = identify_ltp(frd, T, 2, 1, q=50, conversion='log', refit_a=False)
@@ -167,7 +167,7 @@ def test_tustin_route_has_sampling_bias(truth, frd, tests_inputs):
     lam = np.linalg.eigvals(truth.A(0.0))
     assert 1e-4 < e_t.A < 4 * np.abs(lam).max() ** 2 * TS ** 2 / 12
     assert e_l.A < 2e-5 < e_t.A / 10
-    for key, value in _nrmse(tustin, tests_inputs).items():
+    for key, value in _nrmse(tustin, table42_inputs).items():
         assert value <= THESIS_NRMSE[key]
 
 
