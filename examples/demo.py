@@ -56,6 +56,11 @@ def main():
             data, T, 2, 1, q=50, conversion=conversion, transient=10.0,
             input_hold='foh', hold_step=TS / OVERSAMPLE, name=f'estimate ({conversion})')
 
+    print(f"Identified an LTP model from {data[1].shape[0]} sine experiments "
+          f"({data[0][-1] + TS:.0f} s at {1 / TS:.0f} Hz each)")
+    print("Floquet exponents, true:      ", np.round(np.sort_complex(true.poles()), 6))
+    print("Floquet exponents, identified:",
+          np.round(np.sort_complex(models['refit'].poles()), 6), "\n")
     print("Eq. (4.125), controllable canonical form (relative errors)")
     print(f"{'':28s}{'A':>10s}{'B(t)':>10s}{'C(t)':>10s}")
     print(f"{'thesis':28s}" + "".join(f"{e:10.4f}" for e in THESIS_ERRORS))
