@@ -11,13 +11,20 @@ periods, so that on its DFT grid ``ω_i = 2π i / (L T)`` a shift by ω_p is
 exactly L bins.  With the regressor
 ``φ_r(i) = [U_r(i + KL), ..., U_r(i), ..., U_r(i - KL)]`` the extended
 spectra are ``Φ_UU(i) = Σ_r conj(φ_r) φ_rᵀ`` and ``Φ_UY(i) = Σ_r conj(φ_r) Y_r``.
-Per frequency, ``ĝ = Φ_UU⁻¹ Φ_UY`` (eq. 3.31).  The regularised estimate
-solves all frequencies jointly (eq. 3.35),
+A component ``G_k`` is identifiable at ``ω_i`` only when its shifted input
+``U(i - kL)`` is excited: otherwise ``G_k(jω_i) U(jω_i - jkω_p)`` adds nothing
+to ``Y(jω_i)``.  Unexcited regressor columns are therefore dropped, and per
+frequency ``ĝ_E = Φ_UU,E⁻¹ Φ_UY,E`` over the excited set E(i) (eq. 3.31).
+The regularised estimate solves all frequencies jointly (eq. 3.35),
 
     (blkdiag_i Φ_UU(i) + α s D₂ᵀD₂ ⊗ I) g = [Φ_UY(i)]_i,
 
-where ``D₂`` is the second difference along frequency and
-``s = mean_i tr Φ_UU(i) / P`` makes ``α`` independent of the input scale.
+where ``D₂`` is the second difference along frequency and ``s``, the mean
+diagonal of ``Φ_UU`` over the identified (component, frequency) pairs
+(``mean_i tr Φ_UU(i) / P`` for a fully excited design), makes ``α``
+independent of the input scale.  ``Φ_UU(i)`` and ``Φ_UY(i)`` hold the
+excited columns only, so where its shifted input is not excited a component
+is set by the curvature penalty alone.
 """
 
 from dataclasses import dataclass, field
@@ -51,7 +58,12 @@ class HTFEstimate:
     Attributes
     ----------
     components : ndarray, shape (2K+1, ny, nu, F)
-        ``G_k(jω)`` for k = -K..K on `omega`.
+        ``G_k(jω)`` for k = -K..K on `omega`; NaN where the component is
+        not determined: with α = 0 wherever its shifted input
+        ``U(ω - kω_p)`` is not excited; with α > 0 outside the range from
+        the first to the last frequency where it is (inside, the curvature
+        penalty bridges unexcited gaps), and everywhere for a component
+        identified at fewer than two frequencies.
     omega : ndarray, shape (F,)
         Output (base) frequencies in rad/s.
     period : float
@@ -59,10 +71,11 @@ class HTFEstimate:
     std : ndarray, shape (2K+1, ny, nu, F)
         Standard deviation of each component, ``sqrt(E|Ĝ_k - E Ĝ_k|²)``,
         from the residual (white output noise assumed).  For α > 0 it
-        excludes the regularisation bias.  NaN when the residual has no
-        degrees of freedom.
+        excludes the regularisation bias.  NaN where `identified` is False
+        and everywhere when the residual has no degrees of freedom.
     cond : ndarray, shape (F,)
-        Condition number of ``Φ_UU`` at each frequency.
+        Condition number of ``Φ_UU`` restricted to the identified
+        components at each frequency (NaN where none is identified).
     residual : ndarray, shape (ny,)
         Root-mean-square residual ``|Y - Ŷ|`` per output over all equations.
     noise_var : ndarray, shape (ny,)
@@ -75,6 +88,9 @@ class HTFEstimate:
         Generalised cross-validation score ``n |Y - Ŷ|² / (n - tr H)²``.
     nrecords : int
         Number of analysed windows R.
+    identified : ndarray of bool, shape (2K+1, ny, nu, F)
+        True where the shifted input ``U(ω - kω_p)`` of input j is excited,
+        i.e. where the data determine ``G_k(jω)``.
     """
 
     components: np.ndarray
@@ -88,6 +104,7 @@ class HTFEstimate:
     dof: float
     gcv: float
     nrecords: int
+    identified: np.ndarray
     labels: dict = field(default_factory=dict, repr=False)
 
 
@@ -192,7 +209,7 @@ def _spectra(records, period, nharmonics, segments):
 
 
 def _output_bins(U, L, K, threshold):
-    """Output bins m >= 0 whose regressors U(m - kL), |k| <= K, are all excited."""
+    """Output bins m >= 0 and the mask (M, 2K+1, nu) of excited U_j(m - kL)."""
     ns = U.shape[-1]
     power = np.sum(np.abs(U) ** 2, axis=0)                      # (nu, Ns)
     silent = np.nonzero(power.max(axis=1) == 0)[0]
@@ -203,8 +220,8 @@ def _output_bins(U, L, K, threshold):
     m = np.arange(ns // 2 - K * L) if ns // 2 > K * L else np.arange(0)
     k = np.arange(-K, K + 1)
     idx = m[:, None] - k[None, :] * L                           # (M, 2K+1)
-    ok = np.all(excited[:, idx % ns], axis=(0, 2))
-    return m, ok, excited
+    mask = np.transpose(excited[:, idx % ns], (1, 2, 0))        # (M, 2K+1, nu)
+    return m, mask, excited
 
 
 def _regressor(U, bins, L, K):
@@ -349,47 +366,69 @@ def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
     nrec, nu, ns = U.shape
     nunk = (2 * K + 1) * nu
     wgrid = 2 * np.pi / (L * period)
-    m, ok, excited = _output_bins(U, L, K, threshold)
-    if omega_limits is not None:
+    m, mask, excited = _output_bins(U, L, K, threshold)
+    if omega_limits is None:
+        ok = mask.all(axis=(1, 2))          # every component identifiable at m
+        if not np.any(ok):
+            top = np.max(np.nonzero(excited.any(axis=0)[:ns // 2])[0], initial=0) * wgrid
+            raise ValueError(
+                f"nharmonics={K} is too large for the excited band: no output frequency "
+                f"has all shifted inputs ω - kω_p, |k| <= {K}, excited (input excited up "
+                f"to {top:.4g} rad/s, 2Kω_p = {2 * K * 2 * np.pi / period:.4g} rad/s); "
+                "pass omega_limits to estimate each component where its shifted input is "
+                "excited, reduce nharmonics, widen the excitation or lower threshold")
+    else:
+        ok = mask.any(axis=(1, 2))          # some component identifiable at m
         lim = real_array(omega_limits, "omega_limits", ndim=1)
         if lim.size != 2 or not 0 <= lim[0] < lim[1]:
             raise ValueError(f"omega_limits must be (wmin, wmax) with 0 <= wmin < wmax, "
                              f"got {lim}")
         inside = (m * wgrid >= lim[0]) & (m * wgrid <= lim[1])
-        if np.any(inside & ~ok):
-            warnings.warn(f"{np.sum(inside & ~ok)} frequencies in omega_limits have "
-                          f"unexcited shifted inputs ω - kω_p (|k| <= {K}) and are "
-                          f"{'dropped' if alpha == 0 else 'interpolated'}",
-                          UserWarning, stacklevel=3)
-        m, ok = m[inside], ok[inside]
-    if not np.any(ok):
-        top = np.max(np.nonzero(excited.any(axis=0)[:ns // 2])[0], initial=0) * wgrid
-        raise ValueError(
-            f"nharmonics={K} is too large for the excited band: no output frequency "
-            f"has all shifted inputs ω - kω_p, |k| <= {K}, excited (input excited up to "
-            f"{top:.4g} rad/s, 2Kω_p = {2 * K * 2 * np.pi / period:.4g} rad/s); reduce "
-            "nharmonics, widen the excitation or lower threshold")
-    if alpha == 0:
-        if nrec < nunk:
+        m, ok, mask = m[inside], ok[inside], mask[inside]
+        if not np.any(ok):
             raise ValueError(
-                f"alpha=0 needs at least (2K+1)·nu = {nunk} records or segments, got "
-                f"{nrec}; use phase-shifted replicas (chirp_replicas) or alpha > 0 / "
-                "alpha='gcv'")
-        bins = m[ok]
+                f"no output frequency in omega_limits has an excited shifted input "
+                f"ω - kω_p, |k| <= {K}; change omega_limits, widen the excitation or "
+                "lower threshold")
+    if omega_limits is not None and not np.all(ok):
+        # α > 0 bridges the gaps between the first and last identifiable frequency
+        span = np.arange(ok.size)
+        inner = (span > np.argmax(ok)) & (span < ok.size - 1 - np.argmax(ok[::-1]))
+        nint = 0 if alpha == 0 else int(np.sum(inner & ~ok))
+        warnings.warn(f"{np.sum(~ok)} frequencies in omega_limits have all shifted "
+                      f"inputs ω - kω_p (|k| <= {K}) unexcited: {np.sum(~ok) - nint} "
+                      f"dropped, {nint} interpolated", UserWarning, stacklevel=3)
+    if alpha == 0:
+        bins, mask = m[ok], mask[ok]
+        need = int(mask.sum(axis=(1, 2)).max())
+        if nrec < need:
+            raise ValueError(
+                f"alpha=0 with nharmonics={K} needs at least {need} records or segments "
+                f"(the components identifiable at one frequency; at most (2K+1)·nu = "
+                f"{nunk}), got {nrec}; use phase-shifted replicas (chirp_replicas) or "
+                "alpha > 0 / alpha='gcv'")
     else:
-        # contiguous band: unexcited bins inside it are bridged by the penalty
-        first, last = m[ok][0], m[ok][-1]
-        bins = np.arange(first, last + 1)
+        # contiguous band: bins without any excited shifted input are bridged by the penalty
+        first, last = np.nonzero(ok)[0][[0, -1]]
+        bins, mask = m[first:last + 1], mask[first:last + 1]
         if bins.size < 3:
             raise ValueError("the curvature penalty needs at least 3 frequencies; "
                              "lengthen the records or widen the band")
-
-    phi = _regressor(U, bins, L, K)
+    mask = mask.reshape(bins.size, nunk)    # column (k+K)·nu + j, as in _regressor
+    # unknowns: components with data somewhere (α = 0), at >= 2 frequencies for α > 0
+    # (the curvature penalty leaves a component's affine part free)
+    cols = mask.sum(axis=0) >= (1 if alpha == 0 else 2)
+    emask = mask[:, cols]
+    # no data term for unexcited (component, ω): zero regressor column U(ω - kω_p)
+    phi = _regressor(U, bins, L, K)[:, :, cols] * emask
     Yb = np.transpose(Y[:, :, bins], (0, 2, 1))                 # (R, F, ny)
     puu = np.einsum('rfa,rfb->fab', phi.conj(), phi)
+    # cond of Φ_UU restricted to the identified set E: σ_1 / σ_|E|
     sv = np.linalg.svd(puu, compute_uv=False)
-    cond = np.divide(sv[:, 0], sv[:, -1], out=np.full(bins.size, np.inf),
-                     where=sv[:, -1] > 0)
+    count = emask.sum(axis=1)
+    low = sv[np.arange(bins.size), np.maximum(count, 1) - 1]
+    cond = np.divide(sv[:, 0], low, out=np.full(bins.size, np.inf), where=low > 0)
+    cond[count == 0] = np.nan
     n = nrec * bins.size
     if alpha == 0:
         if np.max(cond) > _COND_WARN:
@@ -397,12 +436,13 @@ def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
             warnings.warn(
                 f"Φ_UU is ill-conditioned at {bad.size} frequencies (cond up to "
                 f"{np.max(cond):.2g}, e.g. ω = {bad[0]:.4g} rad/s): the records do not "
-                f"separate the {2 * K + 1} components; use >= {2 * K + 1} phase-shifted "
-                "replicas or alpha > 0", UserWarning, stacklevel=3)
+                f"separate the {need} components identifiable there; use >= {need} "
+                "phase-shifted replicas or alpha > 0", UserWarning, stacklevel=3)
         g, trace, var = _solve_bins(phi, Yb)
     else:
-        penalty = _penalty(bins.size, nunk)
-        scale = float(np.mean(np.real(np.trace(puu, axis1=1, axis2=2)))) / nunk
+        penalty = _penalty(bins.size, int(cols.sum()))
+        # s: mean diagonal of Φ_UU over the identified (component, ω) pairs
+        scale = float(np.sum(np.real(np.trace(puu, axis1=1, axis2=2)))) / emask.sum()
         if alpha == 'gcv':
             alpha = _gcv_search(phi, Yb, penalty, scale, progress)
         g, trace, var = _solve_joint(phi, Yb, alpha, penalty, scale, True)
@@ -410,16 +450,29 @@ def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
     dof = n - trace
     has_dof = dof > 1e-6 * n
     noise_var = sq / dof if has_dof else np.full(sq.shape, np.nan)
+    # reported: identified pairs (α = 0); for α > 0 also the penalty's bridge across
+    # gaps between a component's first and last identified frequency, not its
+    # linear extrapolation beyond them, which no data support
+    span = np.arange(bins.size)[:, None]
+    inner = ((span >= np.argmax(emask, axis=0))
+             & (span <= bins.size - 1 - np.argmax(emask[::-1], axis=0)))
+    gfull = np.full((bins.size, nunk, sq.size), np.nan, complex)
+    vfull = np.full((bins.size, nunk), np.nan)
+    gfull[:, cols] = np.where((emask if alpha == 0 else inner)[..., None], g, np.nan)
+    vfull[:, cols] = np.where(emask, var, np.nan)
     # Var Ĝ_k[o, j](ω_f) = σ_o² · var[f, (k+K)nu + j]
-    std = np.sqrt(var[None, :, :] * noise_var[:, None, None])   # (ny, F, P)
+    std = np.sqrt(vfull[None, :, :] * noise_var[:, None, None])  # (ny, F, P)
     std = np.transpose(std.reshape(-1, bins.size, 2 * K + 1, nu), (2, 0, 3, 1))
-    comps = np.transpose(g.reshape(bins.size, 2 * K + 1, nu, -1), (1, 3, 2, 0))
+    comps = np.transpose(gfull.reshape(bins.size, 2 * K + 1, nu, -1), (1, 3, 2, 0))
+    identified = np.broadcast_to(
+        np.transpose(mask.reshape(bins.size, 2 * K + 1, 1, nu), (1, 2, 3, 0)),
+        comps.shape).copy()
     labels = next((rec[3] for rec in records if rec[3]), {})
     return HTFEstimate(
         components=comps, omega=bins * wgrid, period=period, std=std, cond=cond,
         residual=np.sqrt(sq / n), noise_var=noise_var, alpha=float(alpha),
         dof=float(dof), gcv=float(n * sq.sum() / dof ** 2) if has_dof else np.inf,
-        nrecords=nrec, labels=labels)
+        nrecords=nrec, identified=identified, labels=labels)
 
 
 def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
@@ -451,11 +504,19 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     alpha : float or 'gcv', optional
         Curvature weight relative to the mean diagonal of ``Φ_UU``.  0
         (default) solves each frequency separately (eq. 3.31) and needs at
-        least ``(2K+1)·nu`` windows; ``alpha > 0`` solves eq. 3.35; ``'gcv'``
+        least as many windows as components identified at one frequency
+        (``(2K+1)·nu`` when all are); ``alpha > 0`` solves eq. 3.35; ``'gcv'``
         picks α by generalised cross-validation.
     omega_limits : (float, float), optional
-        Output frequency range (rad/s).  Default: every frequency at which
-        all shifted inputs ``ω - kω_p`` are excited.
+        Output frequency range (rad/s): every frequency in it at which at
+        least one shifted input ``ω - kω_p``, ``|k| <= K``, is excited (for
+        ``alpha > 0`` the band from the first to the last such frequency).
+        At each frequency only the components ``G_k`` whose shifted input
+        ``U(ω - kω_p)`` is excited are estimated: the others contribute
+        nothing to ``Y(jω)`` there.  Use it when the excited band is
+        narrower than ``2Kω_p``, so that no frequency excites all shifted
+        inputs at once.  Default: the frequencies at which all shifted
+        inputs are excited (every component identified).
     threshold : float, optional
         Input power, relative to its maximum, below which a DFT bin counts
         as unexcited (default 1e-2).
@@ -470,9 +531,20 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     HTF
         Data HTF on the estimated grid, with ``std`` (standard deviation of
         each component; None when the residual has no degrees of freedom,
-        e.g. exactly ``(2K+1)·nu`` windows) and ``diagnostics`` holding
-        ``cond`` (of ``Φ_UU`` per frequency), ``residual`` (RMS per output),
-        ``noise_var``, ``alpha``, ``dof``, ``gcv`` and ``nrecords``.
+        e.g. exactly ``(2K+1)·nu`` windows, or when some component is not
+        identified) and ``diagnostics`` holding ``identified`` (bool, shape
+        of the components: True where ``U(ω - kω_p)`` of the input is
+        excited, so that the data determine ``G_k(jω)``), ``cond`` (of
+        ``Φ_UU`` over the identified components per frequency, NaN where
+        there are none), ``residual`` (RMS per output), ``noise_var``,
+        ``alpha``, ``dof``, ``gcv`` and ``nrecords``.  A component that is
+        not determined at a frequency is 0 in the HTF: with ``alpha=0``
+        where it is not identified, with ``alpha > 0`` outside the range
+        from its first to its last identified frequency (inside, the
+        curvature penalty bridges unexcited gaps) and everywhere for a
+        component identified at fewer than two frequencies.  It multiplies
+        an input component that the data did not excite, so predictions
+        for inputs inside the excited band do not use it.
 
     Warns
     -----
@@ -504,10 +576,13 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     check_kwargs(kwargs, "estimate_htf")
     est = _estimate(data, period, nharmonics, segments=segments, alpha=alpha,
                     omega_limits=omega_limits, threshold=threshold, progress=progress)
-    diagnostics = {"cond": est.cond, "residual": est.residual,
-                   "noise_var": est.noise_var, "alpha": est.alpha, "dof": est.dof,
-                   "gcv": est.gcv, "nrecords": est.nrecords}
+    diagnostics = {"identified": est.identified, "cond": est.cond,
+                   "residual": est.residual, "noise_var": est.noise_var,
+                   "alpha": est.alpha, "dof": est.dof, "gcv": est.gcv,
+                   "nrecords": est.nrecords}
     std = est.std if np.all(np.isfinite(est.std)) else None
-    return HTF(est.components, est.omega, est.period, std=std,
+    # G_k U(ω - kω_p) = 0 where the data leave G_k undetermined (U not excited)
+    comps = np.where(np.isnan(est.components), 0, est.components)
+    return HTF(comps, est.omega, est.period, std=std,
                diagnostics=diagnostics, name=name,
                inputs=est.labels.get("inputs"), outputs=est.labels.get("outputs"))

@@ -98,6 +98,8 @@ def test_vhop_prediction():
     low = res['sine_frequencies'] <= 2.1
     assert np.all(errors[low] < 40.0)
     assert res['erms_1hz'] < 15.0
-    assert np.all(np.isfinite(res['noise_errors']))
+    for noise_errors in res['noise_errors'].values():
+        assert np.all(np.isfinite(noise_errors))
+    assert res['gcv_alpha'] > 0
     # the step response is captured qualitatively only (thesis: 68 %)
     assert 0.0 < res['erms_step'] < 150.0

@@ -106,6 +106,7 @@ def test_replicas_noise_free_match_truth(replica_data):
     est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments)
     assert isinstance(est, HTFEstimate)
     assert est.components.shape == (5, 1, 1, est.omega.size)
+    assert est.identified.all()                       # default: fully excited band
     assert est.omega[0] == 0 and est.omega[-1] > 2 * np.pi * 2.5
     true = system.htf(est.omega, 2)
     err = np.abs(est.components - true)
@@ -226,7 +227,7 @@ def test_returns_htf_that_predicts_new_inputs(replica_data):
     est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments)
     w, G = H.components()
     assert np.array_equal(w, est.omega) and np.allclose(G, est.components)
-    assert H.std.shape == G.shape
+    assert H.std.shape == G.shape and H.diagnostics["identified"].all()
     assert set(H.diagnostics) >= {"cond", "residual", "alpha", "dof", "gcv"}
     # validation on an input not used for training: steady-state response to a
     # sum of two sines whose output lines all lie in the estimated band
@@ -242,6 +243,78 @@ def test_no_residual_dof_gives_no_std(replica_data):
     system, exc, y = replica_data
     H = estimate_htf((exc.time, exc.inputs, y), 1.0, 3, segments=exc.segments)
     assert H.std is None and H.diagnostics["dof"] == pytest.approx(0, abs=1e-6)
+
+
+LIMITS = (0.0, 2 * np.pi * 15)          # G_3 reaches 12 + 3.6 Hz
+
+
+@pytest.fixture(scope="module")
+def narrow_band():
+    """ω_p = 4 Hz, three replicas of a 0-3 Hz chirp: no ω excites all of |k| <= 3."""
+    system = ScalarLTP(period=0.25)
+    exc = chirp_replicas(0.25, 3, 10.0, 0.0, 3.0, dt=0.01, gap=8.0)
+    return system, exc, system.simulate(exc.signal, exc.time)[0]
+
+
+@pytest.mark.parametrize("alpha", [0.0, 1e-3])
+def test_narrow_band_estimates_excited_components(narrow_band, alpha):
+    system, exc, y = narrow_band
+    est = _estimate((exc.time, exc.inputs, y), 0.25, 3, segments=exc.segments,
+                    alpha=alpha, omega_limits=LIMITS)
+    ident = est.identified[:, 0, 0]
+    # at most two shifted inputs |ω - 4k Hz| <= 3 Hz (+ leakage) per output frequency
+    assert ident.sum(axis=0).max() == 2 and ident.any(axis=0).all()
+    true = system.htf(est.omega, 3)
+    f = est.omega / (2 * np.pi)
+    for k in range(-3, 4):
+        row, g, gt = ident[k + 3], est.components[k + 3, 0, 0], true[k + 3, 0, 0]
+        # identified exactly where U(ω - kω_p) carries the chirp (|ω - kω_p| <~ 3.6 Hz)
+        assert np.all(row[np.abs(f - 4 * k) <= 3.0])
+        assert not np.any(row[np.abs(f - 4 * k) > 3.7])
+        if alpha == 0:
+            assert np.all(np.isnan(g[~row])) and np.all(np.isfinite(g[row]))
+        assert np.array_equal(np.isnan(est.std[k + 3, 0, 0]), ~row)
+        band = np.abs(f - 4 * k) <= 2.9
+        err = np.abs(g - gt)[band]
+        if k in (0, 1):
+            assert np.max(err / np.abs(gt[band])) < 0.01
+        elif k == 2:                       # 3 % of G_0: 1 % of its peak
+            assert np.max(err) < 0.01 * np.max(np.abs(gt))
+    # G_{-k}(jω), k > 0, needs U(ω + kω_p) >= 4 Hz: identified only through
+    # G_{-k}(jω) = conj G_k(-jω) on negative frequencies
+    assert not ident[:3].any()
+    if alpha > 0:
+        # the penalty is not extrapolated beyond the identified range ...
+        assert np.array_equal(np.isfinite(est.components), est.identified)
+        # ... but bridges gaps inside it: a high threshold cuts the chirp's
+        # spectral ripple into excited and unexcited stretches
+        with pytest.warns(UserWarning, match="interpolated"):
+            gap = _estimate((exc.time, exc.inputs, y), 0.25, 3, alpha=alpha,
+                            segments=exc.segments, omega_limits=LIMITS, threshold=0.5)
+        g1, id1 = gap.components[4, 0, 0], gap.identified[4, 0, 0]
+        inside = (gap.omega > gap.omega[id1][0]) & (gap.omega < gap.omega[id1][-1])
+        assert np.sum(inside & ~id1) > 5 and np.all(np.isfinite(g1[inside]))
+        # G_1 is measured where identified (the bridge near ω_p, where U(ω - ω_p)
+        # is weak, is a smooth guess across the peak of |G_1|)
+        true1 = system.htf(gap.omega, 3)[4, 0, 0]
+        assert np.max(np.abs(g1 - true1)[id1]) < 0.01 * np.max(np.abs(true1))
+    H = estimate_htf((exc.time, exc.inputs, y), 0.25, 3, segments=exc.segments,
+                     alpha=alpha, omega_limits=LIMITS)
+    assert np.all(H.components()[1][:3] == 0)
+    assert np.array_equal(H.diagnostics["identified"], est.identified)
+
+
+def test_partial_frequencies_keep_fully_excited_estimates(replica_data):
+    # omega_limits adds partially identified frequencies; where every component
+    # is identified the per-frequency estimate is unchanged
+    _, exc, y = replica_data
+    full = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments)
+    part = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
+                     omega_limits=(0.0, 2 * np.pi * 6))
+    assert part.omega.size > full.omega.size
+    assert np.array_equal(part.omega[:full.omega.size], full.omega)
+    assert np.array_equal(part.components[..., :full.omega.size], full.components)
+    assert not part.identified[..., full.omega.size:].all(axis=(0, 1, 2)).any()
 
 
 # ----------------------------------------------------------------- bad input
@@ -267,8 +340,16 @@ def test_nan_in_data(replica_data):
 
 def test_nharmonics_too_large_for_band(replica_data):
     _, exc, y = replica_data
-    with pytest.raises(ValueError, match="too large for the excited band"):
+    with pytest.raises(ValueError, match="too large for the excited band.*omega_limits"):
         _estimate((exc.time, exc.inputs, y), 1.0, 5, segments=exc.segments)
+
+
+def test_no_identifiable_frequency_in_limits(replica_data):
+    # inputs excited up to 4 Hz: no shift |k| <= 2 reaches outputs at 40-45 Hz
+    _, exc, y = replica_data
+    with pytest.raises(ValueError, match="no output frequency in omega_limits"):
+        _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
+                  omega_limits=(2 * np.pi * 40, 2 * np.pi * 45))
 
 
 def test_zero_input_rejected():
@@ -295,10 +376,11 @@ def test_alpha_zero_needs_enough_records(single_record):
 
 def test_unexcited_frequencies_in_limits_warn(replica_data):
     _, exc, y = replica_data
-    with pytest.warns(UserWarning, match="unexcited"):
+    # output frequencies up to 6 Hz have U(ω - 2ω_p) excited (chirp 0-4 Hz + leakage)
+    with pytest.warns(UserWarning, match="unexcited: 42 dropped, 0 interpolated"):
         est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
-                        omega_limits=(0.0, 2 * np.pi * 4))
-    assert est.omega[-1] < 2 * np.pi * 2.6
+                        omega_limits=(0.0, 2 * np.pi * 8))
+    assert 2 * np.pi * 6 < est.omega[-1] < 2 * np.pi * 7
 
 
 @pytest.mark.parametrize("kwargs, exc_type, match", [
