@@ -43,7 +43,8 @@ class HTF:
     Parameters
     ----------
     components : array_like, shape (2K+1, ny, nu, nomega)
-        ``G_k(jω)`` for k = -K..K on the grid `omega`.
+        ``G_k(jω)`` for k = -K..K on the grid `omega`; NaN marks a
+        component that the data do not determine at that frequency.
     omega : array_like
         Frequencies in rad/s (increasing).
     period : float
@@ -80,7 +81,7 @@ class HTF:
 
     def __init__(self, components, omega, period, *, std=None, diagnostics=None,
                  name=None, inputs=None, outputs=None):
-        comps = real_array(components, 'components', ndim=4, allow_complex=True)
+        comps = _data_array(components, 'components', allow_complex=True)
         if comps.shape[0] % 2 != 1:
             raise ControlDimension("components must have 2K+1 harmonics on axis 0, "
                                    f"got {comps.shape[0]}")
@@ -91,7 +92,7 @@ class HTF:
         if np.any(np.diff(omega) <= 0):
             raise ValueError("omega must be strictly increasing")
         if std is not None:
-            std = real_array(std, 'std', ndim=4)
+            std = _data_array(std, 'std')
             if std.shape != comps.shape:
                 raise ControlDimension(f"std must have shape {comps.shape}, got {std.shape}")
         self._init(period, comps.shape[0] // 2, comps.shape[1], comps.shape[2], 0.0,
@@ -299,9 +300,20 @@ class HTF:
         neg = wbin < 0
         G[:, :, :, neg] = np.conj(G[::-1][:, :, :, neg])
         Y = np.zeros((self.noutputs, L), complex)
+        unknown = 0.0
         for i, k in enumerate(self.harmonics):
             # U(jω - jkω_p) is bin b - k r
-            Y += np.einsum('ijb,jb->ib', G[i], np.roll(U, k * r, axis=1))
+            Uk = np.roll(U, k * r, axis=1)
+            miss = np.isnan(G[i])
+            if miss.any():
+                # energy of the input terms whose component the data left undetermined
+                unknown = max(unknown, float(np.max(np.abs(Uk)[None] * miss, initial=0.0)))
+                G[i][miss] = 0
+            Y += np.einsum('ijb,jb->ib', G[i], Uk)
+        if unknown > 1e-3 * np.abs(U).max():
+            warnings.warn("the input excites HTF components that the data did not "
+                          "identify; those terms are taken as zero", UserWarning,
+                          stacklevel=2)
         y = np.fft.ifft(Y, axis=1).real
         return y[0] if squeeze and self.noutputs == 1 else y
 
@@ -617,6 +629,17 @@ def _default_omega(H):
     if H.dt:
         return np.linspace(1e-3, np.pi / H.dt, 500)[:-1]
     return np.logspace(np.log10(w / 100), np.log10(10 * w * max(1, H.nharmonics)), 500)
+
+
+def _data_array(data, name, allow_complex=False):
+    """4D array of a data HTF: finite values or NaN (not identified)."""
+    arr = np.asarray(data)
+    if arr.dtype.kind not in 'biufc':
+        raise ControlArgument(f"{name} must be numeric, got dtype {arr.dtype}")
+    if np.any(np.isinf(arr)):
+        raise ValueError(f"{name} contains inf")
+    return real_array(np.where(np.isnan(arr), 0, arr), name, ndim=4,
+                      allow_complex=allow_complex) * np.where(np.isnan(arr), np.nan, 1)
 
 
 def _harmonic(k, K):

@@ -530,21 +530,21 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     -------
     HTF
         Data HTF on the estimated grid, with ``std`` (standard deviation of
-        each component; None when the residual has no degrees of freedom,
-        e.g. exactly ``(2K+1)·nu`` windows, or when some component is not
-        identified) and ``diagnostics`` holding ``identified`` (bool, shape
+        each component, NaN where the component is; None when the residual
+        has no degrees of freedom, e.g. exactly ``(2K+1)·nu`` windows) and ``diagnostics`` holding ``identified`` (bool, shape
         of the components: True where ``U(ω - kω_p)`` of the input is
         excited, so that the data determine ``G_k(jω)``), ``cond`` (of
         ``Φ_UU`` over the identified components per frequency, NaN where
         there are none), ``residual`` (RMS per output), ``noise_var``,
         ``alpha``, ``dof``, ``gcv`` and ``nrecords``.  A component that is
-        not determined at a frequency is 0 in the HTF: with ``alpha=0``
+        not determined at a frequency is NaN in the HTF: with ``alpha=0``
         where it is not identified, with ``alpha > 0`` outside the range
         from its first to its last identified frequency (inside, the
         curvature penalty bridges unexcited gaps) and everywhere for a
         component identified at fewer than two frequencies.  It multiplies
-        an input component that the data did not excite, so predictions
-        for inputs inside the excited band do not use it.
+        an input component that the data did not excite, so `HTF.predict`
+        takes it as zero (and warns when the input to predict from does
+        excite it); `fit_htf` and `estimate_delays` leave it out.
 
     Warns
     -----
@@ -580,9 +580,9 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
                    "residual": est.residual, "noise_var": est.noise_var,
                    "alpha": est.alpha, "dof": est.dof, "gcv": est.gcv,
                    "nrecords": est.nrecords}
-    std = est.std if np.all(np.isfinite(est.std)) else None
-    # G_k U(ω - kω_p) = 0 where the data leave G_k undetermined (U not excited)
-    comps = np.where(np.isnan(est.components), 0, est.components)
-    return HTF(comps, est.omega, est.period, std=std,
+    # NaN marks components the data leave undetermined (U(ω - kω_p) not excited);
+    # std is None only when the residual has no degrees of freedom
+    std = None if np.all(np.isnan(est.std[est.identified])) else est.std
+    return HTF(est.components, est.omega, est.period, std=std,
                diagnostics=diagnostics, name=name,
                inputs=est.labels.get("inputs"), outputs=est.labels.get("outputs"))

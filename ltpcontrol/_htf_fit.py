@@ -254,6 +254,13 @@ def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
         bounds = (-np.inf, np.inf)
     shape = target.shape[1:]
 
+    # components the data leave undetermined (NaN) carry no residual
+    known = ~np.isnan(target)
+    if not known.any():
+        raise ValueError("estimate has no identified component in the fitted range")
+    target = np.where(known, target, 0)
+    wts = np.where(known, np.nan_to_num(wts), 0)
+
     def residual(p):
         g = _model_components(model, p, w_fit, K, ks, shape)
         if magnitude_only:
@@ -352,6 +359,10 @@ def estimate_delays(estimate, reference, *, harmonics=(-1, 0, 1), omega_limits=N
     w = omega[keep]
     meas = comps[ks + K, output, input][:, keep]
     model = np.asarray(ref)[ks + K, output, input][:, keep]
+    # components the data leave undetermined (NaN) get zero weight
+    known = ~np.isnan(meas)
+    meas = np.where(known, meas, 0)
+    model = np.where(known, model, 1)
     if np.any(model == 0):
         raise ValueError("reference components vanish on the grid; restrict "
                          "omega_limits or harmonics")

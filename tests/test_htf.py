@@ -177,3 +177,22 @@ def test_unstable_system_warns_and_poles_raise():
         H = ltp.htf(sys, 1)
     with pytest.raises(ValueError, match="pole"):
         H(0.5)
+
+
+def test_data_htf_marks_unidentified_components_with_nan():
+    sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    model = ltp.htf(sys, 1)
+    w = 2 * np.pi * np.arange(1, 40) / 4          # grid of a 4 s record
+    _, G = model.components(w)
+    G[2, :, :, w > 20] = np.nan                   # G_1 not identified above 20 rad/s
+    data = ltp.HTF(G, w, 1.0)
+    t = np.arange(400) * 0.01
+    low = np.cos(2 * np.pi * 0.5 * t)             # excites only identified terms
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        np.testing.assert_allclose(data.predict(low, t), model.predict(low, t), atol=1e-12)
+    high = np.cos(2 * np.pi * 3.5 * t)            # ω = 22 rad/s needs G_1 there
+    with pytest.warns(UserWarning, match="did not identify"):
+        data.predict(high, t)
+    with pytest.raises(ValueError, match="inf"):
+        ltp.HTF(np.where(np.isnan(G), np.inf, G), w, 1.0)
