@@ -34,3 +34,16 @@ def switching_mathieu(t_switch=0.25, T=0.5, wn=2 * np.pi):
     A = ltp.PeriodicMatrix.switching([piece(0.3, 0.1), piece(0.1, 0.2)],
                                      [0.0, t_switch], T)
     return ltp.ltpss(A, [[0], [1]], [[1, 0]], 0, period=T, name='switching_mathieu')
+
+
+def fd_period_map_jacobian(plant, period, x0, mode0=0, h=1e-4):
+    """Central-difference Jacobian of the simulated period map (independent check)."""
+    from ltpcontrol import period_map
+    n = len(x0)
+    jac = np.empty((n, n))
+    for j in range(n):
+        dx = np.zeros(n)
+        dx[j] = h
+        jac[:, j] = (period_map(plant, period, x0 + dx, mode0)[0]
+                     - period_map(plant, period, x0 - dx, mode0)[0]) / (2 * h)
+    return jac

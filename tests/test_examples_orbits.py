@@ -16,18 +16,8 @@ import mathieu  # noqa: E402
 import vhop  # noqa: E402
 
 from ltpcontrol._hybrid import simulate_hybrid  # noqa: E402
-from ltpcontrol._orbits import linearize_orbit, period_map  # noqa: E402
-
-
-def fd_jacobian(plant, period, x0, mode0, h):
-    n = len(x0)
-    jac = np.empty((n, n))
-    for j in range(n):
-        dx = np.zeros(n)
-        dx[j] = h
-        jac[:, j] = (period_map(plant, period, x0 + dx, mode0)[0]
-                     - period_map(plant, period, x0 - dx, mode0)[0]) / (2 * h)
-    return jac
+from ltpcontrol._orbits import linearize_orbit  # noqa: E402
+from systems import fd_period_map_jacobian  # noqa: E402
 
 
 @pytest.fixture(scope='module')
@@ -49,7 +39,7 @@ class TestHopper:
 
     def test_saltation_jacobian_matches_finite_differences(self, hop):
         plant, orbit = hop
-        fd = fd_jacobian(plant, 1.0, orbit.x0, orbit.mode0, 1e-6)
+        fd = fd_period_map_jacobian(plant, 1.0, orbit.x0, orbit.mode0, 1e-6)
         scale = np.abs(orbit.monodromy).max()
         np.testing.assert_allclose(orbit.monodromy / scale, fd / scale, atol=1e-5)
 
@@ -116,7 +106,7 @@ class TestVhop:
 
     def test_saltation_jacobian_matches_finite_differences(self, vorbit):
         plant, orbit = vorbit
-        fd = fd_jacobian(plant, vhop.PERIOD, orbit.x0, orbit.mode0, 1e-6)
+        fd = fd_period_map_jacobian(plant, vhop.PERIOD, orbit.x0, orbit.mode0, 1e-6)
         scale = np.abs(orbit.monodromy).max()
         np.testing.assert_allclose(orbit.monodromy / scale, fd / scale, atol=1e-5)
         # the touchdown jump: saltation matrix differs from the identity

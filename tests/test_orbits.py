@@ -8,6 +8,7 @@ from control.exception import ControlArgument, ControlDimension
 from ltpcontrol._hybrid import HybridMode, HybridPlant
 from ltpcontrol._ltpsys import LTPStateSpace
 from ltpcontrol._orbits import PeriodicOrbit, linearize_orbit, period_map, periodic_orbit
+from systems import fd_period_map_jacobian
 
 T = 2 * np.pi
 K_S, C_D, BETA = 2.0, 0.5, 0.5
@@ -21,18 +22,6 @@ def duffing(t, x, u, p):
 
 def duffing_jacobian(t, x, u, p):
     return np.array([[0.0, 1.0], [-K_S - 3 * BETA * x[0] ** 2, -C_D]])
-
-
-def fd_period_map_jacobian(plant, period, x0, mode0=0, h=1e-4):
-    """Central-difference Jacobian of the simulated period map."""
-    n = len(x0)
-    jac = np.empty((n, n))
-    for j in range(n):
-        dx = np.zeros(n)
-        dx[j] = h
-        jac[:, j] = (period_map(plant, period, x0 + dx, mode0)[0]
-                     - period_map(plant, period, x0 - dx, mode0)[0]) / (2 * h)
-    return jac
 
 
 @pytest.fixture(scope='module')
