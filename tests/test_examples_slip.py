@@ -203,12 +203,12 @@ def test_vertical_identification_recovers_masses():
         assert d == pytest.approx(slip_data.SPRINGS[s][1], rel=0.03)
 
 
-def _exact_set(spring, n, seed, params=None):
-    """Strides predicted by SLIPD with the true parameters: exact data."""
+def _exact_set(spring, n, seed, params=None, method="SLIPD"):
+    """Strides predicted by `method` with the true parameters: exact data."""
     params = slip_data.spring_params(spring) if params is None else params
     apex, theta = _throws(n, slip_data.spring_params(spring), seed, spread=0.12,
                           method="AAS")
-    pred = sm.predict_stride(apex, theta, params, "SLIPD")
+    pred = sm.predict_stride(apex, theta, params, method)
     ok = np.isfinite(pred.apex.t) & (pred.apex.vy > 0.3)
     a1 = np.column_stack([pred.apex.t, pred.apex.y, pred.apex.z, pred.apex.vy])
     b = np.column_stack([pred.bottom.t, pred.bottom.y, pred.bottom.z])
@@ -266,6 +266,29 @@ def test_leg_identification_recovers_truth(hard_clean):
     assert k_aas < k and d_aas < d
     k_slip, _, _ = sid.fit_leg(hard_clean, start, "SLIP")
     assert k_slip > 1.05 * truth.k
+
+
+@pytest.mark.parametrize("spring", ["hard", "softer"])
+def test_aas_bias_is_its_stance_approximation(spring):
+    """The AAS leg bias comes from the AAS stance map, not from the fit.
+
+    The same cost (2.33) and optimiser recover k and d to 0.01 % from exact
+    transitions of AAS itself and of SLIPD (each fitted with its own map).
+    Fitting AAS to exact SLIPD transitions over the thesis's range of
+    throws (apex speed 0.3-2.5 m/s, height 0.24-0.48 m) moves k and d by
+    several percent, more for the softer spring, whose leg compresses by up
+    to a third (measured with these throws: -2.7 % / -5.9 % hard,
+    -9.5 % / -18 % softer).  A 2 % recovery is within reach of SLIPD only.
+    """
+    truth = slip_data.spring_params(spring)
+    start = truth.replace(k=1.1 * truth.k, d=0.8 * truth.d)
+    for method in ("AAS", "SLIPD"):
+        own = _exact_set(spring, 30, 13, method=method)
+        k, d, cost = sid.fit_leg(own, start, method, max_nfev=100)
+        assert k == pytest.approx(truth.k, rel=1e-4) and d == pytest.approx(truth.d, rel=1e-4)
+        assert cost < 0.01
+    k, d, cost = sid.fit_leg(_exact_set(spring, 30, 13), start, "AAS", max_nfev=100)
+    assert k < 0.98 * truth.k and d < 0.95 * truth.d and cost > 1.0
 
 
 def test_lossless_fits_stiffen_with_leg_damping():
