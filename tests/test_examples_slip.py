@@ -282,12 +282,12 @@ def test_aas_bias_is_its_stance_approximation(spring):
     """
     truth = slip_data.spring_params(spring)
     start = truth.replace(k=1.1 * truth.k, d=0.8 * truth.d)
-    for method in ("AAS", "SLIPD"):
-        own = _exact_set(spring, 30, 13, method=method)
+    exact = {method: _exact_set(spring, 30, 13, method=method) for method in ("AAS", "SLIPD")}
+    for method, own in exact.items():
         k, d, cost = sid.fit_leg(own, start, method, max_nfev=100)
         assert k == pytest.approx(truth.k, rel=1e-4) and d == pytest.approx(truth.d, rel=1e-4)
         assert cost < 0.01
-    k, d, cost = sid.fit_leg(_exact_set(spring, 30, 13), start, "AAS", max_nfev=100)
+    k, d, cost = sid.fit_leg(exact["SLIPD"], start, "AAS", max_nfev=100)
     assert k < 0.98 * truth.k and d < 0.95 * truth.d and cost > 1.0
 
 
