@@ -20,7 +20,7 @@ from control.exception import ControlArgument, ControlDimension
 
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix, as_periodic
-from ._riccati import care, dare
+from ._riccati import _check_weights, care, dare
 from ._validation import check_kwargs, real_array
 
 __all__ = ['lqr', 'dlqr', 'lqe', 'dlqe', 'lqg']
@@ -170,6 +170,8 @@ def lqe(sys, QN, RN, NN=None, **kwargs):
     RN = as_periodic(RN, T, 'RN', shape=(sys.noutputs,) * 2)
     NN = as_periodic(np.zeros((G.shape[1], sys.noutputs)) if NN is None else NN, T, 'NN',
                      shape=(G.shape[1], sys.noutputs))
+    probe = np.arange(16) * T / 16
+    _check_weights(QN(probe), RN(probe), 'QN', 'RN')
     X, E, Gd = care(_reverse(sys.A, True), _reverse(sys.C, True),
                     _reverse(G @ QN @ G.T, False), _reverse(RN, False),
                     _reverse(G @ NN, False), period=T, nsteps=nsteps)
@@ -220,6 +222,7 @@ def dlqe(sys, QN, RN, NN=None, **kwargs):
     _shape_check(QN, (G.shape[2],) * 2, 'QN')
     _shape_check(RN, (C.shape[1],) * 2, 'RN')
     _shape_check(NN, (G.shape[2], C.shape[1]), 'NN')
+    _check_weights(QN, RN, 'QN', 'RN')
     Gt = np.swapaxes(G, 1, 2)
     # dual problem on the reversed step order j = N-1-k
     flip = (lambda M: np.ascontiguousarray(M[::-1]))

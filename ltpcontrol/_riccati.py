@@ -37,8 +37,8 @@ Both cases then share one algorithm:
 Values inside a step ``[t_k, t_{k+1}]`` are ``X(t) = V U⁻¹`` with
 ``[U; V] = Φ_H(t_{k+1}, t)⁻¹ [I; X_{k+1}]`` (the backward flow, which
 contracts onto the stabilizing solution), computed at Chebyshev points of
-every step and interpolated (checked against the exact value inside every
-step).
+every step when X is first evaluated between the step boundaries and
+interpolated (checked against the exact value inside every step).
 """
 
 import warnings
@@ -136,16 +136,7 @@ def care(A, B, Q, R, S=None, period=None, nsteps=None):
     H = PeriodicMatrix._new(period, (2 * n, 2 * n), combine=(hamiltonian, list(ops)),
                             breakpoints=breaks)
     grid = _grid(H, period, breaks, nsteps)
-    # W[k, j] = Φ_H(t_{k+1}, s_j) at the Chebyshev points s_j of step k
-    cheb = chebyshev_nodes(_CHEB_DEG)
-    nodes = grid[:-1, None] + np.diff(grid)[:, None] * cheb
-    sub = _flow(H, nodes[:, :-1].ravel(), np.diff(nodes, axis=1).ravel())
-    sub = sub.reshape(len(grid) - 1, _CHEB_DEG, 2 * n, 2 * n)
-    W = np.empty((len(grid) - 1, _CHEB_DEG + 1, 2 * n, 2 * n))
-    W[:, -1] = np.eye(2 * n)
-    for j in range(_CHEB_DEG - 1, -1, -1):
-        W[:, j] = W[:, j + 1] @ sub[:, j]
-    Psi = W[:, 0]
+    Psi = _flow(H, grid[:-1], np.diff(grid))
     ident = np.broadcast_to(np.eye(2 * n), Psi.shape)
     X0, _ = _stable_solution(ident, Psi, n)
     # backward flow from X(T) = X(0): [U; V] = Ψ_k⁻¹ [I; X_{k+1}]
@@ -158,18 +149,14 @@ def care(A, B, Q, R, S=None, period=None, nsteps=None):
     # closed-loop step factors: x(t_{k+1}) = [Ψ_k [I; X_k]]_top x(t_k)
     factors = (Psi @ _stack(Xg[:-1]))[:, :n]
     L = _exponents(factors, period=period)
-    # values inside the steps by the backward flow, then interpolated
-    values = _graph(np.linalg.solve(W, _stack(Xg[1:])[:, None]), n)
-    values[:, 0] = Xg[:-1]
-    interp = piecewise_chebyshev(grid, values)
-    probe = grid[:-1] + 0.3717 * np.diff(grid)
-    exact = _graph(np.linalg.solve(_flow(H, probe, grid[1:] - probe), _stack(Xg[1:])), n)
-    err = np.abs(interp(probe) - exact).max() / max(1.0, np.abs(exact).max())
-    if err > 1e-10:
-        warnings.warn(f"the interpolated Riccati solution has relative errors up to "
-                      f"{err:.1e} inside the steps; increase nsteps", UserWarning,
-                      stacklevel=2)
-    X = PeriodicMatrix._new(period, (n, n), func=interp, breakpoints=grid[:-1])
+    cache = []
+
+    def solution(t):
+        if not cache:
+            cache.append(_interpolant(H, grid, Xg))
+        return cache[0](t)
+
+    X = PeriodicMatrix._new(period, (n, n), func=solution, breakpoints=grid[:-1])
 
     def gain(b, r, s, x):
         return np.linalg.solve(r, np.swapaxes(b, 1, 2) @ x + np.swapaxes(s, 1, 2))
@@ -251,6 +238,31 @@ def dare(A, B, Q, R, S=None):
 #
 # Shared steps
 #
+
+def _interpolant(H, grid, Xg):
+    """X(t) inside the steps: the backward flow at Chebyshev points, interpolated."""
+    n = Xg.shape[1]
+    cheb = chebyshev_nodes(_CHEB_DEG)
+    nodes = grid[:-1, None] + np.diff(grid)[:, None] * cheb
+    sub = _flow(H, nodes[:, :-1].ravel(), np.diff(nodes, axis=1).ravel())
+    sub = sub.reshape(len(grid) - 1, _CHEB_DEG, 2 * n, 2 * n)
+    # W[k, j] = Φ_H(t_{k+1}, s_j),  [U; V] = W⁻¹ [I; X_{k+1}]
+    W = np.empty((len(grid) - 1, _CHEB_DEG + 1, 2 * n, 2 * n))
+    W[:, -1] = np.eye(2 * n)
+    for j in range(_CHEB_DEG - 1, -1, -1):
+        W[:, j] = W[:, j + 1] @ sub[:, j]
+    values = _graph(np.linalg.solve(W, _stack(Xg[1:])[:, None]), n)
+    values[:, 0] = Xg[:-1]
+    interp = piecewise_chebyshev(grid, values)
+    probe = grid[:-1] + 0.3717 * np.diff(grid)
+    exact = _graph(np.linalg.solve(_flow(H, probe, grid[1:] - probe), _stack(Xg[1:])), n)
+    err = np.abs(interp(probe) - exact).max() / max(1.0, np.abs(exact).max())
+    if err > 1e-10:
+        warnings.warn(f"the interpolated Riccati solution has relative errors up to "
+                      f"{err:.1e} inside the steps; increase nsteps", UserWarning,
+                      stacklevel=4)
+    return interp
+
 
 def _stable_solution(Lk, Mk, n):
     """``X_0 = V U⁻¹`` from the stable deflating subspace of the collapsed pencil."""
