@@ -31,6 +31,8 @@ from ._canonical import to_canonical, matrix_errors, MatrixErrors
 from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
 from ._riccati import care, dare
 from ._design import lqr, dlqr, lqe, dlqe, lqg
+from ._place import place
+from ._lmi import lmi_statefbk, LMIDesign
 
 __version__ = "0.1.0"
 
@@ -60,5 +62,6 @@ __all__ = [
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
     # control design
-    'care', 'dare', 'lqr', 'dlqr', 'lqe', 'dlqe', 'lqg',
+    'care', 'dare', 'lqr', 'dlqr', 'lqe', 'dlqe', 'lqg', 'place',
+    'lmi_statefbk', 'LMIDesign',
 ]
