@@ -21,12 +21,12 @@ from control.exception import ControlArgument, ControlDimension
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix, as_periodic
 from ._riccati import _check_weights, care, dare
-from ._validation import check_kwargs, real_array
+from ._validation import real_array
 
 __all__ = ['lqr', 'dlqr', 'lqe', 'dlqe', 'lqg']
 
 
-def lqr(sys, Q, R, N=None, **kwargs):
+def lqr(sys, Q, R, N=None, nsteps=None):
     """Periodic linear quadratic regulator, as `control.lqr`.
 
     Minimizes ``∫ (xᵀQx + uᵀRu + 2xᵀNu) dt`` for ``ẋ = A(t)x + B(t)u``
@@ -42,7 +42,8 @@ def lqr(sys, Q, R, N=None, **kwargs):
     N : array_like, PeriodicMatrix or callable, optional
         Cross weight (n, m).
     nsteps : int, optional
-        Steps per period of the Riccati solver (see `ltpcontrol.care`).
+        Continuous time: steps per period of the Riccati solver (see
+        `ltpcontrol.care`).
 
     Returns
     -------
@@ -69,16 +70,13 @@ def lqr(sys, Q, R, N=None, **kwargs):
     >>> K.shape, bool(np.all(E.real < 0))
     ((1, 2), True)
     """
-    _check_ltp(sys, 'sys')
-    if sys.isdtime(strict=True):
-        return dlqr(sys, Q, R, N, **kwargs)
-    nsteps = kwargs.pop('nsteps', None)
-    check_kwargs(kwargs, 'lqr')
+    if _discrete(sys, nsteps):
+        return dlqr(sys, Q, R, N)
     X, E, K = care(sys.A, sys.B, Q, R, N, period=sys.period, nsteps=nsteps)
     return K, X, E
 
 
-def dlqr(sys, Q, R, N=None, **kwargs):
+def dlqr(sys, Q, R, N=None):
     """Periodic discrete-time linear quadratic regulator, as `control.dlqr`.
 
     Minimizes ``Σ_k (x_kᵀQ_kx_k + u_kᵀR_ku_k + 2x_kᵀN_ku_k)`` for
@@ -112,7 +110,6 @@ def dlqr(sys, Q, R, N=None, **kwargs):
     ((1, 2), (1, 2), True)
     """
     _check_ltp(sys, 'sys')
-    check_kwargs(kwargs, 'dlqr')
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqr: sys must be a discrete-time system (use lqr)")
     steps = sys.nsteps
@@ -122,7 +119,7 @@ def dlqr(sys, Q, R, N=None, **kwargs):
     return _held(K, sys), _held(X, sys), E
 
 
-def lqe(sys, QN, RN, NN=None, **kwargs):
+def lqe(sys, QN, RN, NN=None, nsteps=None):
     """Periodic Kalman(-Bucy) filter gain, as `control.lqe`.
 
     For ``ẋ = A(t)x + B(t)u + G(t)w``, ``y = C(t)x + v`` with white noises
@@ -159,11 +156,8 @@ def lqe(sys, QN, RN, NN=None, **kwargs):
     >>> L.shape, bool(np.all(E.real < 0))
     ((2, 1), True)
     """
-    _check_ltp(sys, 'sys')
-    if sys.isdtime(strict=True):
-        return dlqe(sys, QN, RN, NN, **kwargs)
-    nsteps = kwargs.pop('nsteps', None)
-    check_kwargs(kwargs, 'lqe')
+    if _discrete(sys, nsteps):
+        return dlqe(sys, QN, RN, NN)
     T = sys.period
     G = sys.B
     QN = as_periodic(QN, T, 'QN', shape=(G.shape[1],) * 2)
@@ -178,7 +172,7 @@ def lqe(sys, QN, RN, NN=None, **kwargs):
     return _reverse(Gd, True), _reverse(X, False), E
 
 
-def dlqe(sys, QN, RN, NN=None, **kwargs):
+def dlqe(sys, QN, RN, NN=None):
     """Periodic discrete-time Kalman filter gain (predictor form), as `control.dlqe`.
 
     For ``x_{k+1} = A_kx_k + B_ku_k + G_kw_k``, ``y_k = C_kx_k + v_k``, the
@@ -212,7 +206,6 @@ def dlqe(sys, QN, RN, NN=None, **kwargs):
     ((2, 1), True)
     """
     _check_ltp(sys, 'sys')
-    check_kwargs(kwargs, 'dlqe')
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqe: sys must be a discrete-time system (use lqe)")
     steps = sys.nsteps
@@ -234,7 +227,7 @@ def dlqe(sys, QN, RN, NN=None, **kwargs):
     return _held(L, sys), _held(P, sys), E
 
 
-def lqg(sys, Q, R, QN, RN, **kwargs):
+def lqg(sys, Q, R, QN, RN, name=None):
     """Periodic LQG output-feedback controller as an `LTPStateSpace`.
 
     Combines the LQR gain ``K`` of ``(Q, R)`` (`lqr`/`dlqr`) with the
@@ -273,8 +266,6 @@ def lqg(sys, Q, R, QN, RN, **kwargs):
     (4, True)
     """
     _check_ltp(sys, 'sys')
-    name = kwargs.pop('name', None)
-    check_kwargs(kwargs, 'lqg')
     K, _, _ = lqr(sys, Q, R)
     L, _, _ = lqe(sys, QN, RN)
     A = sys.A - sys.B @ K - L @ sys.C + L @ sys.D @ K
@@ -286,6 +277,16 @@ def lqg(sys, Q, R, QN, RN, **kwargs):
 #
 # Helpers
 #
+
+def _discrete(sys, nsteps):
+    """True for a discrete-time plant (which takes no nsteps)."""
+    _check_ltp(sys, 'sys')
+    if sys.isdtime(strict=True):
+        if nsteps is not None:
+            raise ControlArgument("nsteps applies to continuous-time systems only")
+        return True
+    return False
+
 
 def _check_ltp(sys, name):
     if not isinstance(sys, LTPStateSpace):

@@ -32,7 +32,6 @@ from control.exception import ControlArgument
 from ._floquet import _log_multipliers
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix
-from ._validation import check_kwargs
 
 __all__ = ['lmi_statefbk', 'LMIDesign']
 
@@ -63,6 +62,14 @@ class LMIDesign:
         'h2', 'hinf' or 'decay'.
     multipliers : ndarray of complex
         Closed-loop Floquet multipliers.
+
+    Examples
+    --------
+    >>> sysd = ltp.ltpss(np.array([[[1.1]], [[0.9]]]), [[1.0]], [[1.0]], 0,
+    ...                  period=2.0, dt=1.0)
+    >>> res = ltp.lmi_statefbk(sysd, objective='h2')
+    >>> res.objective, res.certificate.shape, res.K.shape
+    ('h2', (2, 1, 1), (1, 1))
     """
 
     K: PeriodicMatrix
@@ -74,8 +81,7 @@ class LMIDesign:
     multipliers: np.ndarray
 
 
-def lmi_statefbk(sysd, Q=None, R=None, objective='h2', G=None, rate=None, solver=None,
-                 **kwargs):
+def lmi_statefbk(sysd, Q=None, R=None, objective='h2', G=None, rate=None, solver=None):
     """Periodic state feedback by convex optimization (LMIs, cvxpy).
 
     Parameters
@@ -128,7 +134,6 @@ def lmi_statefbk(sysd, Q=None, R=None, objective='h2', G=None, rate=None, solver
     >>> res.status, bool(np.all(np.abs(res.multipliers) <= 0.9 ** 2))
     ('optimal', True)
     """
-    check_kwargs(kwargs, 'lmi_statefbk')
     import cvxpy as cp
     if not isinstance(sysd, LTPStateSpace) or not sysd.isdtime(strict=True):
         raise ControlArgument("sysd must be a discrete-time LTPStateSpace (sample a "

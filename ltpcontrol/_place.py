@@ -29,12 +29,12 @@ from control.exception import ControlArgument
 from ._floquet import _log_multipliers
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix
-from ._validation import check_kwargs, real_array
+from ._validation import real_array
 
 __all__ = ['place']
 
 
-def place(sys, p, step=None, dt=None, **kwargs):
+def place(sys, p, step=None, dt=None):
     """Periodic state feedback with prescribed closed-loop poles, as `control.place`.
 
     Parameters
@@ -93,7 +93,6 @@ def place(sys, p, step=None, dt=None, **kwargs):
     >>> np.sort(ltp.floquet_multipliers(loop).real).round(8)
     array([-0.2,  0.5])
     """
-    check_kwargs(kwargs, 'place')
     if not isinstance(sys, LTPStateSpace):
         raise ControlArgument(f"sys must be an LTPStateSpace, got {type(sys).__name__}")
     n = sys.nstates

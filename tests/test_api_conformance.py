@@ -184,6 +184,7 @@ def test_unknown_keyword_is_rejected(name):
 # result containers document their fields under Attributes, not Parameters
 _RESULT_CLASSES = {'Excitation', 'HTFFit', 'DelayEstimate', 'FDSubspaceInfo',
                    'PeriodicOrbit', 'FloquetRealization', 'MatrixErrors', 'LTPSubspaceInfo'}
+_RESULT_CLASSES |= {'LMIDesign'}
 
 DOC_DEFECTS = {}
 
