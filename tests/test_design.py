@@ -9,6 +9,7 @@ import numpy as np
 import control as ct
 import pytest
 from control.exception import ControlArgument, ControlDimension
+from hypothesis import given, settings, strategies as st
 from scipy.integrate import simpson
 
 import ltpcontrol as ltp
@@ -244,9 +245,11 @@ def test_lqg_separation_and_discrete_closed_loop():
                                np.sort(np.abs(np.concatenate([EKd, ELd]) ** 8)), atol=1e-10)
 
 
-def test_dare_periodic_residual_and_weights_per_step():
-    rng = np.random.default_rng(5)
-    N, n, m = 5, 3, 2
+@settings(max_examples=20, deadline=None)
+@given(seed=st.integers(0, 10_000), N=st.integers(1, 6), n=st.integers(1, 4),
+       m=st.integers(1, 3))
+def test_dare_periodic_residual_and_weights_per_step(seed, N, n, m):
+    rng = np.random.default_rng(seed)
     A = rng.standard_normal((N, n, n))
     B = rng.standard_normal((N, n, m))
     Q = np.stack([np.diag(rng.uniform(0.5, 2, n)) for _ in range(N)])
@@ -256,11 +259,14 @@ def test_dare_periodic_residual_and_weights_per_step():
         Xn = X[(k + 1) % N]
         rhs = A[k].T @ Xn @ A[k] - A[k].T @ Xn @ B[k] @ np.linalg.solve(
             R[k] + B[k].T @ Xn @ B[k], B[k].T @ Xn @ A[k]) + Q[k]
-        assert np.abs(X[k] - rhs).max() < 1e-10 * np.abs(X).max()
+        assert np.abs(X[k] - rhs).max() < 1e-9 * np.abs(X).max()
+        assert np.linalg.eigvalsh(X[k]).min() > 0
     mono = np.eye(n)
     for k in range(N):
         mono = (A[k] - B[k] @ G[k]) @ mono
-    np.testing.assert_allclose(_sorted(np.linalg.eigvals(mono)), _sorted(L ** N), atol=1e-10)
+    assert np.max(np.abs(L)) < 1
+    np.testing.assert_allclose(_sorted(np.linalg.eigvals(mono)), _sorted(L ** N),
+                               atol=1e-9 * max(1.0, np.abs(mono).max()))
 
 
 #
