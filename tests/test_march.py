@@ -99,3 +99,14 @@ def test_time_varying_feedthrough_discrete_odd_and_even_N():
                                    u[:, None], np.zeros((3, 1)))
         np.testing.assert_allclose(ltp.forced_response(sys, t, u).y, yr[:, 0], rtol=1e-12,
                                    atol=1e-12)
+
+
+@pytest.mark.parametrize("scale", [1e-4, 1e-2, 0.2, 0.8, 2.0, 5.0, 50.0])
+def test_expm_batch_equals_scipy_at_every_pade_degree(scale):
+    import scipy.linalg as sla
+    from ltpcontrol._transition import expm_batch
+    X = np.random.default_rng(2).normal(size=(30, 5, 5)) * scale / 5
+    E = expm_batch(X)
+    for x, e in zip(X, E):
+        ref = sla.expm(x)
+        np.testing.assert_allclose(e, ref, rtol=0, atol=1e-13 * np.abs(ref).max() * max(1, scale))
