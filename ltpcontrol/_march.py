@@ -134,19 +134,21 @@ def periodic_march(Phi, E, F, C, D, u, x0):
     for q in range(P + 1):
         starts[:, q] = xq
         xq = xq @ Psi.T + zper[:, q]
-    # 2.-3. block starts and all samples of each phase, in row chunks
+    # 2.-3. block starts and all samples of each phase, in row chunks: the rows
+    # [u window of every input, x[s]] times the phase operator, written in place
     out = np.empty((n + p, rows, N))
     xb = starts.reshape(rows, n)
-    step = max(1, _CHUNK_BYTES // (8 * (n + p) * b))
+    K = m * (b + 1) + n
+    step = max(1, _CHUNK_BYTES // (8 * K))
     for c, op in enumerate(ops):
         for r0 in range(0, rows, step):
             r1 = min(rows, r0 + step)
+            lhs = np.empty((r1 - r0, K))
             w = windows(c, r0, r1)
-            # columns (signal, k): Φ(k,0) x[s] and C_k Φ(k,0) x[s], plus the window terms
-            G = xb[r0:r1] @ op.start
             for i in range(m):
-                G += w[i] @ op.window[i]
-            out[:, r0:r1, c * b:(c + 1) * b] = G.reshape(r1 - r0, n + p, b).transpose(1, 0, 2)
+                lhs[:, i * (b + 1):(i + 1) * (b + 1)] = w[i]
+            lhs[:, m * (b + 1):] = xb[r0:r1]
+            np.matmul(lhs[None], op.operator, out=out[:, r0:r1, c * b:(c + 1) * b])
         xb = xb @ op.Phi_b.T + z[c]
     out = out.reshape(n + p, R, (P + 1) * N)
     return out[:n, :, :L], out[n:, :, :L]
@@ -155,10 +157,12 @@ def periodic_march(Phi, E, F, C, D, u, x0):
 class _BlockOperators:
     """Matrices of one block phase (see the module docstring)."""
 
-    __slots__ = ('start', 'window', 'last', 'Phi_b')
+    __slots__ = ('operator', 'last', 'Phi_b')
 
-    def __init__(self, start, window, last, Phi_b):
-        self.start, self.window, self.last, self.Phi_b = start, window, last, Phi_b
+    def __init__(self, operator, last, Phi_b):
+        # operator (signal, K, k): coefficients of [u windows, x[s]] in x[s+k], y[s+k]
+        # last (input, j, state): coefficients of the window in x[s+b]; Phi_b = Φ(b, 0)
+        self.operator, self.last, self.Phi_b = operator, last, Phi_b
 
 
 def _block_operators(Phi, E, F, C, D, s, b):
@@ -184,8 +188,9 @@ def _block_operators(Phi, E, F, C, D, s, b):
     Vy = np.einsum('kps,kjsi->kjpi', Ck, V[:b])     # y[s+k] = C_k x[s+k] + D_k u[s+k]
     Vy[np.arange(b), np.arange(b)] += Dk
     Vxy = np.concatenate([V[:b], Vy], axis=2)      # (k, j, signal, i)
-    window = np.ascontiguousarray(Vxy.transpose(3, 1, 2, 0)).reshape(m, b + 1, (n + p) * b)
-    Oxy = np.concatenate([O[:b], np.einsum('kps,ksq->kpq', Ck, O[:b])], axis=1)
-    start = np.ascontiguousarray(Oxy.transpose(2, 1, 0)).reshape(n, (n + p) * b)
+    Oxy = np.concatenate([O[:b], np.einsum('kps,ksq->kpq', Ck, O[:b])], axis=1)  # (k, signal, q)
+    window = Vxy.transpose(2, 3, 1, 0).reshape(n + p, m * (b + 1), b)
+    start = Oxy.transpose(1, 2, 0)
+    operator = np.ascontiguousarray(np.concatenate([window, start], axis=1))
     last = np.ascontiguousarray(V[b].transpose(2, 0, 1))      # (i, j, n)
-    return _BlockOperators(start, window, last, O[b])
+    return _BlockOperators(operator, last, O[b])
