@@ -19,10 +19,12 @@ pencil ``L_k [x_{k+1}; λ_{k+1}] = M_k [x_k; λ_k]`` with
 Both cases then share one algorithm:
 
 1. collapse the cyclic product ``L_{M-1}⁻¹M_{M-1} ... L_0⁻¹M_0`` into one
-   2n x 2n pencil ``(L, M)`` with orthogonal transformations only: for the
-   next factor, a QR factorisation of ``[L; -M_k]`` gives ``[Z1 Z2]`` with
-   ``Z1 L = Z2 M_k``, so ``M_k L⁻¹ = Z2⁻¹ Z1`` and ``(L, M) <- (Z2 L_k,
-   Z1 M)``.  No product, inverse or exponential of a stiff flow is formed;
+   2n x 2n pencil ``(L, M)`` with orthogonal transformations only: for two
+   neighbouring factors, a QR factorisation of ``[L_k; -M_{k+1}]`` gives
+   ``[Z1 Z2]`` with ``Z1 L_k = Z2 M_{k+1}``, so ``M_{k+1} L_k⁻¹ = Z2⁻¹ Z1``
+   and the pair becomes ``(Z2 L_{k+1}, Z1 M_k)``; pairs are merged in a
+   balanced tree.  No product, inverse or exponential of a stiff flow is
+   formed;
 2. the stable deflating subspace ``[U; V]`` of ``(M, L)`` by ordered QZ
    gives ``X_0 = V U⁻¹`` (exactly n multipliers inside the unit circle
    are required: otherwise no stabilizing solution exists);
@@ -284,11 +286,7 @@ def _interpolant(H, grid, Xg):
 
 def _stable_solution(Lk, Mk, n):
     """``X_0 = V U⁻¹`` from the stable deflating subspace of the collapsed pencil."""
-    Lc, Mc = Lk[0], Mk[0]
-    for k in range(1, len(Lk)):
-        q, _ = np.linalg.qr(np.vstack([Lc, -Mk[k]]), mode='complete')
-        Z = q.T[2 * n:]
-        Lc, Mc = Z[:, 2 * n:] @ Lk[k], Z[:, :2 * n] @ Mc
+    Lc, Mc = _collapse(np.asarray(Lk, float), np.asarray(Mk, float))
     # QZ of the pencil M - μ L, stable eigenvalues first
     _, _, alpha, beta, _, Zq = la.ordqz(Mc, Lc, sort='iuc', output='real')
     with np.errstate(divide='ignore', invalid='ignore'):
@@ -307,6 +305,26 @@ def _stable_solution(Lk, Mk, n):
                          "stabilizable)")
     X0 = np.linalg.solve(U.T, V.T).T
     return 0.5 * (X0 + X0.T), mod
+
+
+def _collapse(L, M):
+    """One pencil ``(L, M)`` with ``L⁻¹M = L_{K-1}⁻¹M_{K-1} ... L_0⁻¹M_0``.
+
+    Neighbours are merged pairwise (a balanced tree, batched): for factors
+    k, k+1 the QR factorisation of ``[L_k; -M_{k+1}]`` gives ``[Z1 Z2]``
+    with ``Z1 L_k = Z2 M_{k+1}``, and the pair becomes ``(Z2 L_{k+1}, Z1 M_k)``.
+    """
+    d = L.shape[1]
+    while len(L) > 1:
+        even = len(L) - len(L) % 2
+        q, _ = np.linalg.qr(np.concatenate([L[0:even:2], -M[1:even:2]], axis=1),
+                            mode='complete')
+        Z = np.swapaxes(q, 1, 2)[:, d:]
+        Lnew, Mnew = Z[:, :, d:] @ L[1:even:2], Z[:, :, :d] @ M[0:even:2]
+        if even < len(L):
+            Lnew, Mnew = np.concatenate([Lnew, L[-1:]]), np.concatenate([Mnew, M[-1:]])
+        L, M = Lnew, Mnew
+    return L[0], M[0]
 
 
 def _riccati_step(a, b, q, r, s, xn):
