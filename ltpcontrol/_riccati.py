@@ -145,8 +145,7 @@ def care(A, B, Q, R, S=None, period=None, nsteps=None):
     grid = _grid(H, period, breaks, nsteps)
     Psi = _flow(H, grid[:-1], np.diff(grid))
     ident = np.broadcast_to(np.eye(2 * n), Psi.shape)
-    X0, _ = _stable_solution(ident, Psi, n)
-
+    X0 = _stable_solution(ident, Psi, n)
     Psi_inv = np.linalg.inv(Psi)
 
     def sweep(X0):
@@ -236,7 +235,7 @@ def dare(A, B, Q, R, S=None):
     Mk[:, :n, :n] = Abar
     Mk[:, n:, :n] = -Qbar
     Mk[:, n:, n:] = np.eye(n)
-    X0, _ = _stable_solution(Lk, Mk, n)
+    X0 = _stable_solution(Lk, Mk, n)
     Bt = np.swapaxes(B, 1, 2)
 
     def sweep(X0):
@@ -304,7 +303,7 @@ def _stable_solution(Lk, Mk, n):
                          "is not a graph over the state space (check that (A, B) is "
                          "stabilizable)")
     X0 = np.linalg.solve(U.T, V.T).T
-    return 0.5 * (X0 + X0.T), mod
+    return 0.5 * (X0 + X0.T)
 
 
 def _collapse(L, M):
