@@ -31,6 +31,7 @@ from ._canonical import to_canonical, matrix_errors, MatrixErrors
 from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
 from ._lyapunov import lyap, dlyap, gram
 from ._norms import norm
+from ._zeros import zeros
 
 __version__ = "0.1.0"
 
@@ -60,5 +61,5 @@ __all__ = [
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
     # analysis: Lyapunov equations, gramians, zeros, norms
-    'lyap', 'dlyap', 'gram', 'norm',
+    'lyap', 'dlyap', 'gram', 'norm', 'zeros',
 ]

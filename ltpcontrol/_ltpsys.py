@@ -243,6 +243,11 @@ class LTPStateSpace(NonlinearIOSystem):
         """
         return self.floquet_exponents()
 
+    def zeros(self, **kwargs):
+        """Transmission zeros; see `ltpcontrol.zeros` (so `control.zeros` works)."""
+        from ._zeros import zeros
+        return zeros(self, **kwargs)
+
     def is_stable(self, **kwargs):
         """True when all Floquet multipliers lie inside the unit circle."""
         from ._floquet import is_stable
