@@ -32,6 +32,7 @@ from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceI
 from ._lyapunov import lyap, dlyap, gram
 from ._norms import norm
 from ._zeros import zeros
+from ._harmonic_ss import harmonic_ss
 
 __version__ = "0.1.0"
 
@@ -61,5 +62,5 @@ __all__ = [
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
     # analysis: Lyapunov equations, gramians, zeros, norms
-    'lyap', 'dlyap', 'gram', 'norm', 'zeros',
+    'lyap', 'dlyap', 'gram', 'norm', 'zeros', 'harmonic_ss',
 ]
