@@ -210,81 +210,76 @@ def _linf_continuous(sys, tol, nsteps):
     dmax = float(np.linalg.norm(sys.D(probe), ord=2, axis=(1, 2)).max(initial=0.0))
     if n == 0 or sys.ninputs == 0 or sys.noutputs == 0:
         return dmax, np.inf
-    lo = max(dmax, _htf_lower_bound(sys))
-    if lo == 0.0:
-        lo = 1e-12 * (1 + dmax)
+    # estimate from the HTF, then certify: γ with unit-circle multipliers is a
+    # lower bound (so is sup σ(D)), γ without them an upper bound
+    gc, freq = _htf_peak(sys)
     values = _cached_values(sys)
     # steps short for the Hamiltonian near the norm (h ‖H_γ‖ <= 1)
-    grid = step_grid(_hamiltonian(sys, lo * (1 + 1e-3), values), [sys.B, sys.C, sys.D],
-                     nsteps)
-    hi = lo * (1 + max(tol, 1e-3))
-    freq = np.inf
-    # certified bracket: lo has unit-circle multipliers (or lo <= sup σ(D)),
-    # hi has none
-    while True:
-        angles = _unit_circle_angles(sys, hi, grid, values)
-        if angles is None:
-            break
-        lo, freq = hi, _peak(angles, T)
-        hi *= 2
-    while lo > dmax:
-        angles = _unit_circle_angles(sys, lo, grid, values)
-        if angles is not None:
-            freq = _peak(angles, T)
-            break
-        hi, lo = lo, max(lo / 2, dmax)
-    # candidate from the HTF maximised near the peak frequency; kept only when
-    # the Hamiltonian certifies it (usually two tests instead of a bisection)
-    if np.isfinite(freq) and hi - lo > tol * hi:
-        gc = _htf_local_peak(sys, freq)
-        up, down = gc * (1 + tol / 4), gc * (1 - tol / 4)
-        if lo < up < hi and _unit_circle_angles(sys, up, grid, values) is None:
-            hi = up
-        if lo < down < hi:
-            angles = _unit_circle_angles(sys, down, grid, values)
-            if angles is not None:
-                lo, freq = down, _peak(angles, T)
-    while hi - lo > tol * hi:
-        mid = 0.5 * (lo + hi)
-        angles = _unit_circle_angles(sys, mid, grid, values)
-        if angles is None:
-            hi = mid
+    guess = max(gc, dmax * (1 + 1e-3), 1e-300)
+    grid = step_grid(_hamiltonian(sys, guess, values), [sys.B, sys.C, sys.D], nsteps)
+
+    def lower(gamma):
+        # True (and the peak frequency) when γ is below the norm
+        angles = _unit_circle_angles(sys, gamma, grid, values)
+        return (False, None) if angles is None else (True, _peak(angles, T))
+
+    lo, hi = dmax, np.inf
+    for g in (gc * (1 + tol / 4), gc * (1 - tol / 4)):
+        if lo < g < hi:
+            below, w = lower(g)
+            if below:
+                lo, freq = g, w
+            else:
+                hi = g
+    step = 1e-3
+    while not np.isfinite(hi):                   # grow an upper bound
+        g = max(lo, gc) * (1 + step)
+        below, w = lower(g)
+        if below:
+            lo, freq = g, w
         else:
-            lo, freq = mid, _peak(angles, T)
+            hi = g
+        step *= 4
+    step = 1e-3
+    while lo == dmax and hi * (1 - step) > dmax:  # certify a lower bound
+        g = hi * (1 - step)
+        below, w = lower(g)
+        if below:
+            lo, freq = g, w
+        else:
+            hi = g
+        step = min(4 * step, 0.5)
+    while hi - lo > tol * hi:                     # bisection
+        mid = 0.5 * (lo + hi)
+        below, w = lower(mid)
+        if below:
+            lo, freq = mid, w
+        else:
+            hi = mid
     return hi, freq
 
 
-def _htf_local_peak(sys, freq):
-    """Maximum of σ_max of the HTF (8 harmonics) near ``freq``."""
+def _htf_peak(sys):
+    """Largest σ_max of the HTF (4 harmonics) over ω ∈ [0, ω_p/2] and its ω."""
     from scipy.optimize import minimize_scalar
     from ._htf import htf
+    w = sys.omega_p
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')
-        H = htf(sys, 8)
-        w = sys.omega_p
-        sigma = lambda x: -np.linalg.norm(H(1j * x), ord=2)
-        a, b = max(freq - w / 16, 0.0), min(freq + w / 16, w / 2)
+        H = htf(sys, 4)
+        sigma = lambda x: np.linalg.norm(H(1j * np.atleast_1d(x)), ord=2, axis=(1, 2))
+        grid = np.linspace(0.0, w / 2, 257)
         try:
-            res = minimize_scalar(sigma, bounds=(a, b), method='bounded',
-                                  options={'xatol': 1e-10 * w})
-        except ValueError:
-            return 0.0
-    return float(-res.fun)
-
-
-def _htf_lower_bound(sys):
-    """σ_max of a small HTF on a coarse grid of ω ∈ [0, ω_p/2]."""
-    from ._htf import htf
-    with warnings.catch_warnings():
-        warnings.simplefilter('ignore')
-        H = htf(sys, 2)
-        w = sys.omega_p * np.linspace(0.0, 0.5, 33)
-        # keep off the imaginary-axis poles of a marginal system
-        try:
-            vals = H(1j * w)
-        except ValueError:
-            return 0.0
-    return float(np.linalg.norm(vals, ord=2, axis=(1, 2)).max())
+            vals = sigma(grid)
+        except ValueError:                       # a pole on the imaginary axis
+            return 0.0, np.nan
+        k = int(np.argmax(vals))
+        a, b = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
+        res = minimize_scalar(lambda x: -sigma(x)[0], bounds=(a, b), method='bounded',
+                              options={'xatol': 1e-12 * w})
+    if -res.fun > vals[k]:
+        return float(-res.fun), float(res.x)
+    return float(vals[k]), float(grid[k])
 
 
 def _cached_values(sys):
@@ -326,8 +321,8 @@ def _unit_circle_angles(sys, gamma, grid, values):
     from ._floquet import _log_multipliers
     H = _hamiltonian(sys, gamma, values)
     zero = PeriodicMatrix.constant(np.zeros((H.shape[0], 0)), sys.period)
-    # the test needs the multipliers' moduli to ~1e-9 only
-    Phi, _, _ = step_transitions(H, zero, grid[:-1], np.diff(grid), rtol=1e-10)
+    # the test needs the multipliers' moduli to well below _UNIT only
+    Phi, _, _ = step_transitions(H, zero, grid[:-1], np.diff(grid), rtol=1e-9)
     logmod, arg = _log_multipliers(None, None, grid=grid, factors=Phi)
     on = np.abs(logmod) < _UNIT
     return arg[on] if np.any(on) else None

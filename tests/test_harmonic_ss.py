@@ -14,8 +14,8 @@ from systems import mathieu, switching_mathieu
 def test_harmonic_ss_response_is_the_htf(make):
     sys = make()
     K = 2
-    H = ltp.htf(sys, K)
-    Hs = ltp.harmonic_ss(sys, K)
+    H = ltp.htf(sys, K, internal_harmonics=30)
+    Hs = ltp.harmonic_ss(sys, K, internal_harmonics=30)
     V, _ = _real_basis(np.arange(-K, K + 1), 2 * K + 2)
     Vu, Vy = np.kron(V, np.eye(sys.ninputs)), np.kron(V, np.eye(sys.noutputs))
     for s in (0.3j, 1.7j, 0.2 + 5j):
