@@ -202,11 +202,13 @@ def gram(sys, type):
 # Shared solvers (also used by the norms)
 #
 
-def cyclic_lyap(Phi, W, adjoint=False):
+def cyclic_lyap(Phi, W, adjoint=False, check=True):
     """Solve the cyclic periodic discrete Lyapunov equation (module notes).
 
     ``X_{k+1} = Φ_k X_k Φ_kᵀ + W_k`` (forward) or ``X_k = Φ_kᵀ X_{k+1}
     Φ_k + W_k`` (adjoint), k = 0..M−1 cyclic; returns ``X_0..X_{M−1}``.
+    ``check=False`` skips the uniqueness test (for callers that know the
+    factors are stable).
 
     Examples
     --------
@@ -218,7 +220,8 @@ def cyclic_lyap(Phi, W, adjoint=False):
     M, n = Phi.shape[0], Phi.shape[1]
     if n == 0:
         return np.zeros((M, 0, 0))
-    check_unique(Phi)
+    if check:
+        check_unique(Phi)
     nn = n * n
     K = np.einsum('kia,kjb->kijab', Phi, Phi).reshape(M, nn, nn)   # Φ ⊗ Φ
     if adjoint:

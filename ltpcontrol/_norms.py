@@ -106,18 +106,14 @@ def norm(sys, p=2, tol=1e-6, print_warning=True, *, return_frequency=False,
         raise ValueError(f"tol must be a number in (0, 1), got {tol!r}")
     if return_frequency and p != 'inf':
         raise ValueError("return_frequency applies to p='inf' only")
-    stable = sys.is_stable()
     if p == 'inf':
-        if not stable:
+        if not sys.is_stable():
             if print_warning:
                 warnings.warn("System is unstable!", UserWarning, stacklevel=2)
             return (float('inf'), np.nan) if return_frequency else float('inf')
         value, freq = (_linf_discrete(sys, tol) if sys.isdtime()
                        else _linf_continuous(sys, tol, nsteps))
         return (value, freq) if return_frequency else value
-    if not stable:
-        raise ValueError(f"norm(p={p!r}): the system is unstable; the "
-                         f"{'H2' if p == 2 else 'Hankel'} norm needs a stable system")
     if p == 2:
         return _h2(sys, nsteps, print_warning)
     return _hankel(sys, nsteps)
@@ -131,11 +127,15 @@ def _h2(sys, nsteps, print_warning):
     if sys.isdtime():
         N = sys.nsteps
         A, B, C, D = (M.sample(N) for M in (sys.A, sys.B, sys.C, sys.D))
-        Xo = cyclic_lyap(A, np.swapaxes(C, 1, 2) @ C, adjoint=True)
+        _require_stable(A, 2)
+        Xo = cyclic_lyap(A, np.swapaxes(C, 1, 2) @ C, adjoint=True, check=False)
         Bt = np.swapaxes(B, 1, 2)
         total = np.einsum('kij,kji->', Bt @ np.roll(Xo, -1, axis=0), B) + np.sum(D * D)
         return float(np.sqrt(max(total, 0.0) / N))
-    if _has_feedthrough(sys):
+    if sys.nstates and _has_feedthrough(sys):
+        if not sys.is_stable():
+            raise ValueError("norm(p=2): the system is unstable; the H2 norm needs a "
+                             "stable system")
         if print_warning:
             warnings.warn("System has a direct feedthrough term!", UserWarning, stacklevel=3)
         return float('inf')
@@ -144,9 +144,19 @@ def _h2(sys, nsteps, print_warning):
     grid = step_grid(sys.A, [sys.B, sys.C], nsteps)
     Phi, W, V, S = step_integrals(sys.A, grid[:-1], np.diff(grid),
                                   Qf=sys.B @ sys.B.T, Qa=sys.C.T @ sys.C)
-    Xo = cyclic_lyap(Phi, V, adjoint=True)
+    _require_stable(Phi, 2)
+    Xo = cyclic_lyap(Phi, V, adjoint=True, check=False)
     total = np.einsum('kij,kji->', np.roll(Xo, -1, axis=0), W) + S.sum()
     return float(np.sqrt(max(total, 0.0) / sys.period))
+
+
+def _require_stable(Phi, p):
+    """Raise unless every multiplier of ``Φ_{M-1} ... Φ_0`` has ``|μ| < 1 - 1e-10``."""
+    from ._floquet import _log_multipliers
+    logmod, _ = _log_multipliers(None, None, grid=None, factors=Phi)
+    if logmod.size and logmod.max() >= np.log1p(-1e-10):
+        raise ValueError(f"norm(p={p!r}): the system is unstable; the "
+                         f"{'H2' if p == 2 else 'Hankel'} norm needs a stable system")
 
 
 def _has_feedthrough(sys):
@@ -167,14 +177,16 @@ def _hankel(sys, nsteps):
     if sys.isdtime():
         N = sys.nsteps
         A, B, C = (M.sample(N) for M in (sys.A, sys.B, sys.C))
-        P = cyclic_lyap(A, B @ np.swapaxes(B, 1, 2))
-        Q = cyclic_lyap(A, np.swapaxes(C, 1, 2) @ C, adjoint=True)
+        _require_stable(A, 'hankel')
+        P = cyclic_lyap(A, B @ np.swapaxes(B, 1, 2), check=False)
+        Q = cyclic_lyap(A, np.swapaxes(C, 1, 2) @ C, adjoint=True, check=False)
         return float(np.sqrt(max(_lam_max(P, Q).max(), 0.0)))
     A, T = sys.A, sys.period
     Qf, Qa = sys.B @ sys.B.T, sys.C.T @ sys.C
     grid = step_grid(A, [sys.B, sys.C], nsteps)
     Phi, W, V, _ = step_integrals(A, grid[:-1], np.diff(grid), Qf=Qf, Qa=Qa)
-    Pk, Qk = cyclic_lyap(Phi, W), cyclic_lyap(Phi, V, adjoint=True)
+    _require_stable(Phi, 'hankel')
+    Pk, Qk = cyclic_lyap(Phi, W, check=False), cyclic_lyap(Phi, V, adjoint=True, check=False)
     P = periodic_solution(A, Qf, grid, Pk, False)
     Q = periodic_solution(A, Qa, grid, Qk, True)
     values = _lam_max(Pk, Qk)
@@ -262,12 +274,15 @@ def _linf_continuous(sys, tol, nsteps):
 def _htf_peak(sys):
     """Largest σ_max of the HTF (4 harmonics) over ω ∈ [0, ω_p/2] and its ω."""
     from scipy.optimize import minimize_scalar
-    from ._htf import htf
+    from ._htf import _HarmonicStateSpace, _internal_order
     w = sys.omega_p
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')
-        H = htf(sys, 4)
-        sigma = lambda x: np.linalg.norm(H(1j * np.atleast_1d(x)), ord=2, axis=(1, 2))
+        # the harmonic state space of htf(sys, 4), without its checks (the
+        # estimate needs no accuracy guarantee: the Hamiltonian certifies)
+        H = _HarmonicStateSpace.continuous(sys, 4, _internal_order(sys, 4, None), 'auto')
+        sigma = lambda x: np.linalg.norm(H.evaluate(1j * np.atleast_1d(x)), ord=2,
+                                         axis=(1, 2))
         grid = np.linspace(0.0, w / 2, 257)
         try:
             vals = sigma(grid)
