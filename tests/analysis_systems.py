@@ -54,3 +54,19 @@ def stable_rss(n, p, m, seed, dt=0, strictly_proper=False):
         B, C = rng.standard_normal((n, m)), rng.standard_normal((p, n))
         D = np.zeros((p, m)) if strictly_proper else rng.standard_normal((p, m))
         return ct.ss(A, B, C, D, dt)
+
+
+def zhou_hagiwara_A():
+    """A(t) of Zhou & Hagiwara (2002) and Cantoni & Sandberg (2009), T = π.
+
+    Floquet exponents -1 and -2 (vectorised callable).
+    """
+    def A(t):
+        scalar, t = np.ndim(t) == 0, np.atleast_1d(t)
+        out = np.empty((len(t), 2, 2))
+        out[:, 0, 0] = -1 - np.sin(2 * t) ** 2
+        out[:, 0, 1] = 2 - 0.5 * np.sin(4 * t)
+        out[:, 1, 0] = -2 - 0.5 * np.sin(4 * t)
+        out[:, 1, 1] = -1 - np.cos(2 * t) ** 2
+        return out[0] if scalar else out
+    return ltp.PeriodicMatrix.from_function(A, np.pi)

@@ -7,22 +7,12 @@ import pytest
 import control as ct
 
 import ltpcontrol as ltp
-from analysis_systems import stable_rss, transformed
+from analysis_systems import stable_rss, transformed, zhou_hagiwara_A
 
 
 def cantoni_sandberg():
     """Cantoni & Sandberg (Automatica 2009) example, T = π; L∞ = 1.7639."""
-    def A(t):
-        t = np.atleast_1d(t)
-        out = np.empty((len(t), 2, 2))
-        out[:, 0, 0] = -1 - np.sin(2 * t) ** 2
-        out[:, 0, 1] = 2 - 0.5 * np.sin(4 * t)
-        out[:, 1, 0] = -2 - 0.5 * np.sin(4 * t)
-        out[:, 1, 1] = -1 - np.cos(2 * t) ** 2
-        return out
-    Ap = ltp.PeriodicMatrix.from_function(lambda t: A(t)[0] if np.ndim(t) == 0 else A(t),
-                                          np.pi)
-    return ltp.ltpss(Ap, [[0.0], [1.0]], [[1.0, 1.0]], [[1.0]], period=np.pi)
+    return ltp.ltpss(zhou_hagiwara_A(), [[0.0], [1.0]], [[1.0, 1.0]], [[1.0]], period=np.pi)
 
 
 @pytest.mark.parametrize('T', [0.5, 3.0])

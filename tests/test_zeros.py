@@ -6,21 +6,7 @@ import control as ct
 from control.exception import ControlDimension
 
 import ltpcontrol as ltp
-from analysis_systems import stable_rss, transformed
-
-
-def _zhou_A():
-    # Zhou & Hagiwara (Automatica 2002; SCL 2002), T = π, exponents -1, -2
-    def A(t):
-        t = np.atleast_1d(t)
-        out = np.empty((len(t), 2, 2))
-        out[:, 0, 0] = -1 - np.sin(2 * t) ** 2
-        out[:, 0, 1] = 2 - 0.5 * np.sin(4 * t)
-        out[:, 1, 0] = -2 - 0.5 * np.sin(4 * t)
-        out[:, 1, 1] = -1 - np.cos(2 * t) ** 2
-        return out
-    return ltp.PeriodicMatrix.from_function(lambda t: A(t)[0] if np.ndim(t) == 0 else A(t),
-                                            np.pi)
+from analysis_systems import stable_rss, transformed, zhou_hagiwara_A
 
 
 def _match(z, ref, tol):
@@ -77,7 +63,7 @@ def test_zeros_zhou_hagiwara_switching_input(beta):
     first = ltp.PeriodicMatrix([[[0], [-1j * beta]], [[0], [1]], [[0], [1j * beta]]], T)
     B = ltp.PeriodicMatrix.switching([first, [[0.0], [1.0]]], [0, T / 2], T)
     assert np.allclose(B(0.3), [[0], [1 - 2 * beta * np.sin(0.6)]])
-    z = ltp.zeros(ltp.ltpss(_zhou_A(), B, [[1, 1]], 0, period=T))
+    z = ltp.zeros(ltp.ltpss(zhou_hagiwara_A(), B, [[1, 1]], 0, period=T))
     assert _match(z, [-3.5], 1e-8)
 
 
@@ -85,7 +71,7 @@ def test_zeros_zhou_tac2009():
     # b(t) = [0; 1 - 2β cos 2t], β = 0.5, c = [0 1]: published zero -1.5
     T = np.pi
     B = ltp.PeriodicMatrix([[[0], [-0.5]], [[0], [1]], [[0], [-0.5]]], T)
-    z = ltp.zeros(ltp.ltpss(_zhou_A(), B, [[0, 1]], 0, period=T))
+    z = ltp.zeros(ltp.ltpss(zhou_hagiwara_A(), B, [[0, 1]], 0, period=T))
     assert _match(z, [-1.5], 1e-8)
 
 
