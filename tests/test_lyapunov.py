@@ -79,9 +79,9 @@ def test_lyap_dlyap_lti_equal_python_control():
             assert np.abs(X - ref).max() <= 1e-9 * np.abs(ref).max()
 
 
-@pytest.mark.parametrize('T', [1.0, 3.0])
-def test_gram_lyapunov_transformed(T):
-    G = stable_rss(3, 1, 2, seed=7, strictly_proper=True)
+@pytest.mark.parametrize('T, seed', [(1.0, 7), (3.0, 8), (0.4, 9)])
+def test_gram_lyapunov_transformed(T, seed):
+    G = stable_rss(3, 1, 2, seed=seed, strictly_proper=True)
     sys, P = transformed(G, T)
     ts = RNG.uniform(0, T, 4)
     Pc, Po = ltp.gram(sys, 'c'), ltp.gram(sys, 'o')

@@ -127,3 +127,29 @@ def test_norm_bad_input():
         ltp.norm(stable, 2, return_frequency=True)
     with pytest.raises(TypeError, match="LTPStateSpace"):
         ltp.norm(ct.tf([1], [1, 1]), 2)
+
+
+@pytest.mark.parametrize('N', [3, 4])
+def test_norms_periodic_discrete_against_brute_force(N):
+    rng = np.random.default_rng(40 + N)
+    A = 0.45 * rng.standard_normal((N, 3, 3))
+    B, C = rng.standard_normal((N, 3, 2)), rng.standard_normal((N, 2, 3))
+    D = rng.standard_normal((N, 2, 2))
+    sys = ltp.ltpss(A, B, C, D, period=0.1 * N, dt=0.1)
+    # H2: impulse-response energy from every start step, averaged over the period
+    total = 0.0
+    for k in range(N):
+        total += np.sum(D[k] ** 2)
+        X = B[k]
+        for j in range(k + 1, k + 400):
+            total += np.sum((C[j % N] @ X) ** 2)
+            X = A[j % N] @ X
+    assert abs(ltp.norm(sys, 2) - np.sqrt(total / N)) <= 1e-9 * np.sqrt(total / N)
+    # L∞: the lifted frequency response on a fine grid stays below the norm
+    L = ltp.lift(sys, method='time')
+    w = np.linspace(0, np.pi / L.dt, 4001)
+    sig = np.linalg.norm(np.moveaxis(L.frequency_response(w).complex, -1, 0), ord=2,
+                         axis=(1, 2))
+    value = ltp.norm(sys, 'inf', tol=1e-10)
+    assert sig.max() <= value * (1 + 1e-9)
+    assert sig.max() >= value * (1 - 1e-3)

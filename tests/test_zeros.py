@@ -39,8 +39,9 @@ def test_zeros_lti_discrete(N):
     assert _match(z ** N, ref ** N, 1e-9)
 
 
-def test_zeros_lyapunov_transformed():
-    G = stable_rss(3, 1, 1, seed=4)
+@pytest.mark.parametrize('seed', [4, 6])
+def test_zeros_lyapunov_transformed(seed):
+    G = stable_rss(3, 1, 1, seed=seed)
     sys, _ = transformed(G, 1.0)
     assert _match(ltp.zeros(sys), ct.zeros(G), 1e-9)
 
