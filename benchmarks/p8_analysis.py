@@ -1,8 +1,8 @@
-"""P6: system norms of a continuous-time LTP system.
+"""P8: system norms of a continuous-time LTP system.
 
 Workloads, both on damped Mathieu-type plants (thesis eq. 4.24, T = 0.5 s):
 
-* P6a, L∞ to 1e-6 (ω_n = 0.74π, ζ = 0.05, β = 0.3: a sharp resonance
+* P8a, L∞ to 1e-6 (ω_n = 0.74π, ζ = 0.05, β = 0.3: a sharp resonance
   peak inside [0, ω_p/2]).  Ours: ``ltp.norm(sys, 'inf', tol=1e-6)`` (HTF
   estimate certified by the unit-circle Floquet multipliers of the periodic
   Hamiltonian).  Peer: what a user does without it, the sup of σ_max of
@@ -10,7 +10,7 @@ Workloads, both on damped Mathieu-type plants (thesis eq. 4.24, T = 0.5 s):
   doubled from 1000 points, then K doubled) until two successive values
   agree to 1e-7; the peer time is the whole refinement.  Reference:
   ``ltp.norm(sys, 'inf', tol=1e-12)``, checked against the finest grid value.
-* P6b, H2 (constant A, input matrix switching between [0; 1] and [0; 0.2] at
+* P8b, H2 (constant A, input matrix switching between [0; 1] and [0; 0.2] at
   T/2).  Ours: ``ltp.norm(sys, 2)`` (periodic Lyapunov equation).  Peer:
   quadrature of ``(1/π) ∫_0^∞ Σ_k ‖G_k(jω)‖_F² dω`` over the HTF components
   (``ω = ω_n tan θ``, 800 midpoints in θ, converged to 1e-6 in ω), with K
@@ -97,7 +97,7 @@ def run(quick=False, log=print):
     rows = []
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')
-        log("P6a: L-infinity norm, certified vs HTF grid sup")
+        log("P8a: L-infinity norm, certified vs HTF grid sup")
         sys = linf_plant()
         ref = ltp.norm(sys, 'inf', tol=1e-12)
         t_ours, times, val = median_time(lambda: ltp.norm(sys, 'inf', tol=TOL_INF),
@@ -106,7 +106,7 @@ def run(quick=False, log=print):
         fine = grid_sup(sys, 8, 256000) if not quick else pval
         err_ours, err_peer = abs(val - ref) / ref, abs(pval - ref) / ref
         rows.append(row(
-            'P6a', 'L-inf norm of a damped Mathieu plant to 1e-6',
+            'P8a', 'L-inf norm of a damped Mathieu plant to 1e-6',
             ours='ltp.norm(sys, "inf", tol=1e-6)',
             peer='sup sigma_max of ltp.htf on a uniform grid, refined to agreement',
             t_ours=t_ours, t_peer=t_peer, err_ours=err_ours, err_peer=err_peer,
@@ -117,7 +117,7 @@ def run(quick=False, log=print):
             notes=f'peer stopped at K={K}, {M} frequencies',
             extra=dict(ours_times=times, reference=ref, finest_grid=fine)))
 
-        log("P6b: H2 norm, periodic Lyapunov vs HTF quadrature")
+        log("P8b: H2 norm, periodic Lyapunov vs HTF quadrature")
         sys = h2_plant()
         t_ours, times, h2 = median_time(lambda: ltp.norm(sys, 2), cfg['repeats'])
         check = h2_by_controllability(sys)
@@ -133,7 +133,7 @@ def run(quick=False, log=print):
         if t_peer is None:
             t_peer, err_hit = t, errs[-1]
         rows.append(row(
-            'P6b', 'H2 norm of a switching-input plant to 1e-3',
+            'P8b', 'H2 norm of a switching-input plant to 1e-3',
             ours='ltp.norm(sys, 2) (periodic Lyapunov)',
             peer='HTF quadrature (1/pi) int sum_k |G_k(jw)|^2, K doubled',
             t_ours=t_ours, t_peer=t_peer, err_ours=abs(check - h2) / h2, err_peer=err_hit,
