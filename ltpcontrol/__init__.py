@@ -29,6 +29,10 @@ from ._hybrid_ls import hybrid_ls, HybridLSResult
 from ._realization import floquet_realization, FloquetRealization
 from ._canonical import to_canonical, matrix_errors, MatrixErrors
 from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
+from ._lyapunov import lyap, dlyap, gram
+from ._norms import norm
+from ._zeros import zeros
+from ._harmonic_ss import harmonic_ss
 from ._riccati import care, dare
 from ._design import lqr, dlqr, lqe, dlqe, lqg
 from ._place import place
@@ -61,6 +65,8 @@ __all__ = [
     'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
+    # analysis: Lyapunov equations, gramians, zeros, norms
+    'lyap', 'dlyap', 'gram', 'norm', 'zeros', 'harmonic_ss',
     # control design
     'care', 'dare', 'lqr', 'dlqr', 'lqe', 'dlqe', 'lqg', 'place',
     'lmi_statefbk', 'LMIDesign',
