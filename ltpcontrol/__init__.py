@@ -37,6 +37,7 @@ from ._riccati import care, dare
 from ._design import lqr, dlqr, lqe, dlqe, lqg
 from ._place import place
 from ._lmi import lmi_statefbk, LMIDesign
+from ._reduction import hsvd, balred, minreal
 
 __version__ = "0.1.0"
 
@@ -69,5 +70,5 @@ __all__ = [
     'lyap', 'dlyap', 'gram', 'norm', 'zeros', 'harmonic_ss',
     # control design
     'care', 'dare', 'lqr', 'dlqr', 'lqe', 'dlqe', 'lqg', 'place',
-    'lmi_statefbk', 'LMIDesign',
+    'lmi_statefbk', 'LMIDesign', 'hsvd', 'balred', 'minreal',
 ]

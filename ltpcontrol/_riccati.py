@@ -52,8 +52,9 @@ from control.exception import ControlArgument, ControlDimension
 
 from ._floquet import _log_multipliers, chebyshev_nodes, piecewise_chebyshev
 from ._periodic_matrix import PeriodicMatrix, as_periodic
+from ._steps import step_grid
 from ._transition import step_transitions
-from ._validation import check_positive_int, real_array
+from ._validation import real_array
 
 __all__ = ['care', 'dare']
 
@@ -410,19 +411,13 @@ def _check_weights(Q, R, qname, rname):
 
 
 def _grid(H, period, breaks, nsteps):
+    """Step grid of `_steps.step_grid`, by default ``ceil(T max‖H‖)`` steps
+    (clipped to [16, 4096]) with the norm estimated from 16 samples."""
     if nsteps is None:
         probe = np.concatenate([np.arange(16) * period / 16, breaks])
         norm = np.max(np.linalg.norm(H(probe), ord=2, axis=(1, 2)), initial=0.0)
         nsteps = int(np.clip(np.ceil(period * norm), 16, 4096))
-    else:
-        nsteps = check_positive_int(nsteps, 'nsteps')
-    grid = np.union1d(np.linspace(0, period, nsteps + 1), breaks)
-    keep = np.concatenate([[True], np.diff(grid) > 1e-9 * period / nsteps])
-    keep[-1] = True
-    grid = grid[keep]
-    grid = grid[np.concatenate([np.diff(grid) > 0, [True]])]
-    grid[-1] = period
-    return grid
+    return step_grid(H, nsteps=nsteps)
 
 
 def _period_of(args, period):

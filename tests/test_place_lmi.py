@@ -4,7 +4,7 @@ Truths: the closed-loop multipliers recomputed from the gains (periodic
 Schur form via feedback), python-control's place in the LTI limit, the
 periodic LQR (H2 case), and closed-loop norms computed independently from
 the time-lifted LTI system (python-control/SLICOT and a discrete Lyapunov
-equation).
+equation), cross-checked with `ltp.norm`.
 """
 
 import numpy as np
@@ -96,15 +96,19 @@ def test_place_errors_name_the_problem():
 # LMI design
 #
 
-def _lifted_hinf(sysd, K, Q, R):
-    """ℓ2 gain w -> z = [Q^½ x; R^½ u] of the closed loop, G = I (time lifting)."""
+def _closed_loop(sysd, K, Q, R):
+    """Closed loop w -> z = [Q^½ x; R^½ u] with G = I."""
     N = sysd.nsteps
     A, B = sysd.A.sample(N), sysd.B.sample(N)
     Kk = K.sample(N)
     n = A.shape[1]
     C = np.concatenate([np.broadcast_to(sla.sqrtm(Q), (N, n, n)), -sla.sqrtm(R) @ Kk], axis=1)
-    cl = ltp.ltpss(A - B @ Kk, np.eye(n), C, 0, period=sysd.period, dt=sysd.dt)
-    return ct.norm(ltp.lift(cl, method='time'), 'inf')
+    return ltp.ltpss(A - B @ Kk, np.eye(n), C, 0, period=sysd.period, dt=sysd.dt)
+
+
+def _lifted_hinf(sysd, K, Q, R):
+    """ℓ2 gain of the closed loop from its time-lifted LTI equivalent."""
+    return ct.norm(ltp.lift(_closed_loop(sysd, K, Q, R), method='time'), 'inf')
 
 
 def _h2(sysd, K, Q, R):
@@ -135,6 +139,7 @@ def test_lmi_h2_matches_dlqr(N):
     K, X, _ = ltp.dlqr(sysd, Q, R)
     optimal = np.sqrt(np.mean(np.trace(X.sample(N), axis1=1, axis2=2)))
     achieved = _h2(sysd, res.K, Q, R)
+    assert abs(ltp.norm(_closed_loop(sysd, res.K, Q, R), 2) - achieved) < 1e-9 * achieved
     assert achieved <= res.bound * (1 + 1e-7)
     assert abs(res.bound - optimal) < 1e-6 * optimal
     assert abs(achieved - optimal) < 1e-6 * optimal
@@ -149,6 +154,7 @@ def test_lmi_hinf_bound_is_the_achieved_norm():
     res = ltp.lmi_statefbk(sysd, Q, R, objective='hinf')
     assert res.status == 'optimal'
     achieved = _lifted_hinf(sysd, res.K, Q, R)
+    assert abs(ltp.norm(_closed_loop(sysd, res.K, Q, R), 'inf') - achieved) < 1e-6 * achieved
     assert achieved <= res.bound * (1 + 1e-6)
     assert achieved >= res.bound * (1 - 1e-4)
     # no worse than the H2-optimal gain in the H∞ sense
