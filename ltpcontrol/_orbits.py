@@ -59,7 +59,18 @@ class PeriodicOrbit:
     multipliers : ndarray
         Eigenvalues of `monodromy` (Floquet multipliers).
     is_stable : bool
-        True when all multipliers lie strictly inside the unit circle.
+        True when all `stability_multipliers` lie strictly inside the unit
+        circle.
+    autonomous : bool
+        True for an orbit of an autonomous plant (`limit_cycle`), whose
+        period is an unknown and whose monodromy has the multiplier 1 along
+        the flow.
+    phase_multiplier : float or None
+        Autonomous orbits: the multiplier of the phase direction (1 up to
+        the residual); None otherwise.
+    stability_multipliers : ndarray
+        The multipliers that decide (orbital) stability: all of them for a
+        forced plant, all but the phase multiplier for an autonomous one.
     residual : float
         Final relative residual ``‖P(x0) − x0‖∞ / (1 + ‖x0‖∞)``.
     iterations : int
@@ -89,7 +100,7 @@ class PeriodicOrbit:
     """
 
     def __init__(self, plant, period, flow, x0, mode0, npoints, params, u0,
-                 residual, iterations, periods):
+                 residual, iterations, periods, phase_direction=None):
         self.plant, self.period, self._flow = plant, period, flow
         self.x0, self.mode0, self.params, self.u0 = np.array(x0), mode0, params, u0
         self.time = np.arange(npoints) * period / npoints
@@ -99,7 +110,13 @@ class PeriodicOrbit:
         self.saltation_matrices = list(flow.saltations)
         self.monodromy = flow.phi
         self.multipliers = np.linalg.eigvals(self.monodromy)
-        self.is_stable = bool(np.all(np.abs(self.multipliers) < 1))
+        self.autonomous = phase_direction is not None
+        self.phase_multiplier, self.stability_multipliers = None, self.multipliers
+        if self.autonomous:
+            k = _phase_index(self.monodromy, self.multipliers, phase_direction)
+            self.phase_multiplier = float(self.multipliers[k].real)
+            self.stability_multipliers = np.delete(self.multipliers, k)
+        self.is_stable = bool(np.all(np.abs(self.stability_multipliers) < 1))
         self.residual, self.iterations, self.periods_simulated = residual, iterations, periods
 
     def __call__(self, t):
@@ -109,8 +126,25 @@ class PeriodicOrbit:
 
     def __repr__(self):
         mags = ', '.join(f'{abs(m):.4g}' for m in self.multipliers)
-        return (f"<PeriodicOrbit period={self.period:g}, {len(self.switching_times)} events, "
+        kind = "autonomous, " if self.autonomous else ""
+        return (f"<PeriodicOrbit {kind}period={self.period:g}, {len(self.switching_times)} events, "
                 f"|multipliers|=[{mags}], stable={self.is_stable}>")
+
+
+def _phase_index(monodromy, multipliers, direction):
+    """Index of the multiplier whose eigenvector is the flow direction.
+
+    ``Φ f(x̄(0)) = f(x̄(0))``: among the multipliers near 1 take the one whose
+    eigenvector is best aligned with the vector field (several multipliers
+    equal 1 when the plant conserves a quantity, e.g. energy).
+    """
+    near = np.flatnonzero(np.abs(multipliers - 1) < 1e-3)
+    if near.size <= 1:
+        return int(np.argmin(np.abs(multipliers - 1)))
+    _, vecs = np.linalg.eig(monodromy)
+    unit = direction / np.linalg.norm(direction)
+    align = np.abs(vecs[:, near].conj().T @ unit) / np.linalg.norm(vecs[:, near], axis=0)
+    return int(near[np.argmax(align)])
 
 
 def _as_hybrid(plant, jacobian):
