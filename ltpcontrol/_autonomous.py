@@ -34,10 +34,13 @@ __all__ = ['limit_cycle', 'poincare_map']
 
 
 class _Section:
-    """Poincaré section ``s(x) = 0`` crossed in `direction` while in `mode`."""
+    """Poincaré section ``s(x) = 0`` crossed in `direction` while in `mode`.
 
-    def __init__(self, func, direction, mode):
-        self.func, self.direction, self.mode = func, direction, mode
+    `user` is the callable the user gave (None for the default hyperplane).
+    """
+
+    def __init__(self, func, direction, mode, user):
+        self.func, self.direction, self.mode, self.user = func, direction, mode, user
 
     def __call__(self, x):
         value = np.asarray(self.func(x), float)
@@ -59,10 +62,10 @@ def _section(hp, section, direction, mode, anchor, u0, params):
             raise ValueError("x0 is an equilibrium of the plant (f(x0) = 0): it lies on no "
                              "periodic orbit and defines no section; start elsewhere")
         normal = normal / np.linalg.norm(normal)
-        return _Section(lambda x: normal @ (np.asarray(x) - anchor), 1, mode)
+        return _Section(lambda x: normal @ (np.asarray(x) - anchor), 1, mode, None)
     if not callable(section):
         raise ControlArgument(f"section must be callable, got {type(section).__name__}")
-    return _Section(section, direction, mode)
+    return _Section(section, direction, mode, section)
 
 
 def _check_autonomous(hp, x0, u0, params):
@@ -101,12 +104,22 @@ class _Problem:
     def f(self, mode, x):
         return self.hp._f(mode, 0.0, x, self.u0, self.params)
 
-    def first_crossing(self, x, mode, section, max_time, chunk, skip=0.0):
-        """Time of the first crossing of `section` after `skip`, or None before `max_time`."""
+    def first_crossing(self, x, mode, section, max_time, chunk=None, skip=0.0):
+        """Time of the first crossing of `section` after `skip`, or None before `max_time`.
+
+        Integrates in chunks of length `chunk` (growing from the flow's time
+        scale when None) and checks the sign of the section at the solver's
+        steps, as `solve_ivp` does for events.
+        """
+        growing = chunk is None
         t0 = 0.0
         scale = 1e3 * (1 + np.max(np.abs(x)))
+        if chunk is None:
+            # time scale |x| / |f(x)|, doubled after each chunk without a crossing
+            chunk = (1 + np.max(np.abs(x))) / max(np.max(np.abs(self.f(mode, x))), 1e-300)
         while t0 < max_time:
             duration = min(chunk, max_time - t0)
+            chunk = 2 * chunk if growing else chunk
             fl = self.flow(x, mode, duration)
             for start, end, seg_mode, sol in fl.segments:
                 if seg_mode != section.mode or end <= start:
@@ -199,7 +212,7 @@ def poincare_map(plant, x0, section=None, mode0=0, *, direction=1, max_time=None
     max_time = 1000.0 if max_time is None else check_period(max_time, 'max_time')
     sec = _section(hp, section, direction, mode0, x0, u0, params)
     prob = _Problem(hp, u0, params, opts, None)
-    t_cross = prob.first_crossing(x0, mode0, sec, max_time, max_time / 20)
+    t_cross = prob.first_crossing(x0, mode0, sec, max_time)
     if t_cross is None:
         raise ValueError(f"the trajectory from x0 does not cross the section within "
                          f"max_time={max_time:g}")
@@ -251,7 +264,8 @@ def limit_cycle(plant, period, x0, mode0=0, *, section=None, direction=1, u0=Non
         Autonomous continuous-time plant: vector fields and guards must not
         depend on t (checked at sample points).
     period : float or None
-        Guess of the period.  None: the first return time to the section.
+        Guess of the period.  The first return time to the section replaces
+        it when within a third of it (None: always).
     x0 : array_like
         Initial guess of a state on (or near) the orbit.  When it is off
         a user-given section, the trajectory from it is first followed to
@@ -364,23 +378,24 @@ def _return(search, sec, x, period, max_periods, what):
 
 def _start_on_section(search, sec, x0, mode0, period, max_periods):
     """A start on the section and a period guess (the first return time if not given)."""
-    horizon = max_periods * period if period is not None else 1000.0
+    horizon = max(max_periods, 2) * period if period is not None else 1000.0
     x = x0
     if abs(sec(x0)) > 1e-12 * (1 + np.max(np.abs(x0))):
-        t = search.first_crossing(x0, mode0, sec, horizon,
-                                  period if period is not None else horizon / 50)
+        t = search.first_crossing(x0, mode0, sec, horizon, period)
         if t is None:
             raise ValueError(f"the trajectory from x0 does not cross the section within "
                              f"t={horizon:g}: the orbit may not cross it, or x0 is in the "
                              "basin of an equilibrium")
         x = search.flow(x0, mode0, t).x_final
+    # the first return time refines the guess, unless the section is crossed
+    # several times per period
+    t = search.first_crossing(x, mode0, sec, horizon, skip=1e-9 * horizon)
     if period is None:
-        t = search.first_crossing(x, mode0, sec, horizon, horizon / 50, skip=1e-9 * horizon)
         if t is None:
             raise ValueError(f"the trajectory does not return to the section within "
                              f"t={horizon:g}: give a period guess, or x0 is not near an orbit")
-        period = t
-    return x, period
+        return x, t
+    return x, t if t is not None and abs(t - period) < period / 3 else period
 
 
 def _shoot(prob, search, sec, x, period, tol, max_iter, max_periods, npoints):
@@ -452,10 +467,12 @@ def _newton(prob, sec, x, T, tol, max_iter, npoints, returns, tried):
         jac[n, :n] = sec.gradient(x)
         # least squares handles further neutral directions (e.g. conserved energy)
         step = np.linalg.lstsq(jac, -np.append(gap, phase), rcond=None)[0]
-        if np.max(np.abs(step[:n])) > 10 * scale or abs(step[n]) > 0.5 * T:
+        if np.max(np.abs(step[:n])) > 10 * scale:
             tried.append(f"{where}: step of size {np.max(np.abs(step[:n])):.3g} "
-                         f"(period step {step[n]:.3g}) rejected (divergence)")
+                         "rejected (divergence)")
             return None
+        # damped step: the period changes by at most half of itself
+        step *= min(1.0, 0.5 * T / max(abs(step[n]), 1e-300))
         x, T = x + step[:n], T + step[n]
     return None  # pragma: no cover - the loop always returns
 
@@ -466,8 +483,8 @@ def _finish(prob, sec, fl, x, T, npoints, res, iterations, returns):
     if sec.direction * (grad @ f0) <= 0:
         raise RuntimeError("limit_cycle converged to an orbit that crosses the section in the "
                            "other direction; use direction=-1 or another section")
-    orbit = PeriodicOrbit(prob.hp, T, fl, x, sec.mode, npoints, prob.params, prob.u0, res,
+    orbit = PeriodicOrbit(prob.hp, float(T), fl, x, sec.mode, npoints, prob.params, prob.u0, res,
                           iterations, returns, phase_direction=f0)
-    orbit.section = sec.func
+    orbit.section = sec
     orbit.poincare_jacobian = fl.phi - np.outer(f0, grad @ fl.phi) / (grad @ f0)
     return orbit

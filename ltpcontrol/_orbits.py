@@ -71,6 +71,13 @@ class PeriodicOrbit:
     stability_multipliers : ndarray
         The multipliers that decide (orbital) stability: all of them for a
         forced plant, all but the phase multiplier for an autonomous one.
+    section : callable or None
+        Autonomous orbits: the Poincaré section ``section(x) = 0`` used as
+        phase condition (``x0`` lies on it); None otherwise.
+    poincare_jacobian : ndarray or None
+        Autonomous orbits: Jacobian ``(I − f ∇sᵀ / (∇s·f)) Φ`` of the
+        return map to the section at ``x0``; its eigenvalues are the
+        stability multipliers and 0 (along the flow).  None otherwise.
     residual : float
         Final relative residual ``‖P(x0) − x0‖∞ / (1 + ‖x0‖∞)``.
     iterations : int
@@ -112,6 +119,7 @@ class PeriodicOrbit:
         self.multipliers = np.linalg.eigvals(self.monodromy)
         self.autonomous = phase_direction is not None
         self.phase_multiplier, self.stability_multipliers = None, self.multipliers
+        self.section = self.poincare_jacobian = None
         if self.autonomous:
             k = _phase_index(self.monodromy, self.multipliers, phase_direction)
             self.phase_multiplier = float(self.multipliers[k].real)
