@@ -120,7 +120,11 @@ class _Problem:
         while t0 < max_time:
             duration = min(chunk, max_time - t0)
             chunk = 2 * chunk if growing else chunk
-            fl = self.flow(x, mode, duration)
+            try:
+                fl = self.flow(x, mode, duration)
+            except RuntimeError as err:
+                raise RuntimeError(f"the trajectory diverges or cannot be integrated before it "
+                                   f"crosses the section ({err})") from None
             for start, end, seg_mode, sol in fl.segments:
                 if seg_mode != section.mode or end <= start:
                     continue
@@ -269,7 +273,7 @@ def limit_cycle(plant, period, x0, mode0=0, *, section=None, direction=1, u0=Non
     x0 : array_like
         Initial guess of a state on (or near) the orbit.  When it is off
         a user-given section, the trajectory from it is first followed to
-        the section.
+        the section (for at most 20 period guesses).
     mode0 : int or str, optional
         Mode of `x0` and of the section (hybrid plants).
     section : callable, optional
@@ -361,7 +365,7 @@ def limit_cycle(plant, period, x0, mode0=0, *, section=None, direction=1, u0=Non
     # forward simulation only supplies starting guesses: moderate tolerances
     loose = dict(opts, rtol=max(opts['rtol'], 1e-8), atol=max(opts['atol'], 1e-10))
     search = _Problem(hp, u0, params, loose, deadline)
-    x, period = _start_on_section(search, sec, x0, mode0, period, max_periods)
+    x, period = _start_on_section(search, sec, x0, mode0, period)
     return _shoot(prob, search, sec, x, period, tol, max_iter, max_periods, npoints)
 
 
@@ -376,9 +380,12 @@ def _return(search, sec, x, period, max_periods, what):
     return search.flow(x, sec.mode, t).x_final, t
 
 
-def _start_on_section(search, sec, x0, mode0, period, max_periods):
-    """A start on the section and a period guess (the first return time if not given)."""
-    horizon = max(max_periods, 2) * period if period is not None else 1000.0
+def _start_on_section(search, sec, x0, mode0, period):
+    """A start on the section and a period guess (the first return time if not given).
+
+    The searches span 20 period guesses (1000 time units without a guess).
+    """
+    horizon = 20 * period if period is not None else 1000.0
     x = x0
     if abs(sec(x0)) > 1e-12 * (1 + np.max(np.abs(x0))):
         t = search.first_crossing(x0, mode0, sec, horizon, period)
@@ -387,14 +394,19 @@ def _start_on_section(search, sec, x0, mode0, period, max_periods):
                              f"t={horizon:g}: the orbit may not cross it, or x0 is in the "
                              "basin of an equilibrium")
         x = search.flow(x0, mode0, t).x_final
-    # the first return time refines the guess, unless the section is crossed
-    # several times per period
-    t = search.first_crossing(x, mode0, sec, horizon, skip=1e-9 * horizon)
     if period is None:
+        t = search.first_crossing(x, mode0, sec, horizon, skip=1e-9 * horizon)
         if t is None:
             raise ValueError(f"the trajectory does not return to the section within "
                              f"t={horizon:g}: give a period guess, or x0 is not near an orbit")
         return x, t
+    # the first return time refines the guess, unless the section is crossed
+    # several times per period or the trajectory leaves (unstable orbits)
+    try:
+        t = search.first_crossing(x, mode0, sec, 1.5 * period, period / 4,
+                                  skip=1e-9 * period)
+    except RuntimeError:
+        t = None
     return x, t if t is not None and abs(t - period) < period / 3 else period
 
 
@@ -443,7 +455,11 @@ def _newton(prob, sec, x, T, tol, max_iter, npoints, returns, tried):
         if not 0 < T < np.inf:
             tried.append(f"{where}: the period left (0, ∞)")
             return None
-        fl = prob.flow(x, mode, T, variational=True)
+        try:
+            fl = prob.flow(x, mode, T, variational=True)
+        except RuntimeError as err:
+            tried.append(f"{where}: {err}")
+            return None
         if fl.mode_final != mode:
             tried.append(f"{where}: the period ends in mode "
                          f"{hp.mode_names[fl.mode_final]!r}, not {hp.mode_names[mode]!r}")
