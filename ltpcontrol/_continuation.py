@@ -21,6 +21,7 @@ continuation cannot pass it: the steps fail while a multiplier tends to
 ``(μ − 1)²``, linear in p near the fold, from the last branch points.
 """
 
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import control as ct
@@ -54,6 +55,14 @@ class Bifurcation(NamedTuple):
         The critical multiplier at `value`.
     orbit : PeriodicOrbit or None
         The orbit at `value` (None for a fold located by extrapolation).
+
+    Examples
+    --------
+    Returned in `OrbitBranch.bifurcations`; a named tuple:
+
+    >>> b = ltp.Bifurcation('period-doubling', 2.8324, -1.0 + 0j, None)
+    >>> b.kind, b.value
+    ('period-doubling', 2.8324)
     """
 
     kind: str
@@ -62,8 +71,11 @@ class Bifurcation(NamedTuple):
     orbit: object
 
 
+@dataclass(repr=False, eq=False)
 class OrbitBranch:
     """A branch of periodic orbits computed by `orbit_continuation`.
+
+    Returned by `orbit_continuation`; not meant to be built directly.
 
     Attributes
     ----------
@@ -84,15 +96,33 @@ class OrbitBranch:
         Bifurcations found, in branch order.
     message : str
         How the continuation ended.
+
+    Examples
+    --------
+    >>> def f(t, x, u, p):
+    ...     r2 = x[0] ** 2 + x[1] ** 2
+    ...     return [p['a'] * x[0] * (1 - r2) - x[1], p['a'] * x[1] * (1 - r2) + x[0]]
+    >>> sys = ct.nlsys(f, None, states=2, inputs=0, params={'a': 0.2})
+    >>> branch = ltp.orbit_continuation(ltp.limit_cycle(sys, 6.0, [1.0, 0.0]), 'a', [0.2, 0.1])
+    >>> branch.values, np.round(branch.periods, 6), branch.message
+    (array([0.2, 0.1]), array([6.283185, 6.283185]), 'completed')
     """
 
-    def __init__(self, param, orbits, bifurcations, message):
-        self.param, self.orbits = param, orbits
-        self.values = np.array([o.params[param] for o in orbits], float)
-        self.periods = np.array([o.period for o in orbits])
-        self.multipliers = np.array([_sorted(o.stability_multipliers) for o in orbits])
-        self.stable = np.array([o.is_stable for o in orbits])
-        self.bifurcations, self.message = bifurcations, message
+    param: str
+    values: np.ndarray
+    orbits: list
+    periods: np.ndarray
+    multipliers: np.ndarray
+    stable: np.ndarray
+    bifurcations: list
+    message: str
+
+    @classmethod
+    def _from_orbits(cls, param, orbits, bifurcations, message):
+        return cls(param, np.array([o.params[param] for o in orbits], float), orbits,
+                   np.array([o.period for o in orbits]),
+                   np.array([_sorted(o.stability_multipliers) for o in orbits]),
+                   np.array([o.is_stable for o in orbits]), bifurcations, message)
 
     def __repr__(self):
         bif = ', '.join(f'{b.kind} at {self.param}={b.value:.6g}' for b in self.bifurcations)
@@ -258,7 +288,7 @@ def orbit_continuation(orbit, param, values, *, locate_tol=1e-8, max_halvings=10
         else:
             continue
         break
-    return OrbitBranch(param, branch, bifurcations, message)
+    return OrbitBranch._from_orbits(param, branch, bifurcations, message)
 
 
 class _Solver:
