@@ -343,73 +343,27 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
     opts = _solver_options(kwargs, 'periodic_orbit')
     check_kwargs(kwargs, 'periodic_orbit')
     hp, period, x0, mode0, u0, params = _prepare(plant, period, x0, mode0, u0, params, jacobian)
-    if not isinstance(tol, numbers.Real) or not 0 < tol < 1:
-        raise ValueError(f"tol must be a number in (0, 1), got {tol!r}")
-    max_iter = check_positive_int(max_iter, 'max_iter')
-    max_periods = check_positive_int(max_periods, 'max_periods', minimum=0)
-    warmup = check_positive_int(warmup, 'warmup', minimum=0)
-    npoints = check_positive_int(npoints, 'npoints', minimum=2)
+    tol, max_iter, max_periods, warmup, npoints = _shooting_options(
+        tol, max_iter, max_periods, warmup, npoints)
     _check_periodicity(hp, period, x0, u0, params)
-
-    def flow(x, mode, variational, options=opts):
-        return _Flow(hp, 0.0, period, x, mode, lambda t: u0, params,
-                     variational=variational, **options)
-
-    def relres(x, xT):
-        return np.max(np.abs(xT - x)) / (1 + np.max(np.abs(x)))
-
-    # forward simulation only supplies starting guesses: moderate tolerances
-    loose = dict(opts, rtol=max(opts['rtol'], 1e-8), atol=max(opts['atol'], 1e-10))
-
-    def simulate(x, mode, nper):
-        res = np.inf
-        for _ in range(nper):
-            fl = flow(x, mode, False, loose)
-            res = relres(x, fl.x_final) if fl.mode_final == mode else np.inf
-            x, mode = fl.x_final, fl.mode_final
-        return x, mode, res
-
+    shooter = _PeriodShooter(hp, period, u0, params, opts)
     tried = []
     x, mode, periods = x0.copy(), mode0, warmup
     if warmup:
-        x, mode, res = simulate(x, mode, warmup)
+        x, mode, res = shooter.simulate(x, mode, warmup)
         tried.append(f"warm-up simulation to t={warmup}T: residual {res:.3g}")
     sim_x, sim_mode = x, mode
     while True:
-        # Newton on P(x) − x = 0: (∂P/∂x − I) δ = −(P(x) − x)
-        last, stalled = np.inf, 0
-        for it in range(max_iter + 1):
-            fl = flow(x, mode, True)
-            if fl.mode_final != mode:
-                tried.append(f"Newton from t={periods}T: the period ends in mode "
-                             f"{hp.mode_names[fl.mode_final]!r}, not {hp.mode_names[mode]!r}")
-                break
-            res = relres(x, fl.x_final)
-            if res <= tol:
-                return _finish(hp, period, fl, x, mode, npoints, params, u0, res, it, periods)
-            stalled = stalled + 1 if res > 0.9 * last else 0
-            if res > 1e3 * last or stalled >= 3 or it == max_iter:
-                tried.append(f"Newton from t={periods}T: residual {res:.3g} after {it} "
-                             "iterations" + (" (no progress)" if stalled >= 3 else ""))
-                break
-            last = res
-            # least squares handles neutral directions (multipliers equal to 1)
-            step, _, rank, _ = np.linalg.lstsq(fl.phi - np.eye(hp.nstates), x - fl.x_final,
-                                               rcond=None)
-            if rank == 0:
-                tried.append(f"Newton from t={periods}T: the period map is the identity "
-                             "to first order (all multipliers 1)")
-                break
-            if np.max(np.abs(step)) > 10 * (1 + np.max(np.abs(x))):
-                tried.append(f"Newton from t={periods}T: step of size "
-                             f"{np.max(np.abs(step)):.3g} rejected (divergence)")
-                break
-            x = x + step
+        found = shooter.newton(x, mode, tol, max_iter, f"Newton from t={periods}T", tried)
+        if found is not None:
+            fl, x, res, iterations = found
+            return _finish(hp, period, fl, x, mode, npoints, params, u0, res, iterations,
+                           periods)
         if periods >= warmup + max_periods:
             break
         # fall back to forward simulation towards an attracting orbit
         nper = min(10, warmup + max_periods - periods)
-        sim_x, sim_mode, res = simulate(sim_x, sim_mode, nper)
+        sim_x, sim_mode, res = shooter.simulate(sim_x, sim_mode, nper)
         x, mode, periods = sim_x, sim_mode, periods + nper
         tried.append(f"forward simulation to t={periods}T: residual {res:.3g}")
     raise RuntimeError("periodic_orbit did not converge to a T-periodic orbit "
@@ -417,6 +371,77 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
                        ". The response may be unbounded, quasi-periodic, chaotic or periodic "
                        "with a multiple of the period; try another x0, a warm-up or a larger "
                        "max_periods.")
+
+
+def _shooting_options(tol, max_iter, max_periods, warmup, npoints):
+    """Validated Newton tolerance and iteration, period and grid counts."""
+    if isinstance(tol, bool) or not isinstance(tol, numbers.Real) or not 0 < tol < 1:
+        raise ValueError(f"tol must be a number in (0, 1), got {tol!r}")
+    return (tol, check_positive_int(max_iter, 'max_iter'),
+            check_positive_int(max_periods, 'max_periods', minimum=0),
+            check_positive_int(warmup, 'warmup', minimum=0),
+            check_positive_int(npoints, 'npoints', minimum=2))
+
+
+def _relres(x, xT):
+    """Relative residual ``‖x(T) − x‖∞ / (1 + ‖x‖∞)``."""
+    return np.max(np.abs(xT - x)) / (1 + np.max(np.abs(x)))
+
+
+class _PeriodShooter:
+    """Period map of a forced plant, its Newton iteration and forward simulation."""
+
+    def __init__(self, hp, period, u0, params, opts):
+        self.hp, self.period, self.u0, self.params, self.opts = hp, period, u0, params, opts
+        # forward simulation only supplies starting guesses: moderate tolerances
+        self.loose = dict(opts, rtol=max(opts['rtol'], 1e-8), atol=max(opts['atol'], 1e-10))
+
+    def flow(self, x, mode, variational, options=None):
+        u0 = self.u0
+        return _Flow(self.hp, 0.0, self.period, x, mode, lambda t: u0, self.params,
+                     variational=variational, **(options or self.opts))
+
+    def simulate(self, x, mode, nper):
+        """State, mode and last-period residual after `nper` simulated periods."""
+        res = np.inf
+        for _ in range(nper):
+            fl = self.flow(x, mode, False, self.loose)
+            res = _relres(x, fl.x_final) if fl.mode_final == mode else np.inf
+            x, mode = fl.x_final, fl.mode_final
+        return x, mode, res
+
+    def newton(self, x, mode, tol, max_iter, where, tried):
+        """Newton on ``P(x) − x = 0``: (flow, x, residual, iterations) or None."""
+        names, n = self.hp.mode_names, self.hp.nstates
+        last, stalled = np.inf, 0
+        for it in range(max_iter + 1):
+            fl = self.flow(x, mode, True)
+            if fl.mode_final != mode:
+                tried.append(f"{where}: the period ends in mode {names[fl.mode_final]!r}, "
+                             f"not {names[mode]!r}")
+                return None
+            res = _relres(x, fl.x_final)
+            if res <= tol:
+                return fl, x, res, it
+            stalled = stalled + 1 if res > 0.9 * last else 0
+            if res > 1e3 * last or stalled >= 3 or it == max_iter:
+                tried.append(f"{where}: residual {res:.3g} after {it} iterations"
+                             + (" (no progress)" if stalled >= 3 else ""))
+                return None
+            last = res
+            # (∂P/∂x − I) δ = −(P(x) − x); least squares handles neutral
+            # directions (multipliers equal to 1)
+            step, _, rank, _ = np.linalg.lstsq(fl.phi - np.eye(n), x - fl.x_final, rcond=None)
+            if rank == 0:
+                tried.append(f"{where}: the period map is the identity to first order "
+                             "(all multipliers 1)")
+                return None
+            if np.max(np.abs(step)) > 10 * (1 + np.max(np.abs(x))):
+                tried.append(f"{where}: step of size {np.max(np.abs(step)):.3g} rejected "
+                             "(divergence)")
+                return None
+            x = x + step
+        return None  # pragma: no cover - the loop always returns
 
 
 def _finish(hp, period, fl, x, mode, npoints, params, u0, res, iterations, periods):
