@@ -21,6 +21,7 @@ continuation cannot pass it: the steps fail while a multiplier tends to
 ``(μ − 1)²``, linear in p near the fold, from the last branch points.
 """
 
+import numbers
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -33,7 +34,7 @@ from tqdm.auto import tqdm
 
 from ._autonomous import limit_cycle
 from ._orbits import PeriodicOrbit, periodic_orbit
-from ._validation import real_array
+from ._validation import check_positive_int, real_array
 
 __all__ = ['Bifurcation', 'OrbitBranch', 'orbit_continuation']
 
@@ -204,8 +205,9 @@ def orbit_continuation(orbit, param, values, *, locate_tol=1e-8, max_halvings=10
     Natural-parameter continuation: the orbit is recomputed at each value
     of `values` by the shooting method that produced `orbit` (`limit_cycle`
     or `periodic_orbit`, with the same section, input and parameters),
-    started from the secant predictor; failed steps are halved up to
-    `max_halvings` times, after which the branch ends.  Folds, period
+    started from the secant predictor; failed steps are halved (up to
+    `max_halvings` times below the spacing of `values`), after which the
+    branch ends.  Folds, period
     doublings and Neimark–Sacker bifurcations are detected from the
     stability multipliers and located (see the module notes).
 
@@ -221,7 +223,9 @@ def orbit_continuation(orbit, param, values, *, locate_tol=1e-8, max_halvings=10
     locate_tol : float, optional
         Tolerance on the parameter of a located bifurcation (1e-8).
     max_halvings : int, optional
-        Step halvings before the branch ends (10).
+        The smallest step is the spacing of `values` halved this many times
+        (10); the branch ends when it fails.  Steps double again after
+        each success.
     progress : bool, optional
         Show a progress bar (default False).
     **kwargs
@@ -264,23 +268,29 @@ def orbit_continuation(orbit, param, values, *, locate_tol=1e-8, max_halvings=10
     steps = np.diff(values)
     if values.size < 1 or not (np.all(steps > 0) or np.all(steps < 0)):
         raise ValueError("values must be a non-empty, strictly monotone sequence")
-    if not 0 < locate_tol:
-        raise ValueError(f"locate_tol must be positive, got {locate_tol!r}")
+    if isinstance(locate_tol, bool) or not isinstance(locate_tol, numbers.Real) \
+            or not locate_tol > 0:
+        raise ValueError(f"locate_tol must be a positive number, got {locate_tol!r}")
+    max_halvings = check_positive_int(max_halvings, 'max_halvings', minimum=0)
     solver = _Solver(orbit, param, kwargs)
     start = solver.solve(values[0], [orbit])
     if start is None:
         raise RuntimeError(f"orbit_continuation: no orbit found at {param}={values[0]:g} "
                            f"from the start orbit: {solver.last_error}")
     branch, bifurcations, message = [start], [], "completed"
-    step = np.inf
+    step, previous = np.inf, values[0]
     for target in tqdm(values[1:], desc="continuation", leave=False, disable=not progress):
+        nominal, previous = abs(target - previous), target
         while branch[-1].params[param] != target:
-            new, step = _advance(solver, branch, target, step, max_halvings)
+            new, step = _advance(solver, branch, target, min(2 * step, nominal),
+                                 nominal / 2 ** max_halvings)
             if new is None:
                 message = (f"the branch ends near {param}={branch[-1].params[param]:.8g}: "
                            f"no orbit found beyond it ({solver.last_error})")
                 fold = _extrapolated_fold(branch, param)
-                if fold is not None:
+                if fold is not None and not any(b.kind == 'fold' and abs(b.value - fold.value)
+                                                <= 1e-3 * (1 + abs(fold.value))
+                                                for b in bifurcations):
                     bifurcations.append(fold)
                 break
             bifurcations += _detect(solver, branch[-1], new, locate_tol)
@@ -321,16 +331,17 @@ class _Solver:
             return None
 
 
-def _advance(solver, branch, target, size, max_halvings):
+def _advance(solver, branch, target, size, smallest):
     """Next branch point towards `target` and the step size that reached it.
 
-    The step is at most `size` (the last successful one) and is halved after
-    each failure; the secant predictor starts Newton.
+    The step starts at `size` and is halved after each failure down to
+    `smallest`; the secant predictor starts Newton.
     """
     p_last = branch[-1].params[solver.param]
-    step = np.sign(target - p_last) * min(abs(target - p_last), size)
-    for _ in range(max_halvings + 1):
-        value = target if abs(target - p_last - step) <= 1e-12 * abs(step) else p_last + step
+    size = min(abs(target - p_last), size)
+    while size >= smallest * (1 - 1e-12):
+        step = np.sign(target - p_last) * size
+        value = target if abs(target - p_last - step) <= 1e-12 * size else p_last + step
         x, period = None, None
         if len(branch) >= 2:
             a, b = branch[-2], branch[-1]
@@ -339,9 +350,9 @@ def _advance(solver, branch, target, size, max_halvings):
             period = b.period + ratio * (b.period - a.period) if b.autonomous else None
         new = solver.solve(value, branch, x, period)
         if new is not None and new.mode0 == branch[-1].mode0:
-            return new, abs(step)
-        step /= 2
-    return None, abs(step)
+            return new, size
+        size /= 2
+    return None, size
 
 
 def _detect(solver, a, b, tol):
@@ -358,17 +369,24 @@ def _detect(solver, a, b, tol):
             closest = min(near, key=lambda o: abs(o.params[solver.param] - p))
             orbit = solver.solve(p, [closest])
             if orbit is None:
-                raise RuntimeError(f"orbit_continuation: lost the orbit at "
-                                   f"{solver.param}={p:.10g} while locating a {kind}: "
-                                   f"{solver.last_error}")
+                raise _Lost
             near.append(orbit)
             return _tests(orbit.stability_multipliers)[kind]
 
-        value = brentq(test, pa, pb, xtol=tol, rtol=4 * np.finfo(float).eps)
+        try:
+            value = brentq(test, pa, pb, xtol=tol, rtol=4 * np.finfo(float).eps)
+        except _Lost:
+            # the orbit is lost inside the bracket (e.g. at a fold, where the
+            # branch continued on the other side): report its middle
+            value = 0.5 * (pa + pb)
         orbit = min(near, key=lambda o: abs(o.params[solver.param] - value))
         found.append(Bifurcation(kind, float(value),
                                  _critical(kind, orbit.stability_multipliers), orbit))
     return found
+
+
+class _Lost(Exception):
+    """No orbit found while locating a bifurcation."""
 
 
 def _extrapolated_fold(branch, param):
