@@ -222,8 +222,8 @@ def poincare_map(plant, x0, section=None, mode0=0, *, direction=1, max_time=None
                          f"max_time={max_time:g}")
     fl = prob.flow(x0, mode0, t_cross, variational=bool(jacobian))
     if not jacobian:
-        return fl.x_final, t_cross
-    return fl.x_final, t_cross, _projected(prob, sec, fl)
+        return fl.x_final, float(t_cross)
+    return fl.x_final, float(t_cross), _projected(prob, sec, fl)
 
 
 def _projected(prob, sec, fl):
