@@ -170,10 +170,14 @@ class OrbitBranch:
         for b in self.bifurcations:
             for ax in (ax_mu, ax_T):
                 ax.axvline(b.value, color='C3', lw=1)
-            ax_mu.annotate(f" {_KINDS[b.kind]}\n {self.param}={b.value:.6g}",
-                           (b.value, 1), color='C3', fontsize=8, va='bottom')
+            ax_mu.text(b.value, 0.5, f" {_KINDS[b.kind]}, {self.param} = {b.value:.6g}",
+                       transform=ax_mu.get_xaxis_transform(), color='C3', fontsize=8,
+                       rotation=90, va='center', ha='right')
         ax_mu.set_ylabel("Re μ (stability multipliers)")
         ax_T.set_ylabel("period")
+        ax_T.ticklabel_format(axis='y', useOffset=False)
+        if np.ptp(self.periods) <= 1e-6 * np.mean(self.periods):
+            ax_T.set_ylim(np.mean(self.periods) * np.array([0.99, 1.01]))
         ax_T.set_xlabel(self.param)
         fig.suptitle(title or f"Orbit branch in {self.param}")
         return ct.ControlPlot(lines, np.array([[ax_mu], [ax_T]]), fig)
