@@ -177,23 +177,35 @@ def _as_hybrid(plant, jacobian):
                        params=plant.params, name=plant.name)
 
 
-def _check_periodicity(plant, period, x0, u0, params):
-    """Raise when a vector field or guard is not T-periodic in t."""
-    probes = period * np.array([0.1234567, 0.5, 0.8765432])
+def _time_mismatch(plant, x0, u0, params, pairs):
+    """First vector field or guard that differs between the times of a pair.
+
+    Compares at `x0` and a perturbed state; returns ``(label, mode name,
+    t_a, t_b, largest difference)`` or None.
+    """
     bumps = np.linspace(-1.0, 1.0, plant.nstates) * 0.1 * (1 + np.abs(x0))
     for i, mode in enumerate(plant.modes):
         checks = [('updfcn', lambda t, x: plant._f(i, t, x, u0, params))]
         if mode.guard is not None:
             checks.append(('guard', lambda t, x: plant._g(i, t, x, u0, params)))
         for label, func in checks:
-            for t in probes:
+            for ta, tb in pairs:
                 for x in (x0, x0 + bumps):
-                    a, b = np.asarray(func(t, x)), np.asarray(func(t + period, x))
+                    a, b = np.asarray(func(ta, x)), np.asarray(func(tb, x))
                     if not np.allclose(a, b, rtol=1e-8, atol=1e-10 * (1 + np.abs(a).max())):
-                        raise ValueError(
-                            f"plant is not periodic with period={period:g}: {label} of mode "
-                            f"{plant.mode_names[i]!r} differs between t={t:.6g} and t+T "
-                            f"(max difference {np.abs(a - b).max():.3g})")
+                        return label, plant.mode_names[i], ta, tb, np.abs(a - b).max()
+    return None
+
+
+def _check_periodicity(plant, period, x0, u0, params):
+    """Raise when a vector field or guard is not T-periodic in t."""
+    probes = period * np.array([0.1234567, 0.5, 0.8765432])
+    bad = _time_mismatch(plant, x0, u0, params, [(t, t + period) for t in probes])
+    if bad is not None:
+        label, mode, t, _, diff = bad
+        raise ValueError(f"plant is not periodic with period={period:g}: {label} of mode "
+                         f"{mode!r} differs between t={t:.6g} and t+T (max difference "
+                         f"{diff:.3g})")
 
 
 def _prepare(plant, period, x0, mode0, u0, params, jacobian):
