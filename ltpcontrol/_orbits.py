@@ -29,7 +29,8 @@ __all__ = ['PeriodicOrbit', 'periodic_orbit', 'period_map', 'linearize_orbit']
 class PeriodicOrbit:
     """T-periodic steady state of a forced (hybrid) plant.
 
-    Returned by `periodic_orbit`; not meant to be built directly.  Calling
+    Returned by `periodic_orbit` (and, for autonomous plants, by
+    `limit_cycle`); not meant to be built directly.  Calling
     the object, ``orbit(t)``, evaluates ``x̄(t mod T)`` from the solver's
     dense output (shape ``(n,)`` for scalar t, ``(n, len(t))`` otherwise).
 
@@ -83,7 +84,8 @@ class PeriodicOrbit:
     iterations : int
         Newton iterations of the successful attempt.
     periods_simulated : int
-        Periods of forward simulation used before convergence.
+        Periods of forward simulation (returns to the section for an
+        autonomous orbit) used before convergence.
     plant : HybridPlant
         The plant as a hybrid plant (a smooth system becomes one mode).
     params : dict
