@@ -20,6 +20,8 @@ from ._discretize import sample_system, d2c
 from ._lifting import lift
 from ._hybrid import HybridMode, HybridPlant, simulate_hybrid, saltation_matrix
 from ._orbits import PeriodicOrbit, periodic_orbit, period_map, linearize_orbit
+from ._autonomous import limit_cycle, poincare_map
+from ._continuation import Bifurcation, OrbitBranch, orbit_continuation
 from ._excitation import Excitation, chirp_replicas, multisine, sine_experiments
 from ._htf_estimate import estimate_htf
 from ._htf_fit import HTFFit, DelayEstimate, fit_htf, estimate_delays
@@ -59,6 +61,7 @@ __all__ = [
     # rhythmic plants and their orbits
     'HybridMode', 'HybridPlant', 'simulate_hybrid', 'saltation_matrix',
     'PeriodicOrbit', 'periodic_orbit', 'period_map', 'linearize_orbit',
+    'limit_cycle', 'poincare_map', 'Bifurcation', 'OrbitBranch', 'orbit_continuation',
     # identification
     'Excitation', 'chirp_replicas', 'multisine', 'sine_experiments',
     'estimate_htf', 'HTFFit', 'DelayEstimate', 'fit_htf', 'estimate_delays',

@@ -164,8 +164,13 @@ def floquet_exponents(sys, nsteps=None):
     return (logmod + 1j * arg) / sys.period
 
 
-def is_stable(sys, tol=1e-10, nsteps=None):
+def is_stable(sys, tol=1e-10, nsteps=None, *, autonomous=False):
     """True when every Floquet multiplier satisfies ``|μ| < 1 - tol``.
+
+    With ``autonomous=True``, `sys` is the linearisation about an orbit of
+    an autonomous plant (see `limit_cycle`): the multiplier nearest 1
+    belongs to the phase direction and is left out, so the verdict is
+    orbital stability.
 
     Parameters
     ----------
@@ -177,6 +182,9 @@ def is_stable(sys, tol=1e-10, nsteps=None):
         as stable.
     nsteps : int, optional
         Continuous time only; see `monodromy`.
+    autonomous : bool, optional
+        Leave out the phase multiplier of an autonomous orbit (default
+        False).
 
     Returns
     -------
@@ -191,8 +199,17 @@ def is_stable(sys, tol=1e-10, nsteps=None):
     if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, numbers.Real) \
             or not 0 <= tol < 1:
         raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
-    logmod, _ = _log_multipliers(sys, nsteps)
+    logmod, arg = _log_multipliers(sys, nsteps)
+    if autonomous:
+        logmod = _without_phase_multiplier(logmod, arg)
     return bool(logmod.size == 0 or np.max(logmod) < np.log1p(-tol))
+
+
+def _without_phase_multiplier(logmod, arg):
+    """Log-moduli without the multiplier nearest 1 (phase of an autonomous orbit)."""
+    if logmod.size == 0:
+        raise ValueError("autonomous=True needs at least one multiplier (the phase one)")
+    return np.delete(logmod, np.argmin(np.hypot(logmod, arg)))
 
 
 def floquet_transform(sys, real=True, nsteps=None, **kwargs):
