@@ -28,6 +28,8 @@ from ._fdsubspace import fdsubspace, FDSubspaceInfo
 from ._hybrid_ls import hybrid_ls, HybridLSResult
 from ._realization import floquet_realization, FloquetRealization
 from ._canonical import to_canonical, matrix_errors, MatrixErrors
+from ._canonical import compare_ltp, LTPComparison
+from ._structure import select_structure, StructureSelection
 from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
 
 __version__ = "0.1.0"
@@ -57,4 +59,5 @@ __all__ = [
     'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
+    'compare_ltp', 'LTPComparison', 'select_structure', 'StructureSelection',
 ]
