@@ -74,7 +74,7 @@ def test_compare_ltp_is_branch_and_basis_invariant():
                         lambda t: np.array([[1.0, 0.0]]) @ R(t), 0, period=T)
     cmp = ltp.compare_ltp(shifted, sys, UNSEEN[:5])
     assert cmp.htf_error < 1e-6 and cmp.exponent_error < 1e-8
-    assert np.abs(np.linalg.eigvals(Ashift).imag).max() > wp     # other branch
+    assert np.abs(np.linalg.eigvals(Ashift).imag).max() > wp / 2   # other branch
 
 
 def test_compare_ltp_bad_input():
