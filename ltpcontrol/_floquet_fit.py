@@ -126,7 +126,7 @@ class _FloquetFit:
         return G, J
 
 
-def fit_floquet(sys, Gc, omega, K, *, estimate_d=True, fit_a=True, maxiter=50, rtol=1e-12,
+def fit_floquet(sys, Gc, omega, K, *, estimate_d=True, fit_a=True, maxiter=50, rtol=1e-8,
                 **labels):
     """Least-squares Floquet-form model of K harmonics fitted to ``G_n(jΩ)``.
 
@@ -152,16 +152,17 @@ def fit_floquet(sys, Gc, omega, K, *, estimate_d=True, fit_a=True, maxiter=50, r
     f = r @ r
     mu, converged = 0.0, False
     for _ in range(maxiter):
+        # column scaling, floored so that (nearly) uninfluential parameters stay put
         colnorm = np.linalg.norm(J, axis=0)
-        colnorm[colnorm == 0] = 1.0
-        Js = J / colnorm
+        colnorm = np.maximum(colnorm, 1e-8 * max(colnorm.max(), np.finfo(float).tiny))
+        # one SVD per iteration: the damped step -V diag(s/(s²+μ)) U^T r for any μ
+        U, sv, Vt = np.linalg.svd(J / colnorm, full_matrices=False)
+        Utr = U.T @ r
+        sv = np.where(sv > max(J.shape) * np.finfo(float).eps * sv[0], sv, 0.0)
         while True:
-            if mu:
-                Js_aug = np.vstack([Js, np.sqrt(mu) * np.eye(Js.shape[1])])
-                rhs = np.concatenate([-r, np.zeros(Js.shape[1])])
-            else:
-                Js_aug, rhs = Js, -r
-            step = np.linalg.lstsq(Js_aug, rhs, rcond=None)[0] / colnorm
+            with np.errstate(divide='ignore', invalid='ignore'):
+                gain = np.where(sv > 0, sv / (sv ** 2 + mu), 0.0)
+            step = -(Vt.T @ (gain * Utr)) / colnorm
             with np.errstate(all='ignore'):
                 r_new = cost(theta + step)
             f_new = r_new @ r_new

@@ -7,12 +7,17 @@ import ltpcontrol as ltp
 from ltpcontrol._lifting import _real_basis
 
 
-def random_ltp(seed, nstates=2, noutputs=1, harmonics=2, period=1.0, depth=0.3):
+def random_ltp(seed, nstates=2, noutputs=1, harmonics=2, period=1.0, depth=0.3,
+               allow_negative=False):
     """Random stable continuous LTP plant with harmonics up to `harmonics` in A, B, C.
 
     The mean A has exponents with real parts in [-3, -0.5] and imaginary
     parts below ω_p/4; every harmonic of A, B and C has a relative size of
     about ``depth / h``.  Stability is checked with the Floquet multipliers.
+    Plants with negative real multipliers (exponents on ``Im λ = ω_p/2``
+    with distinct real parts, a parametric resonance) are redrawn: they
+    have no real Floquet form of period T, so no real K-harmonic model of
+    period T can match them (see `negative_multiplier_plant`).
     """
     rng = np.random.default_rng(seed)
     wp = 2 * np.pi / period
@@ -44,7 +49,10 @@ def random_ltp(seed, nstates=2, noutputs=1, harmonics=2, period=1.0, depth=0.3):
         sys = ltp.ltpss(ltp.PeriodicMatrix(A, period), ltp.PeriodicMatrix(B, period),
                         ltp.PeriodicMatrix(C, period), 0, period=period,
                         name=f'plant{seed}')
-        if np.abs(ltp.floquet_multipliers(sys)).max() < np.exp(-0.3 * period):
+        mu = ltp.floquet_multipliers(sys)
+        negative = (np.abs(mu.imag) <= 1e-9 * np.abs(mu)) & (mu.real < 0)
+        if np.abs(mu).max() < np.exp(-0.3 * period) and (allow_negative
+                                                       or not negative.any()):
             return sys
 
 
