@@ -55,6 +55,15 @@ def to_canonical(sys, input=0, name=None, **kwargs):
         -a_1]``), ``B̄_0[:, input] = e_n``, ``B(t) = Q^{-1} B(t)`` and
         ``C(t) = C(t) Q`` (module notes), as in thesis eqs. (4.122)-(4.124).
 
+    Notes
+    -----
+    The form removes constant changes of state only.  Two Floquet forms of
+    one system may differ by the branch of their exponents (``λ -> λ +
+    jkω_p`` with a periodic change of state, which also moves the
+    harmonics of B(t) and C(t)); their canonical forms then differ by
+    O(ω_p) in A.  Compare identified models with `compare_ltp` (HTFs and
+    exponents modulo ``jω_p``), or bring both to the same branch first.
+
     Raises
     ------
     ControlArgument

@@ -1,4 +1,5 @@
-"""Seeded random LTP plants with periodic A(t), B(t), C(t) and their exact data."""
+"""Seeded random LTP plants with periodic A(t), B(t), C(t) and their exact lifted data
+(used by the generic identification study and the test suite)."""
 
 import numpy as np
 import control as ct
