@@ -40,7 +40,8 @@ The realization is read from the transformed model: ``A_F = Re Ā``,
 ``B_l``, ``C_l``, ``D_l`` the diagonal averages, ``B[k] = Σ_l B_l w^{lk}``.
 
 Method 'direct' finds T without search.  The eigenvalues of Â are the
-ladders ``μ_i w^{-n}`` (thesis eq. 4.91); in the modal coordinates
+ladders ``μ_i w^{-n}`` (thesis eq. 4.91), found by optimal matching of
+the eigenvalues to the ideal ladders of candidate centres (`_ladders`); in the modal coordinates
 ``q = Ŵ^{-1} x̂`` the identified output matrix is ``Ĉ_{r,(n,i)} = d_{n,i}
 γ_{r-n,i}`` (``γ_{l,i} = C_l W_i``) with unknown eigenvector scales, so
 consecutive ratios follow from ``Ĉ_{r+1,(n+1,i)} = (d_{n+1,i}/d_{n,i})
@@ -104,8 +105,10 @@ class FloquetRealization:
     nfev : int
         Number of distance evaluations (0 for 'direct').
     ladder_mismatch : float or None
-        'direct' only: largest ``|λ w^{-1} - λ'|`` between neighbouring
-        ladder members, relative to the ladder step ``2|λ| sin(π/N)``.
+        'direct' only: largest distance of a ladder member from its ideal
+        place ``μ w^{-n}``, in ladder steps ``2|μ| sin(π/N)``, weighted by
+        the member's contribution to the response relative to the largest
+        of its ladder (weakly excited outer members count little).
 
     Examples
     --------
@@ -175,8 +178,9 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
         Success threshold on the relative mismatch between the lifted model
         of the realization and `sys` (default 0.05).
     ladder_tol : float
-        'direct' only: largest accepted ladder mismatch relative to the
-        ladder step (default 0.1; a spectrum without ladders gives O(1)).
+        'direct' only: largest weighted ladder mismatch (`FloquetRealization`)
+        for `success` (default 0.1; a spectrum without ladders gives O(1)).
+        A larger mismatch still gives a realization, flagged unsuccessful.
     seed : int, optional
         Seed of the swarm ('pso'); the global NumPy random state used by
         pyswarms is restored afterwards.
@@ -198,7 +202,10 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
     -------
     FloquetRealization
         Its ``success`` flag must be checked: a search may end in a local
-        minimum, and 'direct' reports missing ladders as a failure.
+        minimum, and 'direct' flags imperfect ladders.  ``sys`` is None
+        only when no realization can be formed: repeated eigenvalues, or
+        eigenvalues that cannot be grouped into ``nstates`` conjugate-closed
+        ladders ('direct'), or a singular similarity ('pso').
 
     Raises
     ------

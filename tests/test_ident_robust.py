@@ -33,11 +33,12 @@ PLANTS = [(seed, n, ny) for seed in range(10) for n, ny in ((2, 1), (3, 2), (4, 
 def test_thirty_random_plants():
     """30 plants, n_p = 2-4, harmonics up to 2 in A, B, C, one and two outputs: a
     model for every one; K = 3: HTF error <= 1e-3 at unseen frequencies; K = 4
-    (first 10 plants): HTF error and Floquet exponents (modulo jω_p) <= 1e-3."""
+    (first 6 plants; all 30 in examples/generic_identification_study.py): HTF
+    error and Floquet exponents (modulo jω_p) <= 1e-3."""
     worst = {3: [0.0, 0.0], 4: [0.0, 0.0]}
     for i, (seed, n, ny) in enumerate(PLANTS):
         plant = random_ltp(seed, n, ny)
-        for K in (3, 4) if i < 10 else (3,):
+        for K in (3, 4) if i < 6 else (3,):
             model, _ = _identify(plant, K)
             cmp = ltp.compare_ltp(model, plant, UNSEEN)
             worst[K] = np.maximum(worst[K], [cmp.htf_error, cmp.exponent_error])
@@ -142,7 +143,8 @@ def test_replicas_default_and_alias_warning():
 
 
 def test_unusable_lines_dropped_and_skipped():
-    with pytest.warns(UserWarning, match='dropped 1'):
+    with pytest.warns(UserWarning, match='multiples'), \
+            pytest.warns(UserWarning, match='dropped 1'):
         exc = ltp.sine_experiments([np.pi, 4.0, 5.5], 1.0, dt=0.05, nperiods=8,
                                    unusable='drop')
     assert exc.frequencies.size == 2
