@@ -39,8 +39,6 @@ from ._discretize import d2c
 from ._fdsubspace import fdsubspace, FDSubspaceInfo
 from ._floquet_fit import _harmonic_response, fit_floquet
 from ._lifting import _harmonic_labels, _real_basis
-from ._ltpsys import LTPStateSpace
-from ._periodic_matrix import PeriodicMatrix
 from ._realization import FloquetRealization, floquet_realization
 from ._validation import (check_kwargs, check_period, check_positive_int,
                           real_array, steps_per_period)
