@@ -1,7 +1,10 @@
 """Every documentation page with runnable examples is collected by pytest."""
 
 import pathlib
-import tomllib
+
+import pytest
+
+tomllib = pytest.importorskip('tomllib')      # Python >= 3.11
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
