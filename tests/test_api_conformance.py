@@ -122,6 +122,9 @@ KWARG_CALLS = {
     'LTPStateSpace.htf': lambda **kw: SYS.htf(1, **kw),
     'LTPStateSpace.sample': lambda **kw: SYS.sample(0.1, **kw),
     'HTF.plot': lambda **kw: H.plot(omega_num=5, **kw),
+    'compare_ltp': lambda **kw: ltp.compare_ltp(SYS, SYS, [1.0], **kw),
+    'select_structure': lambda **kw: ltp.select_structure(ltp.lifted_frequency_response(
+        _SINE_RESPONSE, 0.5, 1, transient=6.0), 0.5, [1], [0], **kw),
 }
 
 # autonomous plants: limit cycles, return maps, continuation
@@ -194,7 +197,8 @@ def test_unknown_keyword_is_rejected(name):
 
 # result containers document their fields under Attributes, not Parameters
 _RESULT_CLASSES = {'Excitation', 'HTFFit', 'DelayEstimate', 'FDSubspaceInfo',
-                   'PeriodicOrbit', 'FloquetRealization', 'MatrixErrors', 'LTPSubspaceInfo'}
+                   'PeriodicOrbit', 'FloquetRealization', 'MatrixErrors', 'LTPSubspaceInfo',
+                   'LTPComparison', 'StructureSelection'}
 _RESULT_CLASSES |= {'OrbitBranch', 'Bifurcation'}
 _RESULT_CLASSES |= {'LMIDesign'}
 
