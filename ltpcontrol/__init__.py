@@ -37,6 +37,11 @@ from ._lyapunov import lyap, dlyap, gram
 from ._norms import norm
 from ._zeros import zeros
 from ._harmonic_ss import harmonic_ss
+from ._riccati import care, dare
+from ._design import lqr, dlqr, lqe, dlqe, lqg
+from ._place import place
+from ._lmi import lmi_statefbk, LMIDesign
+from ._reduction import hsvd, balred, minreal
 
 __version__ = "0.1.0"
 
@@ -69,4 +74,7 @@ __all__ = [
     'compare_ltp', 'LTPComparison', 'select_structure', 'StructureSelection',
     # analysis: Lyapunov equations, gramians, zeros, norms
     'lyap', 'dlyap', 'gram', 'norm', 'zeros', 'harmonic_ss',
+    # control design
+    'care', 'dare', 'lqr', 'dlqr', 'lqe', 'dlqe', 'lqg', 'place',
+    'lmi_statefbk', 'LMIDesign', 'hsvd', 'balred', 'minreal',
 ]

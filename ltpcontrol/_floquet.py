@@ -555,6 +555,37 @@ def _assemble(sys, grid, G, E, R):
     return sysF, P
 
 
+def chebyshev_nodes(degree):
+    """Chebyshev points ``(1 - cos(jπ/D))/2``, j = 0..D, on [0, 1]."""
+    return 0.5 * (1 - np.cos(np.pi * np.arange(degree + 1) / degree))
+
+
+def piecewise_chebyshev(grid, values):
+    """Callable interpolating matrix values given on every grid interval.
+
+    ``values[k, j]`` is the value at ``t_k + h_k c_j`` (`chebyshev_nodes`);
+    evaluation (at times taken modulo ``grid[-1]``) is by the barycentric
+    formula on the interval that contains t.
+    """
+    period, starts, h = grid[-1], grid[:-1], np.diff(grid)
+    degree = values.shape[1] - 1
+    cheb = chebyshev_nodes(degree)
+    bary = (-1.0) ** np.arange(degree + 1)
+    bary[[0, -1]] *= 0.5
+
+    def evaluate(t):
+        tau = np.mod(np.atleast_1d(np.asarray(t, float)), period)
+        k = np.clip(np.searchsorted(starts, tau, side='right') - 1, 0, len(starts) - 1)
+        xi = np.clip((tau - starts[k]) / h[k], 0.0, 1.0)
+        diff = xi[:, None] - cheb[None, :]
+        hit = diff == 0
+        with np.errstate(divide='ignore'):
+            weights = np.where(hit.any(axis=1, keepdims=True), hit.astype(float), bary / diff)
+        weights /= weights.sum(axis=1, keepdims=True)
+        return np.einsum('sj,sj...->s...', weights, values[k])
+    return evaluate
+
+
 def _chebyshev_transform(A, grid, G, E, R):
     """Callable P(t) interpolating exact values on every grid interval.
 
@@ -564,9 +595,7 @@ def _chebyshev_transform(A, grid, G, E, R):
     """
     n = G.shape[1]
     period, starts, h = grid[-1], grid[:-1], np.diff(grid)
-    cheb = 0.5 * (1 - np.cos(np.pi * np.arange(_CHEB_DEG + 1) / _CHEB_DEG))
-    bary = (-1.0) ** np.arange(_CHEB_DEG + 1)
-    bary[[0, -1]] *= 0.5
+    cheb = chebyshev_nodes(_CHEB_DEG)
     zero = PeriodicMatrix.constant(np.zeros((n, 0)), A.period)
     nodes = starts[:, None] + h[:, None] * cheb                        # (M, D+1)
     # Φ(s_j, t_k) = Φ(s_j, s_{j-1}) ... Φ(s_1, s_0): short steps, chained
@@ -586,16 +615,7 @@ def _chebyshev_transform(A, grid, G, E, R):
                       f"number up to {cond:.1e}): B_F = P^{{-1}} B is large and the "
                       "Floquet form amplifies rounding errors", UserWarning, stacklevel=4)
 
-    def transform(t):
-        tau = np.mod(np.atleast_1d(np.asarray(t, float)), period)
-        k = np.clip(np.searchsorted(starts, tau, side='right') - 1, 0, len(starts) - 1)
-        xi = np.clip((tau - starts[k]) / h[k], 0.0, 1.0)
-        diff = xi[:, None] - cheb[None, :]
-        hit = diff == 0
-        with np.errstate(divide='ignore'):
-            weights = np.where(hit.any(axis=1, keepdims=True), hit.astype(float), bary / diff)
-        weights /= weights.sum(axis=1, keepdims=True)
-        return np.einsum('sj,sjab->sab', weights, values[k])
+    transform = piecewise_chebyshev(grid, values)
 
     # check the interpolant against exact values inside every interval
     probe = starts + 0.3717 * h

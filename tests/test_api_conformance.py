@@ -200,6 +200,7 @@ _RESULT_CLASSES = {'Excitation', 'HTFFit', 'DelayEstimate', 'FDSubspaceInfo',
                    'PeriodicOrbit', 'FloquetRealization', 'MatrixErrors', 'LTPSubspaceInfo',
                    'LTPComparison', 'StructureSelection'}
 _RESULT_CLASSES |= {'OrbitBranch', 'Bifurcation'}
+_RESULT_CLASSES |= {'LMIDesign'}
 
 DOC_DEFECTS = {}
 
