@@ -29,6 +29,8 @@ from ._hybrid_ls import hybrid_ls, HybridLSResult
 from ._realization import floquet_realization, FloquetRealization
 from ._canonical import to_canonical, matrix_errors, MatrixErrors
 from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
+from ._refine import refine_ltp, RefineInfo
+from ._montecarlo import monte_carlo, MonteCarloResult
 
 __version__ = "0.1.0"
 
@@ -57,4 +59,6 @@ __all__ = [
     'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
+    # noisy data and Monte-Carlo studies
+    'refine_ltp', 'RefineInfo', 'monte_carlo', 'MonteCarloResult',
 ]
