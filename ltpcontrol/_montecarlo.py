@@ -7,6 +7,7 @@ pool on one machine, or any backend made active with
 ``joblib.parallel_config`` (for example Dask's on a cluster).
 """
 
+import multiprocessing
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -59,6 +60,20 @@ def _draw(func, index, seq, args, kwargs):
     except Exception as exc:
         raise RuntimeError(f"monte_carlo: draw {index} raised "
                            f"{type(exc).__name__}: {exc}") from exc
+
+
+def _checked(value, i, first):
+    """Draw i's value as an array, checked against draw 0."""
+    value = np.asarray(value)
+    if value.dtype.kind not in 'biufc':
+        raise ValueError(f"draw {i} returned {value.dtype} values; func must return "
+                         "numbers (an array of fixed shape)")
+    if first is not None and value.shape != first.shape:
+        raise ValueError(f"draw {i} returned shape {value.shape}, draw 0 returned "
+                         f"{first.shape}: every draw must return the same shape")
+    if not np.all(np.isfinite(value)):
+        raise ValueError(f"draw {i} returned non-finite values")
+    return value
 
 
 def monte_carlo(func, ndraws, *, seed=None, n_jobs=None, timeout=None, progress=False,
@@ -141,18 +156,13 @@ def monte_carlo(func, ndraws, *, seed=None, n_jobs=None, timeout=None, progress=
              for i, seq in enumerate(root.spawn(ndraws)))
     runner = Parallel(n_jobs=n_jobs, timeout=timeout, return_as='generator')
     values = []
-    for i, value in enumerate(tqdm(runner(tasks), total=ndraws, desc="Monte Carlo",
-                                   disable=(not progress) or None, leave=False)):
-        value = np.asarray(value)
-        if value.dtype.kind not in 'biufc':
-            raise ValueError(f"draw {i} returned {value.dtype} values; func must return "
-                             "numbers (an array of fixed shape)")
-        if values and value.shape != values[0].shape:
-            raise ValueError(f"draw {i} returned shape {value.shape}, draw 0 returned "
-                             f"{values[0].shape}: every draw must return the same shape")
-        if not np.all(np.isfinite(value)):
-            raise ValueError(f"draw {i} returned non-finite values")
-        values.append(value)
+    try:
+        for value in tqdm(runner(tasks), total=ndraws, desc="Monte Carlo",
+                          disable=(not progress) or None, leave=False):
+            values.append(_checked(value, len(values), values[0] if values else None))
+    except multiprocessing.TimeoutError:
+        raise TimeoutError(f"monte_carlo: a draw did not finish within timeout={timeout} "
+                           f"s ({len(values)} of {ndraws} draws collected)") from None
     samples = np.stack(values)
     flat = samples.reshape(ndraws, -1)
     mean = flat.mean(axis=0)

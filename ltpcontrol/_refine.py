@@ -128,8 +128,11 @@ class RefineInfo:
 
 
 # ------------------------------------------------------------------ data
-def _data_points(data, period, ny, nu):
-    """Harmonic index k, input frequency Ω, values (P, ny, nu), std or None."""
+def _data_points(data, period, ny, nu, std=None):
+    """Harmonic index k, input frequency Ω, values (P, ny, nu), std or None, K."""
+    if std is not None and not isinstance(data, ct.FrequencyResponseData):
+        raise ControlArgument("std applies to lifted frequency-response data; an HTF "
+                              "carries its own std")
     if isinstance(data, HTF):
         if data.omega is None:
             raise ControlArgument("data must be a data HTF (from estimate_htf) or lifted "
@@ -157,7 +160,15 @@ def _data_points(data, period, ny, nu):
         k = np.repeat(np.arange(-K, K + 1), data.omega.size)
         Om = np.tile(data.omega, H)
         vals = np.transpose(Gc, (0, 2, 1)).reshape(-1, ny, 1)
-        std = None
+        if std is not None:
+            std = real_array(std, 'std', ndim=(0, 1, 2, 3))
+            try:
+                std = np.broadcast_to(std, (H, ny, data.omega.size))
+            except ValueError:
+                raise ControlDimension(f"std of shape {std.shape} does not broadcast to "
+                                       f"(2K+1, ny, nlines) = {(H, ny, data.omega.size)}"
+                                       ) from None
+            std = np.transpose(std, (0, 2, 1)).reshape(vals.shape)
     else:
         raise ControlArgument("data must be an HTF (estimate_htf) or the "
                               "FrequencyResponseData of lifted_frequency_response, got "
@@ -187,6 +198,10 @@ def _modal(A):
         raise ValueError("A has complex eigenvalues without conjugate partners")
     lam = np.array([o[0] for o in order])
     V = np.stack([o[1] for o in order], axis=1)
+    gap = np.abs(lam[:, None] - lam[None, :]) + np.diag(np.full(lam.size, np.inf))
+    if lam.size > 1 and gap.min() <= 1e-8 * scale:
+        raise ValueError("A has repeated eigenvalues: the modal parametrisation needs "
+                         "distinct eigenvalues")
     if np.linalg.cond(V) > _COND_MODAL:
         raise ValueError("A is (nearly) defective: its eigenvector matrix has condition "
                          f"number {np.linalg.cond(V):.2g}; the modal parametrisation needs "
@@ -375,7 +390,7 @@ def _harmonics(harmonics, sys, K):
     return tuple(check_positive_int(h, 'harmonics', minimum=0) for h in harmonics)
 
 
-def refine_ltp(sys, data, *, harmonics=None, weighted=True, stable=False, refine_a=True,
+def refine_ltp(sys, data, *, std=None, harmonics=None, weighted=True, stable=False, refine_a=True,
                estimate_d=None, maxiter=200, tol=1e-10, return_info=False, name=None,
                **kwargs):
     r"""Maximum-likelihood refinement of a Floquet-form LTP model on frequency data.
@@ -398,7 +413,12 @@ def refine_ltp(sys, data, *, harmonics=None, weighted=True, stable=False, refine
         A data HTF (`estimate_htf`): all components ``G_k(jω)`` that are not
         NaN are fitted, weighted by ``1/std`` when the HTF carries `std`.
         Or the real lifted response of `lifted_frequency_response` (as for
-        `identify_ltp`), fitted with equal weights.
+        `identify_ltp`), weighted by `std` when given.
+    std : array_like, optional
+        Lifted frequency-response data only: standard deviations of the
+        complex harmonic responses ``G_n(jΩ)`` (which the real lifted
+        coordinates share), broadcastable to ``(2K+1, ny, nlines)``, e.g.
+        one value per line.
     harmonics : int or (int, int, int), optional
         Numbers ``(K_B, K_C, K_D)`` of harmonics of B, C and D in the
         refined model.  Default: those of `sys` (for matrices given as
@@ -512,7 +532,7 @@ def refine_ltp(sys, data, *, harmonics=None, weighted=True, stable=False, refine
         if decay < 0:
             raise ValueError(f"stable must be True, False or a decay rate >= 0, got {decay}")
     period, wp = sys.period, 2 * np.pi / sys.period
-    k, Om, vals, std, K = _data_points(data, period, sys.noutputs, sys.ninputs)
+    k, Om, vals, std, K = _data_points(data, period, sys.noutputs, sys.ninputs, std)
     KB, KC, KD = _harmonics(harmonics, sys, K)
     if estimate_d is None:
         estimate_d = bool(np.any(sys.D.fourier(KD) != 0))
