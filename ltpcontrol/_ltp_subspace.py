@@ -275,6 +275,7 @@ class LTPSubspaceInfo:
 
 def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
                  realization='direct', realization_options=None, refit_a=True,
+                 refine=None, refine_options=None,
                  estimate_d=True,
                  seed=None, progress=False,
                  return_info=False, name=None, **kwargs):
@@ -336,6 +337,13 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         Seed of the 'pso' realization search (reproducibility).
     progress : bool, optional
         Show progress bars (experiment batches, realization).
+    refine : {None, 'ml'}, optional
+        'ml': finish with `ltpcontrol.refine_ltp` on the lifted data (the
+        maximum-likelihood fit of the Floquet-form model, equal weights
+        unless ``refine_options`` gives ``std``); default None.
+    refine_options : dict, optional
+        Keywords of `ltpcontrol.refine_ltp` (``std``, ``stable``,
+        ``harmonics``, ...).
     return_info : bool, optional
         Also return an `LTPSubspaceInfo`.
     name : str, optional
@@ -409,6 +417,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
     if conversion not in _CONVERSIONS:
         raise ValueError(f"conversion must be one of {_CONVERSIONS}, got {conversion!r}")
+    if refine not in (None, 'ml'):
+        raise ValueError(f"refine must be None or 'ml', got {refine!r}")
     if isinstance(data, ct.FrequencyResponseData):
         if lfr_kwargs:
             raise TypeError(f"identify_ltp: {sorted(lfr_kwargs)} only apply to time "
@@ -461,6 +471,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         sysc = d2c(sysd, 'log', name=name, **labels)
         if conversion == 'refit':
             sysc = _refit(sysc, Gc, G.omega, K, estimate_d, refit_a, name, labels)
+    if refine == 'ml':
+        sysc = _ml_refine(sysc, G, refine_options)
     if not return_info:
         return sysc
     resid = _harmonic_response(sysc, G.omega, K) - Gc
@@ -707,3 +719,9 @@ def _refit(sys, Gc, omega, K, estimate_d, refit_a, name, labels, maxiter=30,
     return LTPStateSpace(A, PeriodicMatrix(Bc, period), PeriodicMatrix(Cc, period),
                          PeriodicMatrix(Dc, period), period, name=name,
                          states=sys.state_labels, **labels)
+
+
+def _ml_refine(sys, data, options):
+    """``refine='ml'`` of `identify_ltp`: `refine_ltp` on the lifted data."""
+    from ._refine import refine_ltp
+    return refine_ltp(sys, data, **(options or {}))

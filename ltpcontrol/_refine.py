@@ -60,6 +60,8 @@ _COND_MODAL = 1e8
 _REAL_TOL = 1e-9
 # Fisher information condition number above which parameters are unidentifiable
 _COND_FISHER = 1e12
+# Re λ is kept above -_FAST times the largest frequency of the data
+_FAST = 1e4
 
 
 @dataclass(frozen=True)
@@ -572,7 +574,9 @@ def refine_ltp(sys, data, *, std=None, harmonics=None, weighted=True, stable=Fal
         Jz = (J[rows] @ par.M) * weight[:, None]
         return f, np.vstack([Jz.real, Jz.imag])
 
+    # a mode much faster than the data is a feedthrough: bound Re λ from below
     lower = np.full(p, -np.inf)
+    lower[par.decay] = -_FAST * max(np.abs(Om).max() + (KB + 1) * wp, np.abs(lam).max())
     upper = np.full(p, np.inf)
     theta0 = par.theta0.copy()
     if decay is not None:
@@ -586,6 +590,7 @@ def refine_ltp(sys, data, *, std=None, harmonics=None, weighted=True, stable=Fal
         else:
             upper[par.decay] = bound
             theta0[par.decay] = np.minimum(theta0[par.decay], bound * (1 + 1e-3) - 1e-6 * wp)
+    theta0 = np.maximum(theta0, lower * (1 - 1e-3))
     f0 = residual(theta0)
     if maxiter == 0:
         theta, nfev, njev, success, message = theta0, 1, 1, True, "evaluated, not refined"

@@ -228,3 +228,27 @@ def test_bad_input():
     few = ltp.HTF(H.components()[1][:, :, :, :2], H.omega[:2], 1.0)
     with pytest.raises(ValueError, match="cannot determine"):
         ltp.refine_ltp(true, few, harmonics=(3, 6, 0))
+
+
+def test_identify_ltp_refine_hook():
+    # identify_ltp(..., refine='ml') equals refine_ltp on its own model
+    true = random_floquet(12, nx=2, KB=1, KC=1)
+    T, K, N = true.period, 1, 20
+    w = 2 * np.pi / T * (np.arange(1, 40) / 8 + 1 / 16)
+    H = ltp.htf(true, K)
+    Gn = np.stack([H.components(w + n * 2 * np.pi / T)[1][n + K] for n in range(-K, K + 1)])
+    from ltpcontrol._lifting import _real_basis
+    V, _ = _real_basis(np.arange(-K, K + 1), N)
+    rng = np.random.default_rng(0)
+    noise = 1e-3 * (rng.standard_normal(Gn.shape) + 1j * rng.standard_normal(Gn.shape))
+    frd = ct.frd((V.conj().T @ (Gn + noise)[:, 0, 0])[:, None, :], w, dt=T / N)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        base = ltp.identify_ltp(frd, T, 2, K, q=12)
+        hooked = ltp.identify_ltp(frd, T, 2, K, q=12, refine='ml',
+                                  refine_options={'std': 1e-3 * np.sqrt(2)})
+    direct = ltp.refine_ltp(base, frd, std=1e-3 * np.sqrt(2))
+    assert np.allclose(np.sort_complex(np.linalg.eigvals(hooked.A(0.0))),
+                       np.sort_complex(np.linalg.eigvals(direct.A(0.0))), atol=1e-8)
+    with pytest.raises(ValueError, match="refine must be"):
+        ltp.identify_ltp(frd, T, 2, K, q=12, refine='pem')
