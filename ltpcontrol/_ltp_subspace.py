@@ -331,12 +331,6 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         ``B``, ``C``, ``D`` (default True, which makes the result independent
         of `q`); False keeps the 'log' ``A`` and refits ``B``, ``C``, ``D``
         given ``A`` only.
-    estimate_d : bool, optional
-        Estimate a feedthrough (default True); False forces ``D = 0``.
-    seed : int, optional
-        Seed of the 'pso' realization search (reproducibility).
-    progress : bool, optional
-        Show progress bars (experiment batches, realization).
     refine : {None, 'ml'}, optional
         'ml': finish with `ltpcontrol.refine_ltp` on the lifted data (the
         maximum-likelihood fit of the Floquet-form model, equal weights
@@ -344,6 +338,12 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     refine_options : dict, optional
         Keywords of `ltpcontrol.refine_ltp` (``std``, ``stable``,
         ``harmonics``, ...).
+    estimate_d : bool, optional
+        Estimate a feedthrough (default True); False forces ``D = 0``.
+    seed : int, optional
+        Seed of the 'pso' realization search (reproducibility).
+    progress : bool, optional
+        Show progress bars (experiment batches, realization).
     return_info : bool, optional
         Also return an `LTPSubspaceInfo`.
     name : str, optional
