@@ -75,8 +75,8 @@ lfr = dict(transient=TRANSIENT, input_hold='foh', hold_step=TS / OVERSAMPLE)
 def line_std(yw):
     """Std of each line's harmonic response from the DFT bins between the lines.
 
-    Output lines lie at ``Ω + nω_p``, i.e. on the bins ``≡ Ω (mod P)`` of a
-    window of P periods; every other bin holds noise only.  With ``Y =
+    A real output has lines at ``±Ω + nω_p``, i.e. on the bins ``≡ ±Ω (mod
+    P)`` of a window of P periods; every other bin holds noise only.  With ``Y =
     (1/L) Σ y e^{-jωt}`` a noise bin has variance ``σ²/L`` and ``G = Y/U``,
     ``U = 1/2`` for a unit cosine.
     """
@@ -85,7 +85,8 @@ def line_std(yw):
     spec = np.fft.rfft(yw, axis=-1) / L
     line = np.rint(FREQS * L * TS).astype(int)
     bins = np.arange(spec.shape[-1])
-    noise = (bins[None, :] - line[:, None]) % P != 0
+    offset = bins[None, :] - line[:, None]
+    noise = (offset % P != 0) & ((offset + 2 * line[:, None]) % P != 0)
     noise &= (bins[None, :] % P != 0) & (bins[None, :] > 0)
     var = np.sum(np.abs(spec) ** 2 * noise, axis=-1) / noise.sum(axis=-1)
     return 2 * np.sqrt(var)

@@ -599,9 +599,10 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     HTF
         Data HTF on the estimated grid, with ``std`` (standard deviation of
         each component, NaN where the component is; None when the residual
-        has no degrees of freedom, e.g. exactly ``(2K+1)·nu`` windows) and ``diagnostics`` holding ``identified`` (bool, shape
-        of the components: True where ``U(ω - kω_p)`` of the input is
-        excited, so that the data determine ``G_k(jω)``), ``cond`` (of
+        has no degrees of freedom, e.g. exactly ``(2K+1)·nu`` windows) and
+        ``diagnostics`` holding ``identified`` (bool, shape of the
+        components: True where ``U(ω - kω_p)`` of the input is excited, so
+        that the data determine ``G_k(jω)``), ``cond`` (of
         ``Φ_UU`` over the identified components per frequency, NaN where
         there are none), ``residual`` (RMS per output), ``noise_var``,
         ``alpha``, ``dof``, ``gcv``, ``nrecords`` and ``harmonic_test`` (see
