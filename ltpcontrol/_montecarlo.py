@@ -36,8 +36,9 @@ class MonteCarloResult:
     sem : ndarray
         Standard error of the mean, ``sqrt(diag(cov) / ndraws)``, shaped
         like `mean`.
-    seed : int or None
-        Entropy of the root `numpy.random.SeedSequence`.
+    seed : int
+        Entropy of the root `numpy.random.SeedSequence`: passing it as
+        `seed` repeats the study (also when it was drawn at random).
 
     Examples
     --------
@@ -50,7 +51,7 @@ class MonteCarloResult:
     mean: np.ndarray
     cov: np.ndarray = field(repr=False)
     sem: np.ndarray
-    seed: int | None
+    seed: int
 
 
 def _draw(func, index, seq, args, kwargs):
@@ -172,5 +173,4 @@ def monte_carlo(func, ndraws, *, seed=None, n_jobs=None, timeout=None, progress=
     sem = np.sqrt(np.real(np.diag(cov)) / ndraws)
     shape = samples.shape[1:]
     return MonteCarloResult(samples=samples, mean=mean.reshape(shape), cov=cov,
-                            sem=sem.reshape(shape), seed=root.entropy if seed is not None
-                            else None)
+                            sem=sem.reshape(shape), seed=root.entropy)

@@ -81,3 +81,9 @@ def test_dask_backend_gives_the_same_samples():
         with joblib.parallel_config(backend='dask'):
             res = ltp.monte_carlo(_normal_pair, 16, seed=3)
     assert np.array_equal(res.samples, ltp.monte_carlo(_normal_pair, 16, seed=3).samples)
+
+
+def test_unseeded_study_can_be_repeated():
+    first = ltp.monte_carlo(_normal_pair, 5)
+    again = ltp.monte_carlo(_normal_pair, 5, seed=first.seed)
+    assert np.array_equal(first.samples, again.samples)
