@@ -12,6 +12,7 @@ import control as ct
 import numpy as np
 import pytest
 import scipy.linalg
+from hypothesis import given, settings, strategies as st
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
@@ -252,3 +253,18 @@ def test_identify_ltp_refine_hook():
                        np.sort_complex(np.linalg.eigvals(direct.A(0.0))), atol=1e-8)
     with pytest.raises(ValueError, match="refine must be"):
         ltp.identify_ltp(frd, T, 2, K, q=12, refine='pem')
+
+
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 10 ** 6), nx=st.integers(1, 4), ny=st.integers(1, 2),
+       nu=st.integers(1, 2), pair=st.booleans())
+def test_modal_pivot_form_is_a_state_transformation(seed, nx, ny, nu, pair):
+    # maxiter=0 only changes the state basis: the HTF is unchanged
+    sys = random_floquet(seed, nx=nx, ny=ny, nu=nu, KC=2, d=0.2,
+                         complex_pair=pair and nx >= 2)
+    H, G = data_htf(sys, 2, OMEGA[::4], std=1.0)
+    model, info = ltp.refine_ltp(sys, H, maxiter=0, return_info=True)
+    _, Gm = ltp.htf(model, 2).components(OMEGA[::4])
+    assert np.allclose(Gm, G, atol=1e-9 * np.abs(G).max())
+    assert info.cost < 1e-16 * np.abs(G).max() ** 2 * G.size
+    assert np.linalg.matrix_rank(info.fisher) == info.x.size
