@@ -42,6 +42,8 @@ from ._design import lqr, dlqr, lqe, dlqe, lqg
 from ._place import place
 from ._lmi import lmi_statefbk, LMIDesign
 from ._reduction import hsvd, balred, minreal
+from ._refine import refine_ltp, RefineInfo
+from ._montecarlo import monte_carlo, MonteCarloResult
 
 __version__ = "0.1.0"
 
@@ -77,4 +79,6 @@ __all__ = [
     # control design
     'care', 'dare', 'lqr', 'dlqr', 'lqe', 'dlqe', 'lqg', 'place',
     'lmi_statefbk', 'LMIDesign', 'hsvd', 'balred', 'minreal',
+    # noisy data and Monte-Carlo studies
+    'refine_ltp', 'RefineInfo', 'monte_carlo', 'MonteCarloResult',
 ]
