@@ -28,8 +28,7 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
-from ._ltpsys import LTPStateSpace
-from ._validation import check_kwargs, check_positive_int
+from ._validation import as_ltp, check_kwargs, check_positive_int
 
 __all__ = ['lift']
 
@@ -104,11 +103,7 @@ def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, **kwar
     ((4, 4), 1.0)
     """
     check_kwargs(kwargs, 'lift')
-    if not isinstance(sysd, LTPStateSpace):
-        raise ControlArgument(f"sysd must be an LTPStateSpace, got {type(sysd).__name__}")
-    if not sysd.isdtime(strict=True):
-        raise ValueError("sysd must be a discrete-time system (lift the result of "
-                         "sample_system); got a continuous-time one")
+    sysd = as_ltp(sysd, 'sysd', discrete=True)
     if method not in ('frequency', 'time'):
         raise ValueError(f"method must be 'frequency' or 'time', got {method!r}")
     if not isinstance(real, (bool, np.bool_)):
