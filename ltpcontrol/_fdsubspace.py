@@ -75,7 +75,7 @@ def fdsubspace(data, omega=None, order=None, *, q=None, dt=None, weights=None,
     r"""Identify an LTI state-space model from frequency-response data.
 
     Frequency-domain subspace identification of McKelvey, Akçay and Ljung
-    (1996), algorithm for arbitrarily spaced frequencies.  It is non-iterative
+    [McKelvey1996]_, algorithm for arbitrarily spaced frequencies.  It is non-iterative
     and exact on noise-free data of a system of the identified order.
 
     Parameters

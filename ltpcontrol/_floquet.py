@@ -85,7 +85,8 @@ def floquet_multipliers(sys, nsteps=None):
 
     Computed by the periodic real Schur decomposition of the factors
     ``H_1 H_2 ... H_p`` with ``H_1 = Φ_{M-1}, ..., H_p = Φ_0`` (SLICOT
-    MB03VD/MB03WD) without forming the product.
+    MB03VD/MB03WD) without forming the product; see [BittantiColaneri2009]_
+    for the theory and [Varga2008]_ for periodic Schur methods.
 
     Parameters
     ----------

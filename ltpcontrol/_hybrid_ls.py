@@ -6,7 +6,7 @@ The model (thesis §4.1) is a linear time-periodic system
 
 whose `M` modes are switched on by known rectangular functions ``s^i(t) = 1`` on
 ``[t_i, t_{i+1}) + nT``.  Each mode is a smooth periodic matrix truncated to
-``K`` harmonics, ``A^i(t) = Σ_{|k|≤K} A^i_k e^{jkω_p t}``.  In the frequency domain
+```K``` harmonics, ``A^i(t) = Σ_{|k|≤K} A^i_k e^{jkω_p t}``.  In the frequency domain
 (eq. 4.11)
 
     jω X(ω) = Σ_i Σ_k A^i_k X^i_k(ω) + Σ_i Σ_k B^i_k U^i_k(ω),
@@ -49,7 +49,7 @@ class HybridLSResult:
     B : array_like, shape (M, 2K+1, n, m)
         Fourier coefficients of the mode input matrices.
     period : float
-        Period `T` of the system.
+        Period ``T`` of the system.
     switching_times : array_like, shape (M,)
         Mode start times ``t_1 = 0 < t_2 < ... < t_M < T``.
     nequations, rank : int, optional
@@ -65,11 +65,11 @@ class HybridLSResult:
     B : ndarray, shape (M, 2K+1, n, m), complex
         Fourier coefficients of the mode input matrices ``B^i(t)``.
     period : float
-        Period `T`.
+        Period ``T``.
     switching_times : ndarray, shape (M,)
         Mode start times.
     nharmonics : int
-        Number `K` of harmonics per mode.
+        Number ``K`` of harmonics per mode.
     nunknowns : int
         Number of real unknowns per state component, ``M (2K+1) (n+m)``.
     nequations, rank : int or None
@@ -191,22 +191,22 @@ def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, *, nconv=None,
     u : array_like or list of array_like
         Inputs, shape (m, L) (or (L,) when m = 1), one array per record.
     period : float
-        Period `T` of the system.
+        Period ``T`` of the system.
     switching_times : array_like
         Mode start times ``t_1 = 0 < t_2 < ... < t_M < T`` (thesis eq. 4.3);
         ``[0]`` identifies a single smooth LTP system.
     nharmonics : int, optional
-        Number of harmonics `K` estimated for each ``A^i(t)``, ``B^i(t)``
-        (thesis `K`); ``K = 0`` gives a piecewise LTI model.  Default 1.
+        Number of harmonics ``K`` estimated for each ``A^i(t)``, ``B^i(t)``
+        (thesis ``K``); ``K = 0`` gives a piecewise LTI model.  Default 1.
 
     nconv : int, optional
-        Truncation `N` of the convolution ``X^i_k(ω) = Σ_{|n|≤N} S^i_{n-k}
-        X(ω - nω_p)`` with the switching-function coefficients (thesis `N`,
-        Remark 3).  Default: the largest `N` with ``N ω_p`` below the Nyquist
+        Truncation ``N`` of the convolution ``X^i_k(ω) = Σ_{|n|≤N} S^i_{n-k}
+        X(ω - nω_p)`` with the switching-function coefficients (thesis ``N``,
+        Remark 3).  Default: the largest ``N`` with ``N ω_p`` below the Nyquist
         frequency of the slowest-sampled record.
     nshifts : int, optional
         Equations are formed at ``ω + hω_p`` for ``|h| ≤ nshifts`` around every
-        excited input frequency ``ω`` (thesis `h`, eq. 4.19).  The input
+        excited input frequency ``ω`` (thesis ``h``, eq. 4.19).  The input
         spectrum sits on the excited lines only, so these equations see the
         harmonics ``|h| <= nshifts`` of ``B(t)`` (and, when the states carry no
         harmonics beyond the input lines, of ``A(t)``): a unique estimate
@@ -254,10 +254,10 @@ def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, *, nconv=None,
     excited line.  Records must therefore start from the periodic steady
     state; a lightly damped LTP (Floquet multipliers near the unit circle)
     needs the exact periodic initial state ``x0 = (I - Φ)^{-1} x_forced``
-    (see the research note ``thesis-errata.md``).
+    (see :ref:`thesis-notes`).  The method is that of [Uyanik2016b]_.
 
     The error floor is set by aliasing of the non-smooth state and by the
-    truncation `N`; it falls as the sampling rate and `nconv` grow.  On the
+    truncation ``N``; it falls as the sampling rate and `nconv` grow.  On the
     switching Mathieu example of thesis §4.1.3 the largest coefficient error
     is about 2e-2 at 100 Hz and 2e-4 at 1 kHz.  Work and memory grow as
     (excited lines) x (2h+1) x (2N+1) x (n+m); lower `nconv` for broadband
