@@ -19,8 +19,9 @@ PACKAGE = pathlib.Path(__file__).resolve().parents[1] / 'ltpcontrol'
 #: layers listed before it.
 LAYERS = {
     # systems, periodic matrices, simulation, Floquet theory, frequency domain
-    'core': ['_validation', '_transition', '_periodic_matrix', '_ltpsys', '_timeresp',
-             '_floquet', '_htf', '_htfplot', '_discretize', '_lifting', '_metrics'],
+    'core': ['_validation', '_transition', '_march', '_periodic_matrix', '_ltpsys',
+             '_timeresp', '_floquet', '_htf', '_htfplot', '_discretize', '_lifting',
+             '_metrics'],
     # analysis and synthesis on LTP models
     'analysis': ['_lyap', '_riccati', '_norms', '_zeros', '_design', '_reduction',
                  '_interconnect'],
@@ -75,7 +76,7 @@ def violations(graph, layers, top=frozenset()):
             continue
         if mod not in rank:
             errors.append(f"{mod} has no layer: add it to LAYERS in tests/test_layering.py "
-                          f"(one of {names}) and to the layer map on the Developer notes page")
+                          f"(one of {names}); the Developer notes page shows that map")
             continue
         for dep in sorted(graph[mod]):
             if dep in top:
