@@ -18,8 +18,10 @@ blocks of the transition matrix Ψ of the block upper-triangular generator
     M(t) = [[-Aᵀ, Qa, 0], [0, A, Qf], [0, 0, -Aᵀ]]:
     Φ = Ψ22,  W = Ψ23 Φᵀ,  V = Φᵀ Ψ12,  S = tr(Φᵀ Ψ13),
 
-computed by the library's Magnus integrator (`_transition.step_transitions`)
-for every step at once.  Only the blocks that are asked for are built.
+computed by the library's integrator (`_transition.step_transitions`: one
+exponential per segment when A and the weights are piecewise constant,
+Magnus otherwise) for every step at once, with M evaluated block by block
+at the integrator's nodes.  Only the blocks that are asked for are built.
 The steps are short (``h ‖A‖ <= 1`` by default), so the growing blocks
 ``e^{-Aᵀh}`` stay moderate even for stiff A.
 """
@@ -66,6 +68,24 @@ def step_grid(A, others=(), nsteps=None):
     grid = grid[np.concatenate([np.diff(grid) > 0, [True]])]
     grid[-1] = T
     return grid
+
+
+def gram_weight(F, adjoint=False):
+    """``F Fᵀ`` (``Fᵀ F`` when `adjoint`) of a periodic matrix, pointwise.
+
+    Examples
+    --------
+    >>> from ltpcontrol._steps import gram_weight
+    >>> C = ltp.PeriodicMatrix.constant([[1.0, 2.0]], 1.0)
+    >>> gram_weight(C, adjoint=True)(0.0)
+    array([[1., 2.],
+           [2., 4.]])
+    """
+    if adjoint:
+        n, op = F.shape[1], lambda f: np.swapaxes(f, 1, 2) @ f
+    else:
+        n, op = F.shape[0], lambda f: f @ np.swapaxes(f, 1, 2)
+    return PeriodicMatrix._new(F.period, (n, n), combine=(op, [F]), breakpoints=F.breakpoints)
 
 
 def step_integrals(A, t0, h, Qf=None, Qa=None):
