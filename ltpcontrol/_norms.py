@@ -335,9 +335,8 @@ def _unit_circle_angles(sys, gamma, grid, values):
     """Angles of the unit-circle multipliers of H_γ, or None if there are none."""
     from ._floquet import _log_multipliers
     H = _hamiltonian(sys, gamma, values)
-    zero = PeriodicMatrix.constant(np.zeros((H.shape[0], 0)), sys.period)
     # the test needs the multipliers' moduli to well below _UNIT only
-    Phi, _, _ = step_transitions(H, zero, grid[:-1], np.diff(grid), rtol=1e-9)
+    Phi, _, _ = step_transitions(H, None, grid[:-1], np.diff(grid), rtol=1e-9)
     logmod, arg = _log_multipliers(None, None, grid=grid, factors=Phi)
     on = np.abs(logmod) < _UNIT
     return arg[on] if np.any(on) else None
