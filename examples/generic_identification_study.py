@@ -13,7 +13,7 @@ last row refits the K = 3 data with a model whose B(t) has K + 1 harmonics
 (``refit_harmonics=4``): the input harmonics just beyond the data's remove
 most of the truncation bias of the exponents.
 
-Run ``python examples/generic_identification_study.py`` (about a minute;
+Run ``python examples/generic_identification_study.py`` (about two minutes;
 ``LTP_EXAMPLES_QUICK=1`` uses 6 plants).
 """
 
