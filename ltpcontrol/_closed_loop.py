@@ -446,21 +446,21 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
 
     Examples
     --------
-    A ball bounced by a paddle force ``u`` (a hybrid plant forced with
-    period 1), with a proportional controller on the height:
+    A forced oscillator hitting a wall at ``x = 0`` (restitution 0.7), its
+    hopping orbit, and a proportional controller recovering from a push:
 
-    >>> def air(t, x, u, p):
-    ...     return [x[1], -9.81 + 5 * np.cos(2 * np.pi * t) + u[0]]
-    >>> mode = ltp.HybridMode(air, guard=lambda t, x, u, p: x[0] + 1,
-    ...                       reset=lambda t, x, u, p: [x[0], -0.5 * x[1]], target=0)
-    >>> ball = ltp.HybridPlant([mode], lambda t, x, u, p: [x[0]], states=2,
+    >>> def free(t, x, u, p):
+    ...     return [x[1], -40 * (x[0] - 0.1) - x[1] + 5 * np.cos(2 * np.pi * t) + u[0]]
+    >>> mode = ltp.HybridMode(free, guard=lambda t, x, u, p: x[0],
+    ...                       reset=lambda t, x, u, p: [x[0], -0.7 * x[1]], target=0)
+    >>> wall = ltp.HybridPlant([mode], lambda t, x, u, p: [x[0]], states=2,
     ...                        inputs=1, outputs=1)
-    >>> orbit = ltp.periodic_orbit(ball, 1.0, [0.0, 0.0], warmup=20)
-    >>> K = ct.ss([], [], [], [[-2.0]])
-    >>> resp = ltp.closed_loop_response(ball, K, orbit, np.linspace(0, 3, 31),
-    ...                                 orbit.x0 + [0.05, 0.0])
-    >>> resp.states.shape, resp.inputs.shape
-    ((2, 31), (1, 31))
+    >>> orbit = ltp.periodic_orbit(wall, 1.0, [0.2, 0.0], warmup=30)
+    >>> K = ct.ss([], [], [], [[-5.0]])
+    >>> resp = ltp.closed_loop_response(wall, K, orbit, np.linspace(0, 3, 31),
+    ...                                 orbit.x0 + [0.0, 0.5], saturation=(-2, 2))
+    >>> resp.states.shape, bool(np.abs(resp.inputs).max() <= 2)
+    ((2, 31), True)
     """
     opts = _solver_options(kwargs, 'closed_loop_response')
     check_kwargs(kwargs, 'closed_loop_response')
@@ -559,7 +559,7 @@ def _run_continuous(loop, opts, timepts, z, mode, vfun, bar):
 
 
 def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_state=None,
-                      tol=1e-10, max_iter=20, max_periods=200, **kwargs):
+                      tol=1e-10, max_iter=20, max_periods=20, **kwargs):
     """Periodic orbit of the closed hybrid loop and its Floquet multipliers.
 
     The loop of `closed_loop_response` (noise-free) is T-periodic; its
@@ -580,7 +580,8 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
     controller_state : array_like, optional
         Guess of the controller state at t = 0 (default 0).
     tol, max_iter, max_periods : optional
-        As in `periodic_orbit` (continuous controllers); discrete
+        As in `periodic_orbit` (defaults 1e-10, 20, 20; continuous
+        controllers); discrete
         controllers use `tol` and `max_iter` for Newton and fall back to
         `max_periods` periods of simulation.
     rtol, atol, method, max_events : optional
@@ -599,19 +600,21 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
 
     Examples
     --------
-    The loop of the `closed_loop_response` example; the proportional
-    gain speeds up the return to the orbit:
+    The loop of the `closed_loop_response` example stays stable; strong
+    positive feedback destabilises the orbit:
 
-    >>> def air(t, x, u, p):
-    ...     return [x[1], -9.81 + 5 * np.cos(2 * np.pi * t) + u[0]]
-    >>> mode = ltp.HybridMode(air, guard=lambda t, x, u, p: x[0] + 1,
-    ...                       reset=lambda t, x, u, p: [x[0], -0.5 * x[1]], target=0)
-    >>> ball = ltp.HybridPlant([mode], lambda t, x, u, p: [x[0]], states=2,
+    >>> def free(t, x, u, p):
+    ...     return [x[1], -40 * (x[0] - 0.1) - x[1] + 5 * np.cos(2 * np.pi * t) + u[0]]
+    >>> mode = ltp.HybridMode(free, guard=lambda t, x, u, p: x[0],
+    ...                       reset=lambda t, x, u, p: [x[0], -0.7 * x[1]], target=0)
+    >>> wall = ltp.HybridPlant([mode], lambda t, x, u, p: [x[0]], states=2,
     ...                        inputs=1, outputs=1)
-    >>> orbit = ltp.periodic_orbit(ball, 1.0, [0.0, 0.0], warmup=20)
-    >>> cl = ltp.closed_loop_orbit(ball, ct.ss([], [], [], [[-2.0]]), orbit)
-    >>> bool(cl.dominant_multiplier < np.abs(orbit.multipliers).max())
-    True
+    >>> orbit = ltp.periodic_orbit(wall, 1.0, [0.2, 0.0], warmup=30)
+    >>> cl = ltp.closed_loop_orbit(wall, ct.ss([], [], [], [[-5.0]]), orbit)
+    >>> cl.is_stable, cl.monodromy.shape
+    (True, (2, 2))
+    >>> ltp.closed_loop_orbit(wall, ct.ss([], [], [], [[60.0]]), orbit).is_stable
+    False
     """
     opts = _solver_options(kwargs, 'closed_loop_orbit')
     check_kwargs(kwargs, 'closed_loop_orbit')
