@@ -67,6 +67,7 @@ class _Loop:
             mats = (self.ctrl.A, self.ctrl.B, self.ctrl.C, self.ctrl.D)
             self._fixed = [M(0.0) if M.is_constant else None for M in mats]
             self._varying = [M for M in mats]
+            self._last = (None, None)
         self._ybar = _output_interpolant(plant, orbit)
         self._check_algebraic_loop()
 
@@ -82,9 +83,16 @@ class _Loop:
                              "proper")
 
     def matrices(self, t):
-        """Controller matrices ``A_c, B_c, C_c, D_c`` at time t (linear controllers)."""
-        return [F if F is not None else M._eval(np.array([t]))[0]
-                for F, M in zip(self._fixed, self._varying)]
+        """Controller matrices ``A_c, B_c, C_c, D_c`` at time t (linear controllers).
+
+        The last evaluation is kept: the loop's field, output and Jacobian
+        ask for the same t in turn, and designed gains (Riccati solutions)
+        are costly to evaluate.
+        """
+        if t != self._last[0]:
+            self._last = (t, [F if F is not None else M._eval(np.array([t]))[0]
+                              for F, M in zip(self._fixed, self._varying)])
+        return self._last[1]
 
     def ctrl_rhs(self, t, xc, e):
         if not self.linear:
