@@ -29,6 +29,7 @@ from ._hybrid_ls import hybrid_ls, HybridLSResult
 from ._realization import floquet_realization, FloquetRealization
 from ._canonical import to_canonical, matrix_errors, MatrixErrors
 from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
+from ._arx import identify_arx
 from ._closed_loop import ClosedLoopOrbit, closed_loop_response, closed_loop_orbit
 
 __version__ = "0.1.0"
@@ -58,6 +59,7 @@ __all__ = [
     'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
+    'identify_arx',
     # feedback around orbits of hybrid plants
     'ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit',
 ]
