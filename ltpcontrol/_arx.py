@@ -77,8 +77,9 @@ def identify_arx(data, period, na, nb, *, ridge=0.0, name=None, **kwargs):
     Raises
     ------
     ValueError
-        If some phase has fewer equations than coefficients, or the data
-        are not uniform or not commensurate with the period.
+        If some phase has fewer equations than coefficients or linearly
+        dependent regressors, or the data are not uniform or not
+        commensurate with the period.
 
     Examples
     --------
@@ -121,7 +122,12 @@ def identify_arx(data, period, na, nb, *, ridge=0.0, name=None, **kwargs):
             raise ValueError(f"phase {p} of {N} has {rows.sum()} equations for {na + nb} "
                              "coefficients: record more periods")
         P = phi[rows]
-        theta[p] = np.linalg.solve(P.T @ P + scale * np.eye(na + nb), P.T @ target[rows])
+        gram = P.T @ P + scale * np.eye(na + nb)
+        if np.linalg.cond(gram) > 1e12:
+            raise ValueError(f"the regressors of phase {p} of {N} are (nearly) linearly "
+                             "dependent: excite the input more richly, lower na or nb, or "
+                             "give a ridge weight")
+        theta[p] = np.linalg.solve(gram, P.T @ target[rows])
     return _realize(theta, na, nb, period, dt, name if name is not None else 'arx')
 
 

@@ -3,7 +3,8 @@
 A controller ``K`` (an `LTPStateSpace`, a python-control LTI system or a
 `control.NonlinearIOSystem`; continuous or discrete time) closes the loop
 around the nominal orbit ``x̄(t)``, ``u0``, ``ȳ(t) = h(t, x̄(t), u0)`` of a
-`HybridPlant`, in the deviation coordinates of `linearize_orbit`::
+`HybridPlant` (or a smooth `control.NonlinearIOSystem`), in the deviation
+coordinates of `linearize_orbit`::
 
     e(t) = y(t) + v(t) − ȳ(t)      controller input (v: measurement noise)
     u(t) = sat(u0 + w(t))           plant input (w: controller output)
@@ -25,6 +26,8 @@ samples, with the Jacobian composed alike.
 """
 
 import numbers
+from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 import control as ct
@@ -33,7 +36,7 @@ from control.exception import ControlArgument, ControlDimension
 from ._hybrid import (HybridMode, HybridPlant, _central_jacobian, _Flow, _input_function,
                       _solver_options)
 from ._ltpsys import LTPStateSpace
-from ._orbits import PeriodicOrbit, periodic_orbit
+from ._orbits import PeriodicOrbit, _as_hybrid, periodic_orbit
 from ._validation import check_kwargs, check_positive_int, real_array, steps_per_period
 
 __all__ = ['ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit']
@@ -43,8 +46,7 @@ class _Loop:
     """Validated plant, controller, orbit and saturation of one feedback loop."""
 
     def __init__(self, plant, controller, orbit, saturation):
-        if not isinstance(plant, HybridPlant):
-            raise ControlArgument(f"plant must be a HybridPlant, got {type(plant).__name__}")
+        plant = _as_hybrid(plant, None)
         if not isinstance(orbit, PeriodicOrbit):
             raise ControlArgument(f"orbit must be a PeriodicOrbit, got {type(orbit).__name__}")
         if orbit.plant.nstates != plant.nstates or orbit.plant.mode_names != plant.mode_names:
@@ -336,6 +338,7 @@ class _Sampled:
         return z, mode, J
 
 
+@dataclass(repr=False)
 class ClosedLoopOrbit:
     """Periodic orbit of a closed hybrid loop and its return map.
 
@@ -367,20 +370,41 @@ class ClosedLoopOrbit:
         discrete controller.
     residual : float
         Relative fixed-point residual of the period map.
+
+    Examples
+    --------
+    Proportional feedback doubles the decay rate of ``ẋ = −x + cos t + u``:
+
+    >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t) + u, None, states=1, inputs=1)
+    >>> orbit = ltp.periodic_orbit(sys, 2 * np.pi, [0.0])
+    >>> cl = ltp.closed_loop_orbit(sys, ct.ss([], [], [], [[-1.0]]), orbit)
+    >>> bool(np.isclose(cl.dominant_multiplier, np.exp(-4 * np.pi)))
+    True
     """
 
-    def __init__(self, period, z0, n, mode0, monodromy, orbit, residual):
-        self.period, self.mode0, self.orbit, self.residual = period, mode0, orbit, residual
-        self.x0, self.controller_state = np.array(z0[:n]), np.array(z0[n:])
-        self.monodromy = monodromy
-        mult = np.linalg.eigvals(monodromy)
-        self.multipliers = mult[np.argsort(-np.abs(mult), kind='stable')]
-        self.dominant_multiplier = float(np.abs(self.multipliers[0]))
-        self.is_stable = bool(self.dominant_multiplier < 1)
+    period: float
+    x0: np.ndarray
+    controller_state: np.ndarray
+    mode0: int
+    monodromy: np.ndarray
+    multipliers: np.ndarray
+    dominant_multiplier: float
+    is_stable: bool
+    orbit: Optional[PeriodicOrbit]
+    residual: float
 
     def __repr__(self):
         return (f"<ClosedLoopOrbit period={self.period:g}, dominant |multiplier|="
                 f"{self.dominant_multiplier:.4g}, stable={self.is_stable}>")
+
+
+def _result(period, z0, n, mode0, monodromy, orbit, residual):
+    """`ClosedLoopOrbit` with the multipliers sorted by decreasing magnitude."""
+    mult = np.linalg.eigvals(monodromy)
+    mult = mult[np.argsort(-np.abs(mult), kind='stable')]
+    dominant = float(np.abs(mult[0]))
+    return ClosedLoopOrbit(period, np.array(z0[:n]), np.array(z0[n:]), mode0, monodromy, mult,
+                           dominant, bool(dominant < 1), orbit, residual)
 
 
 def _initial(loop, initial_state, controller_state, mode0, t0):
@@ -415,8 +439,8 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
 
     Parameters
     ----------
-    plant : HybridPlant
-        The plant.
+    plant : HybridPlant or control.NonlinearIOSystem
+        The plant (a continuous-time smooth system acts as one mode).
     controller : LTPStateSpace, control.StateSpace, control.TransferFunction or control.NonlinearIOSystem
         Continuous or discrete controller from the plant's outputs to its
         inputs; an LTP controller's period must divide the orbit's period.
@@ -473,6 +497,7 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
     opts = _solver_options(kwargs, 'closed_loop_response')
     check_kwargs(kwargs, 'closed_loop_response')
     loop = _Loop(plant, controller, orbit, saturation)
+    plant = loop.plant
     timepts = real_array(timepts, 'timepts', ndim=1)
     if timepts.size < 2 or np.any(np.diff(timepts) <= 0):
         raise ValueError("timepts must be strictly increasing with at least 2 points")
@@ -632,7 +657,7 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
     if not loop.dt:
         cl = periodic_orbit(_loop_plant(loop), loop.T, z0, mode0, tol=tol, max_iter=max_iter,
                             max_periods=max_periods, **opts)
-        return ClosedLoopOrbit(loop.T, cl.x0, loop.n, cl.mode0, cl.monodromy, cl, cl.residual)
+        return _result(loop.T, cl.x0, loop.n, cl.mode0, cl.monodromy, cl, cl.residual)
     return _sampled_orbit(_Sampled(loop, opts), z0, mode0, tol, max_iter, max_periods)
 
 
@@ -648,7 +673,7 @@ def _sampled_orbit(sampled, z, mode, tol, max_iter, max_periods):
             zT, modeT, J = sampled.period_map(z, mode, jacobian=True)
             res = np.max(np.abs(zT - z)) / (1 + np.max(np.abs(z)))
             if modeT == mode and res <= tol:
-                return ClosedLoopOrbit(loop.T, z, loop.n, mode, J, None, res)
+                return _result(loop.T, z, loop.n, mode, J, None, res)
             if modeT != mode or not np.all(np.isfinite(zT)):
                 break
             step = np.linalg.lstsq(J - np.eye(len(z)), z - zT, rcond=None)[0]

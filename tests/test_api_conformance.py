@@ -122,6 +122,13 @@ KWARG_CALLS = {
     'LTPStateSpace.htf': lambda **kw: SYS.htf(1, **kw),
     'LTPStateSpace.sample': lambda **kw: SYS.sample(0.1, **kw),
     'HTF.plot': lambda **kw: H.plot(omega_num=5, **kw),
+    # feedback around orbits
+    'closed_loop_response': lambda **kw: ltp.closed_loop_response(
+        FORCED, ct.ss([], [], [], [[-1.0]]), ltp.periodic_orbit(FORCED, T, [0.0]), [0, 0.5],
+        **kw),
+    'closed_loop_orbit': lambda **kw: ltp.closed_loop_orbit(
+        FORCED, ct.ss([], [], [], [[-1.0]]), ltp.periodic_orbit(FORCED, T, [0.0]), **kw),
+    'identify_arx': lambda **kw: ltp.identify_arx(DATA, T, 1, 1, ridge=1e-6, **kw),
 }
 
 # plotting functions hand **kwargs to matplotlib, whose error is AttributeError
@@ -184,6 +191,7 @@ def test_unknown_keyword_is_rejected(name):
 # result containers document their fields under Attributes, not Parameters
 _RESULT_CLASSES = {'Excitation', 'HTFFit', 'DelayEstimate', 'FDSubspaceInfo',
                    'PeriodicOrbit', 'FloquetRealization', 'MatrixErrors', 'LTPSubspaceInfo'}
+_RESULT_CLASSES |= {'ClosedLoopOrbit'}
 
 DOC_DEFECTS = {}
 

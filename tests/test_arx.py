@@ -96,6 +96,8 @@ def test_bad_input():
         ltp.identify_arx((t, u, u), 0.33, 1, 1)
     with pytest.raises(ValueError, match="record more periods"):
         ltp.identify_arx((t[:20], u[:20], u[:20]), T, 3, 3)
+    with pytest.raises(ValueError, match="linearly dependent"):
+        ltp.identify_arx((t, u, 2 * u), T, 1, 1)          # y[k-1] = 2 u[k-1]
     with pytest.raises(ValueError, match="na"):
         ltp.identify_arx((t, u, u), T, 0, 1)
     with pytest.raises(ValueError, match="ridge"):

@@ -255,7 +255,9 @@ class TestBadInput:
         with pytest.raises(ControlArgument, match="controller"):
             ltp.closed_loop_orbit(plant, 'K', orbit)
         with pytest.raises(ControlArgument, match="plant"):
-            ltp.closed_loop_orbit(ct.rss(2, 1, 1), ltp_controller(), orbit)
+            ltp.closed_loop_orbit('wall', ltp_controller(), orbit)
+        with pytest.raises(ValueError, match="different states"):
+            ltp.closed_loop_orbit(ct.rss(3, 1, 1), ltp_controller(), orbit)
         with pytest.raises(ControlArgument, match="orbit"):
             ltp.closed_loop_orbit(plant, ltp_controller(), orbit.x0)
         with pytest.raises(ControlArgument, match="saturation"):
