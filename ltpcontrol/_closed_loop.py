@@ -27,6 +27,7 @@ samples, with the Jacobian composed alike.
 
 import numbers
 from dataclasses import dataclass
+from types import SimpleNamespace
 from typing import Optional
 
 import numpy as np
@@ -502,8 +503,10 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
     if timepts.size < 2 or np.any(np.diff(timepts) <= 0):
         raise ValueError("timepts must be strictly increasing with at least 2 points")
     z0, mode = _initial(loop, initial_state, controller_state, mode0, timepts[0])
-    vfun = _input_function(_NoiseShape(loop.p), 0.0 if noise is None else noise, timepts)
-    bar = _progress(progress, timepts, loop.T)
+    # the noise has one entry per plant output
+    vfun = _input_function(SimpleNamespace(ninputs=loop.p), 0.0 if noise is None else noise,
+                           timepts)
+    bar = _progress(progress, timepts)
     if loop.dt:
         states, modes, events, u = _run_sampled(loop, opts, timepts, z0, mode, vfun, bar)
     else:
@@ -523,14 +526,7 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
     return resp
 
 
-class _NoiseShape:
-    """Stand-in with `ninputs` for `_input_function` (noise has one entry per output)."""
-
-    def __init__(self, p):
-        self.ninputs = p
-
-
-def _progress(progress, timepts, T):
+def _progress(progress, timepts):
     from tqdm.auto import tqdm
     if not isinstance(progress, (bool, np.bool_)):
         raise ControlArgument(f"progress must be True or False, got {progress!r}")
