@@ -20,6 +20,8 @@ from ._discretize import sample_system, d2c
 from ._lifting import lift
 from ._hybrid import HybridMode, HybridPlant, simulate_hybrid, saltation_matrix
 from ._orbits import PeriodicOrbit, periodic_orbit, period_map, linearize_orbit
+from ._autonomous import limit_cycle, poincare_map
+from ._continuation import Bifurcation, OrbitBranch, orbit_continuation
 from ._excitation import Excitation, chirp_replicas, multisine, sine_experiments
 from ._htf_estimate import estimate_htf
 from ._htf_fit import HTFFit, DelayEstimate, fit_htf, estimate_delays
@@ -31,6 +33,10 @@ from ._canonical import to_canonical, matrix_errors, MatrixErrors
 from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
 from ._arx import identify_arx
 from ._closed_loop import ClosedLoopOrbit, closed_loop_response, closed_loop_orbit
+from ._lyapunov import lyap, dlyap, gram
+from ._norms import norm
+from ._zeros import zeros
+from ._harmonic_ss import harmonic_ss
 
 __version__ = "0.1.0"
 
@@ -52,6 +58,7 @@ __all__ = [
     # rhythmic plants and their orbits
     'HybridMode', 'HybridPlant', 'simulate_hybrid', 'saltation_matrix',
     'PeriodicOrbit', 'periodic_orbit', 'period_map', 'linearize_orbit',
+    'limit_cycle', 'poincare_map', 'Bifurcation', 'OrbitBranch', 'orbit_continuation',
     # identification
     'Excitation', 'chirp_replicas', 'multisine', 'sine_experiments',
     'estimate_htf', 'HTFFit', 'DelayEstimate', 'fit_htf', 'estimate_delays',
@@ -62,4 +69,6 @@ __all__ = [
     'identify_arx',
     # feedback around orbits of hybrid plants
     'ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit',
+    # analysis: Lyapunov equations, gramians, zeros, norms
+    'lyap', 'dlyap', 'gram', 'norm', 'zeros', 'harmonic_ss',
 ]

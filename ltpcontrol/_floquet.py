@@ -28,6 +28,7 @@ import scipy.sparse.linalg as spla
 from control.exception import ControlArgument
 
 from ._periodic_matrix import PeriodicMatrix
+from ._steps import step_grid
 from ._transition import expm_batch, step_transitions
 from ._validation import check_kwargs, check_positive_int, steps_per_period
 
@@ -163,8 +164,13 @@ def floquet_exponents(sys, nsteps=None):
     return (logmod + 1j * arg) / sys.period
 
 
-def is_stable(sys, tol=1e-10, nsteps=None):
+def is_stable(sys, tol=1e-10, nsteps=None, *, autonomous=False):
     """True when every Floquet multiplier satisfies ``|μ| < 1 - tol``.
+
+    With ``autonomous=True``, `sys` is the linearisation about an orbit of
+    an autonomous plant (see `limit_cycle`): the multiplier nearest 1
+    belongs to the phase direction and is left out, so the verdict is
+    orbital stability.
 
     Parameters
     ----------
@@ -176,6 +182,9 @@ def is_stable(sys, tol=1e-10, nsteps=None):
         as stable.
     nsteps : int, optional
         Continuous time only; see `monodromy`.
+    autonomous : bool, optional
+        Leave out the phase multiplier of an autonomous orbit (default
+        False).
 
     Returns
     -------
@@ -190,8 +199,17 @@ def is_stable(sys, tol=1e-10, nsteps=None):
     if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, numbers.Real) \
             or not 0 <= tol < 1:
         raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
-    logmod, _ = _log_multipliers(sys, nsteps)
+    logmod, arg = _log_multipliers(sys, nsteps)
+    if autonomous:
+        logmod = _without_phase_multiplier(logmod, arg)
     return bool(logmod.size == 0 or np.max(logmod) < np.log1p(-tol))
+
+
+def _without_phase_multiplier(logmod, arg):
+    """Log-moduli without the multiplier nearest 1 (phase of an autonomous orbit)."""
+    if logmod.size == 0:
+        raise ValueError("autonomous=True needs at least one multiplier (the phase one)")
+    return np.delete(logmod, np.argmin(np.hypot(logmod, arg)))
 
 
 def floquet_transform(sys, real=True, nsteps=None, **kwargs):
@@ -347,17 +365,7 @@ def _factors(sys, nsteps):
         return np.arange(nper + 1) * sys.dt, A.sample(nper)
     if n == 0:
         return np.array([0.0, T]), np.zeros((1, 0, 0))
-    if nsteps is None:
-        probe = np.concatenate([np.arange(256) * T / 256, A.breakpoints])
-        norm = np.max(np.linalg.norm(A(probe), ord=2, axis=(1, 2)), initial=0.0)
-        nsteps = int(np.clip(np.ceil(T * norm), 16, 4096))
-    grid = np.union1d(np.linspace(0, T, nsteps + 1), A.breakpoints)
-    # drop grid points that nearly coincide with a switching instant
-    keep = np.concatenate([[True], np.diff(grid) > 1e-9 * T / nsteps])
-    keep[-1] = True
-    grid = grid[keep]
-    grid = grid[np.concatenate([np.diff(grid) > 0, [True]])]
-    grid[-1] = T
+    grid = step_grid(A, nsteps=nsteps)
     zero = PeriodicMatrix.constant(np.zeros((n, 0)), T)
     phi, _, _ = step_transitions(A, zero, grid[:-1], np.diff(grid))
     return grid, phi

@@ -131,6 +131,17 @@ KWARG_CALLS = {
     'identify_arx': lambda **kw: ltp.identify_arx(DATA, T, 1, 1, ridge=1e-6, **kw),
 }
 
+# autonomous plants: limit cycles, return maps, continuation
+_OSC = ct.nlsys(lambda t, x, u, p: [p['a'] * x[0] * (1 - x[0] ** 2 - x[1] ** 2) - x[1],
+                                    p['a'] * x[1] * (1 - x[0] ** 2 - x[1] ** 2) + x[0]],
+                None, states=2, inputs=0, params={'a': 0.5}, name='oscillator')
+KWARG_CALLS.update({
+    'limit_cycle': lambda **kw: ltp.limit_cycle(_OSC, 6.3, [1.0, 0.0], npoints=4, **kw),
+    'poincare_map': lambda **kw: ltp.poincare_map(_OSC, [1.0, 0.0], **kw),
+    'orbit_continuation': lambda **kw: ltp.orbit_continuation(
+        ltp.limit_cycle(_OSC, 6.3, [1.0, 0.0], npoints=4), 'a', [0.5], **kw),
+})
+
 # plotting functions hand **kwargs to matplotlib, whose error is AttributeError
 _MATPLOTLIB_KWARGS = {'bode_htf', 'HTF.plot'}
 
@@ -192,6 +203,7 @@ def test_unknown_keyword_is_rejected(name):
 _RESULT_CLASSES = {'Excitation', 'HTFFit', 'DelayEstimate', 'FDSubspaceInfo',
                    'PeriodicOrbit', 'FloquetRealization', 'MatrixErrors', 'LTPSubspaceInfo'}
 _RESULT_CLASSES |= {'ClosedLoopOrbit'}
+_RESULT_CLASSES |= {'OrbitBranch', 'Bifurcation'}
 
 DOC_DEFECTS = {}
 
