@@ -30,6 +30,8 @@ from ._fdsubspace import fdsubspace, FDSubspaceInfo
 from ._hybrid_ls import hybrid_ls, HybridLSResult
 from ._realization import floquet_realization, FloquetRealization
 from ._canonical import to_canonical, matrix_errors, MatrixErrors
+from ._canonical import compare_ltp, LTPComparison
+from ._structure import select_structure, StructureSelection
 from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
 from ._arx import identify_arx
 from ._closed_loop import ClosedLoopOrbit, closed_loop_response, closed_loop_orbit
@@ -66,6 +68,7 @@ __all__ = [
     'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
+    'compare_ltp', 'LTPComparison', 'select_structure', 'StructureSelection',
     'identify_arx',
     # feedback around orbits of hybrid plants
     'ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit',

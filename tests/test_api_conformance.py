@@ -129,6 +129,9 @@ KWARG_CALLS = {
     'closed_loop_orbit': lambda **kw: ltp.closed_loop_orbit(
         FORCED, ct.ss([], [], [], [[-1.0]]), ltp.periodic_orbit(FORCED, T, [0.0]), **kw),
     'identify_arx': lambda **kw: ltp.identify_arx(DATA, T, 1, 1, ridge=1e-6, **kw),
+    'compare_ltp': lambda **kw: ltp.compare_ltp(SYS, SYS, [1.0], **kw),
+    'select_structure': lambda **kw: ltp.select_structure(ltp.lifted_frequency_response(
+        _SINE_RESPONSE, 0.5, 1, transient=6.0), 0.5, [1], [0], **kw),
 }
 
 # autonomous plants: limit cycles, return maps, continuation
@@ -201,7 +204,8 @@ def test_unknown_keyword_is_rejected(name):
 
 # result containers document their fields under Attributes, not Parameters
 _RESULT_CLASSES = {'Excitation', 'HTFFit', 'DelayEstimate', 'FDSubspaceInfo',
-                   'PeriodicOrbit', 'FloquetRealization', 'MatrixErrors', 'LTPSubspaceInfo'}
+                   'PeriodicOrbit', 'FloquetRealization', 'MatrixErrors', 'LTPSubspaceInfo',
+                   'LTPComparison', 'StructureSelection'}
 _RESULT_CLASSES |= {'ClosedLoopOrbit'}
 _RESULT_CLASSES |= {'OrbitBranch', 'Bifurcation'}
 
