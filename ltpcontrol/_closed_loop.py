@@ -629,21 +629,16 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
 
     Examples
     --------
-    The loop of the `closed_loop_response` example stays stable; strong
-    positive feedback destabilises the orbit:
+    Output feedback on ``ẋ = −x + cos t + u``: negative feedback speeds up
+    the return to the orbit, positive feedback beyond 1 destabilises it:
 
-    >>> def free(t, x, u, p):
-    ...     return [x[1], -40 * (x[0] - 0.1) - x[1] + 5 * np.cos(2 * np.pi * t) + u[0]]
-    >>> mode = ltp.HybridMode(free, guard=lambda t, x, u, p: x[0],
-    ...                       reset=lambda t, x, u, p: [x[0], -0.7 * x[1]], target=0)
-    >>> wall = ltp.HybridPlant([mode], lambda t, x, u, p: [x[0]], states=2,
-    ...                        inputs=1, outputs=1)
-    >>> orbit = ltp.periodic_orbit(wall, 1.0, [0.2, 0.0], warmup=30)
-    >>> cl = ltp.closed_loop_orbit(wall, ct.ss([], [], [], [[-5.0]]), orbit)
-    >>> cl.is_stable, cl.monodromy.shape
-    (True, (2, 2))
-    >>> ltp.closed_loop_orbit(wall, ct.ss([], [], [], [[60.0]]), orbit).is_stable
-    False
+    >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t) + u, None, states=1, inputs=1)
+    >>> orbit = ltp.periodic_orbit(sys, 2 * np.pi, [0.0])
+    >>> ltp.closed_loop_orbit(sys, ct.ss([], [], [], [[-2.0]]), orbit).is_stable
+    True
+    >>> cl = ltp.closed_loop_orbit(sys, ct.ss([], [], [], [[3.0]]), orbit)
+    >>> cl.is_stable, bool(np.isclose(cl.dominant_multiplier, np.exp(4 * np.pi)))
+    (False, True)
     """
     opts = _solver_options(kwargs, 'closed_loop_orbit')
     check_kwargs(kwargs, 'closed_loop_orbit')
