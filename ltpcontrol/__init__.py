@@ -39,6 +39,13 @@ from ._lyapunov import lyap, dlyap, gram
 from ._norms import norm
 from ._zeros import zeros
 from ._harmonic_ss import harmonic_ss
+from ._riccati import care, dare
+from ._design import lqr, dlqr, lqe, dlqe, lqg
+from ._place import place
+from ._lmi import lmi_statefbk, LMIDesign
+from ._reduction import hsvd, balred, minreal
+from ._refine import refine_ltp, RefineInfo
+from ._montecarlo import monte_carlo, MonteCarloResult
 
 __version__ = "0.1.0"
 
@@ -74,4 +81,9 @@ __all__ = [
     'ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit',
     # analysis: Lyapunov equations, gramians, zeros, norms
     'lyap', 'dlyap', 'gram', 'norm', 'zeros', 'harmonic_ss',
+    # control design
+    'care', 'dare', 'lqr', 'dlqr', 'lqe', 'dlqe', 'lqg', 'place',
+    'lmi_statefbk', 'LMIDesign', 'hsvd', 'balred', 'minreal',
+    # noisy data and Monte-Carlo studies
+    'refine_ltp', 'RefineInfo', 'monte_carlo', 'MonteCarloResult',
 ]

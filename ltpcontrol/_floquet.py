@@ -27,10 +27,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from control.exception import ControlArgument
 
+from ._ltpsys import ltpss
 from ._periodic_matrix import PeriodicMatrix
 from ._steps import step_grid
 from ._transition import expm_batch, step_transitions
-from ._validation import check_kwargs, check_positive_int, steps_per_period
+from ._validation import as_ltp, check_kwargs, check_positive_int, steps_per_period
 
 __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
            'is_stable', 'floquet_transform']
@@ -85,7 +86,8 @@ def floquet_multipliers(sys, nsteps=None):
 
     Computed by the periodic real Schur decomposition of the factors
     ``H_1 H_2 ... H_p`` with ``H_1 = Φ_{M-1}, ..., H_p = Φ_0`` (SLICOT
-    MB03VD/MB03WD) without forming the product.
+    MB03VD/MB03WD) without forming the product; see [BittantiColaneri2009]_
+    for the theory and [Varga2008]_ for periodic Schur methods.
 
     Parameters
     ----------
@@ -341,18 +343,9 @@ def floquet_transform(sys, real=True, nsteps=None, **kwargs):
 # Private helpers
 #
 
-def _check_sys(sys):
-    for attr in ('A', 'B', 'C', 'D'):
-        if not isinstance(getattr(sys, attr, None), PeriodicMatrix):
-            raise ControlArgument("sys must be an LTPStateSpace (with PeriodicMatrix "
-                                  f"attributes A, B, C, D), got {type(sys).__name__}")
-    if getattr(sys, 'dt', None) is None or getattr(sys, 'period', None) is None:
-        raise ControlArgument("sys must have a period and a time base dt")
-
-
 def _factors(sys, nsteps):
     """Grid ``t_0..t_M`` and step transition matrices ``Φ_k`` (M, n, n)."""
-    _check_sys(sys)
+    sys = as_ltp(sys)
     A, T = sys.A, sys.period
     n = A.shape[0]
     if nsteps is not None:
@@ -522,15 +515,10 @@ def _logm_form(grid, factors, logmod, dtime):
 
 def _assemble(sys, grid, G, E, R):
     """Build P(t) and the Floquet-form system from the grid values."""
-    from ._ltpsys import ltpss
     period = grid[-1]
     n = G.shape[1]
-    labels = {key: getattr(sys, f'{key[:-1]}_labels') for key in ('inputs', 'outputs',
-                                                                     'states')
-              if hasattr(sys, f'{key[:-1]}_labels')}
-    name = getattr(sys, 'name', None)
-    if name is not None:
-        labels['name'] = f'{name}$floquet'
+    labels = dict(inputs=sys.input_labels, outputs=sys.output_labels,
+                  states=sys.state_labels, name=f'{sys.name}$floquet')
     if sys.dt:
         # discrete time: P[k] = G_k R, B_F[k] = P[k+1]^{-1} B[k], C_F[k] = C[k] P[k]
         nw = len(G)
@@ -555,6 +543,37 @@ def _assemble(sys, grid, G, E, R):
     return sysF, P
 
 
+def chebyshev_nodes(degree):
+    """Chebyshev points ``(1 - cos(jπ/D))/2``, j = 0..D, on [0, 1]."""
+    return 0.5 * (1 - np.cos(np.pi * np.arange(degree + 1) / degree))
+
+
+def piecewise_chebyshev(grid, values):
+    """Callable interpolating matrix values given on every grid interval.
+
+    ``values[k, j]`` is the value at ``t_k + h_k c_j`` (`chebyshev_nodes`);
+    evaluation (at times taken modulo ``grid[-1]``) is by the barycentric
+    formula on the interval that contains t.
+    """
+    period, starts, h = grid[-1], grid[:-1], np.diff(grid)
+    degree = values.shape[1] - 1
+    cheb = chebyshev_nodes(degree)
+    bary = (-1.0) ** np.arange(degree + 1)
+    bary[[0, -1]] *= 0.5
+
+    def evaluate(t):
+        tau = np.mod(np.atleast_1d(np.asarray(t, float)), period)
+        k = np.clip(np.searchsorted(starts, tau, side='right') - 1, 0, len(starts) - 1)
+        xi = np.clip((tau - starts[k]) / h[k], 0.0, 1.0)
+        diff = xi[:, None] - cheb[None, :]
+        hit = diff == 0
+        with np.errstate(divide='ignore'):
+            weights = np.where(hit.any(axis=1, keepdims=True), hit.astype(float), bary / diff)
+        weights /= weights.sum(axis=1, keepdims=True)
+        return np.einsum('sj,sj...->s...', weights, values[k])
+    return evaluate
+
+
 def _chebyshev_transform(A, grid, G, E, R):
     """Callable P(t) interpolating exact values on every grid interval.
 
@@ -564,9 +583,7 @@ def _chebyshev_transform(A, grid, G, E, R):
     """
     n = G.shape[1]
     period, starts, h = grid[-1], grid[:-1], np.diff(grid)
-    cheb = 0.5 * (1 - np.cos(np.pi * np.arange(_CHEB_DEG + 1) / _CHEB_DEG))
-    bary = (-1.0) ** np.arange(_CHEB_DEG + 1)
-    bary[[0, -1]] *= 0.5
+    cheb = chebyshev_nodes(_CHEB_DEG)
     zero = PeriodicMatrix.constant(np.zeros((n, 0)), A.period)
     nodes = starts[:, None] + h[:, None] * cheb                        # (M, D+1)
     # Φ(s_j, t_k) = Φ(s_j, s_{j-1}) ... Φ(s_1, s_0): short steps, chained
@@ -586,16 +603,7 @@ def _chebyshev_transform(A, grid, G, E, R):
                       f"number up to {cond:.1e}): B_F = P^{{-1}} B is large and the "
                       "Floquet form amplifies rounding errors", UserWarning, stacklevel=4)
 
-    def transform(t):
-        tau = np.mod(np.atleast_1d(np.asarray(t, float)), period)
-        k = np.clip(np.searchsorted(starts, tau, side='right') - 1, 0, len(starts) - 1)
-        xi = np.clip((tau - starts[k]) / h[k], 0.0, 1.0)
-        diff = xi[:, None] - cheb[None, :]
-        hit = diff == 0
-        with np.errstate(divide='ignore'):
-            weights = np.where(hit.any(axis=1, keepdims=True), hit.astype(float), bary / diff)
-        weights /= weights.sum(axis=1, keepdims=True)
-        return np.einsum('sj,sjab->sab', weights, values[k])
+    transform = piecewise_chebyshev(grid, values)
 
     # check the interpolant against exact values inside every interval
     probe = starts + 0.3717 * h

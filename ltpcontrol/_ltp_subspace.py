@@ -40,6 +40,7 @@ from ._fdsubspace import fdsubspace, FDSubspaceInfo
 from ._floquet_fit import _harmonic_response, fit_floquet
 from ._lifting import _harmonic_labels, _real_basis
 from ._realization import FloquetRealization, floquet_realization
+from ._refine import refine_ltp
 from ._validation import (check_kwargs, check_period, check_positive_int,
                           real_array, steps_per_period)
 
@@ -287,6 +288,7 @@ class LTPSubspaceInfo:
 
 def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
                  realization='direct', realization_options=None, refit_a=True,
+                 refine=None, refine_options=None,
                  estimate_d=True,
                  seed=None, progress=False,
                  return_info=False, name=None, **kwargs):
@@ -342,6 +344,13 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         ``B``, ``C``, ``D`` (default True, which makes the result independent
         of `q`); False keeps the 'log' ``A`` and refits ``B``, ``C``, ``D``
         given ``A`` only.
+    refine : {None, 'ml'}, optional
+        'ml': finish with `ltpcontrol.refine_ltp` on the lifted data (the
+        maximum-likelihood fit of the Floquet-form model, equal weights
+        unless ``refine_options`` gives ``std``); default None.
+    refine_options : dict, optional
+        Keywords of `ltpcontrol.refine_ltp` (``std``, ``stable``,
+        ``harmonics``, ...).
     estimate_d : bool, optional
         Estimate a feedthrough (default True); False forces ``D = 0``.
     seed : int, optional
@@ -438,6 +447,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
     if conversion not in _CONVERSIONS:
         raise ValueError(f"conversion must be one of {_CONVERSIONS}, got {conversion!r}")
+    if refine not in (None, 'ml'):
+        raise ValueError(f"refine must be None or 'ml', got {refine!r}")
     # 1. lifted frequency response
     G = _lifted_data(data, period, K, progress, lfr_kwargs)
     ny, N = _check_lifted_data(G, period, K, nstates, q)
@@ -456,6 +467,9 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         if not converged:
             warnings.warn("the least-squares refit did not converge", UserWarning,
                           stacklevel=2)
+    # 6. optional maximum-likelihood refinement weighted by the data's uncertainty
+    if refine == 'ml':
+        sysc = _ml_refine(sysc, G, refine_options)
     resid = _harmonic_response(sysc, G.omega, min(K, Kr) if conversion != 'refit' else K)
     Gk = Gc if conversion == 'refit' else _harmonic_data(G, min(K, Kr), N, ny)
     relres = float(np.linalg.norm(resid - Gk) / np.linalg.norm(Gk))
@@ -689,3 +703,8 @@ def _hold_factor(omega, dt, hold):
         return np.ones_like(omega)
     x = np.sinc(omega * dt / (2 * np.pi))                  # np.sinc(x) = sin(πx)/(πx)
     return x ** 2 if hold == 'foh' else x * np.exp(-0.5j * omega * dt)
+
+
+def _ml_refine(sys, data, options):
+    """``refine='ml'`` of `identify_ltp`: `refine_ltp` on the lifted data."""
+    return refine_ltp(sys, data, **(options or {}))

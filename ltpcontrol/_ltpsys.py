@@ -477,8 +477,9 @@ def feedback(sys1, sys2=1, sign=-1, **kwargs):
     ----------
     sys1 : LTPStateSpace, control.StateSpace, TransferFunction or array_like
         Forward system.
-    sys2 : LTPStateSpace, control.StateSpace, TransferFunction or array_like
-        Return-path system (default: unity).
+    sys2 : LTPStateSpace, control.StateSpace, TransferFunction, PeriodicMatrix or array_like
+        Return-path system (default: unity); a `PeriodicMatrix` is a
+        periodic static gain such as the state feedback ``K(t)`` of `lqr`.
     sign : {-1, 1}
         Feedback sign (default negative).
     name : str, optional
@@ -670,6 +671,11 @@ def _to_ltp(obj, period, dt):
                              states=obj.state_labels)
     if isinstance(obj, ct.InputOutputSystem):
         raise ControlArgument(f"cannot combine an LTPStateSpace with {type(obj).__name__}")
+    if isinstance(obj, PeriodicMatrix):
+        # a periodic static gain, e.g. a state-feedback gain K(t)
+        rows, cols = obj.shape
+        return LTPStateSpace(np.zeros((0, 0)), np.zeros((0, cols)), np.zeros((rows, 0)),
+                             obj, period, dt=dt)
     gain = real_array(obj, 'gain', ndim=(0, 1, 2))
     gain = np.atleast_2d(gain)
     return LTPStateSpace(np.zeros((0, 0)), np.zeros((0, gain.shape[1])),
@@ -683,7 +689,7 @@ def _to_ltp_or_none(obj, ref):
     if isinstance(obj, (int, float, np.number)) and not isinstance(obj, bool):
         # a scalar acts on every channel, as in python-control
         return _to_ltp(float(obj) * np.eye(ref.noutputs), ref.period, ref.dt)
-    if isinstance(obj, (ct.StateSpace, ct.TransferFunction, np.ndarray, list)):
+    if isinstance(obj, (ct.StateSpace, ct.TransferFunction, np.ndarray, list, PeriodicMatrix)):
         return _to_ltp(obj, ref.period, ref.dt)
     return None
 

@@ -111,6 +111,8 @@ KWARG_CALLS = {
     'fdsubspace': lambda **kw: ltp.fdsubspace(1 / (1j * OMEGA + 1), OMEGA, 1, **kw),
     'hybrid_ls': lambda **kw: ltp.hybrid_ls(T_LS, np.sin(6 * np.pi * T_LS),
                                             np.cos(6 * np.pi * T_LS), T, [0.0], 0, **kw),
+    'refine_ltp': lambda **kw: ltp.refine_ltp(
+        ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=T), H_DATA, **kw),
     # public methods with **kwargs
     'LTPStateSpace.to_ss': lambda **kw: ltp.ltpss(ct.rss(1, 1, 1), T).to_ss(**kw),
     'LTPStateSpace.linearize': lambda **kw: SYS.linearize(0.1, **kw),
@@ -208,6 +210,8 @@ _RESULT_CLASSES = {'Excitation', 'HTFFit', 'DelayEstimate', 'FDSubspaceInfo',
                    'LTPComparison', 'StructureSelection'}
 _RESULT_CLASSES |= {'ClosedLoopOrbit'}
 _RESULT_CLASSES |= {'OrbitBranch', 'Bifurcation'}
+_RESULT_CLASSES |= {'LMIDesign'}
+_RESULT_CLASSES |= {'RefineInfo', 'MonteCarloResult'}
 
 DOC_DEFECTS = {}
 
@@ -353,7 +357,7 @@ def _representative_slice():
     ltp.simulate_hybrid(BALL, np.linspace(0, 0.6, 61), [1.0, 0.0])
     orbit = ltp.periodic_orbit(FORCED, T, [0.0], npoints=16)
     ltp.linearize_orbit(FORCED, orbit)
-    exc = ltp.chirp_replicas(T, 3, 8.0, 0.1, 20.0, dt=0.01)
+    exc = ltp.chirp_replicas(T, 6, 8.0, 0.1, 20.0, dt=0.01)
     y = (1 + np.cos(2 * np.pi * exc.time)) * exc.inputs
     est = ltp.estimate_htf((exc.time, exc.inputs, y), T, 1, segments=exc.segments)
     ltp.fit_htf(_model, est, [1.0], harmonics=[0])
