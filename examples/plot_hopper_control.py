@@ -31,7 +31,6 @@ prints both.  Set ``LTP_EXAMPLES_QUICK=1`` for shorter records.
 """
 
 import os
-import sys
 import time
 
 import matplotlib
@@ -40,8 +39,6 @@ matplotlib.use('Agg')
 
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import ltpcontrol as ltp  # noqa: E402
 from control_chain import output_lqg, push_recovery, record, strides_to_recover  # noqa: E402
@@ -123,7 +120,7 @@ def main():
     axes[0].plot(closed.time, closed.states[0] - ref[0], label='periodic LQG')
     axes[0].set_ylabel('x − x̄ (m)')
     axes[0].legend()
-    axes[0].set_title('Simplified hopper: recovery from a push in flight')
+    axes[0].set_title('Simplified hopper: recovery from a push while falling')
     axes[1].plot(closed.time, closed.inputs, drawstyle='steps-post', color='C1')
     axes[1].set_ylabel('u (N)')
     axes[1].set_xlabel('time (s)')
