@@ -19,8 +19,8 @@ spring whose damper acts only while it moves up, pumped by ``cos 2πt``):
    multipliers of the closed loop's orbit (`ltpcontrol.closed_loop_orbit`,
    exact return map with the events' saltation matrices), the same design
    on the true linearization (`ltpcontrol.linearize_orbit` sampled with
-   zero-order hold) for comparison, and the recovery from a push in
-   flight (`ltpcontrol.closed_loop_response`): strides until the state is
+   zero-order hold) for comparison, and the recovery from a push in the
+   falling phase (`ltpcontrol.closed_loop_response`): strides until the state is
    back within 1 % of the orbit (per state, relative to its range on the
    orbit), with the actuator effort.
 
