@@ -305,6 +305,17 @@ class PeriodicMatrix:
                 self._coeffs.shape[0]) != self._coeffs.shape[0] // 2]))
 
     @property
+    def _piecewise_constant(self):
+        """True when the matrix is constant between its breakpoints (by its form)."""
+        if self._coeffs is not None:
+            return self.is_constant
+        if self._pieces is not None:
+            return all(p._piecewise_constant for p in self._pieces)
+        # pointwise combinations of piecewise-constant operands
+        return self._combine is not None and all(o._piecewise_constant
+                                                  for o in self._combine[1])
+
+    @property
     def nharmonics(self):
         """Number K of harmonics of an exact Fourier form, else None."""
         return None if self._coeffs is None else self._coeffs.shape[0] // 2
