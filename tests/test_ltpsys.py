@@ -35,7 +35,7 @@ def test_lti_round_trip_and_to_ss():
 
 def test_frozen_and_averaged_systems():
     sys = damped_mathieu()
-    np.testing.assert_allclose(sys.linearize(0.0).A, [[0, 1], [-1.4 * (2 * np.pi) ** 2, -0.4 * np.pi]])
+    np.testing.assert_allclose(sys.linearize(t=0.0).A, [[0, 1], [-1.4 * (2 * np.pi) ** 2, -0.4 * np.pi]])
     np.testing.assert_allclose(sys.average().A, [[0, 1], [-(2 * np.pi) ** 2, -0.4 * np.pi]])
 
 
