@@ -89,6 +89,9 @@ def interconnect(syslist, connections=None, inplist=None, outlist=None, **kwargs
         if not isinstance(s, ct.InputOutputSystem):
             gain = _to_ltp(s, period, dt)
             s = LTPStateSpace(gain.A, gain.B, gain.C, gain.D, period, dt=dt, name=f"sys[{i}]")
+        elif isinstance(s, LTPStateSpace) and not s.nstates and s.dt != dt:
+            s = LTPStateSpace(s.A, s.B, s.C, s.D, s.period, dt=dt, name=s.name,
+                              inputs=s.input_labels, outputs=s.output_labels)
         elif not isinstance(s, (LTPStateSpace, ct.StateSpace)):
             raise ControlArgument(f"interconnect: block {i} is a {type(s).__name__}; only "
                                   "LTP, LTI and static blocks give an LTPStateSpace (use "
@@ -121,9 +124,9 @@ def _period_and_dt(syslist):
     period = periodic[0].period
     for s in periodic[1:]:
         period = _merge_period(period, s.period)
-    dts = {s.dt for s in syslist if isinstance(s, LTPStateSpace)}
-    dts |= {s.dt for s in syslist if isinstance(s, ct.InputOutputSystem)
-            and not isinstance(s, LTPStateSpace) and s.dt not in (None, True) and s.nstates}
+    # static blocks (no states) fit any timebase
+    dts = {s.dt for s in syslist if isinstance(s, ct.InputOutputSystem)
+           and s.dt not in (None, True) and s.nstates}
     if len(dts) > 1:
         raise ValueError(f"interconnect: blocks have incompatible timebases {sorted(dts)}")
     return period, (dts.pop() if dts else 0.0)

@@ -691,9 +691,9 @@ def _merge_period(p1, p2):
 
 def _to_ltp(obj, period, dt):
     if isinstance(obj, LTPStateSpace):
-        if obj.dt != dt:
+        if obj.dt != dt and obj.nstates:      # a static gain fits any timebase
             raise ValueError(f"systems have incompatible timebases (dt={obj.dt} and dt={dt})")
-        if obj.period == period:
+        if obj.period == period and obj.dt == dt:
             return obj
         return LTPStateSpace(obj.A, obj.B, obj.C, obj.D, period, dt=dt,
                              inputs=obj.input_labels, outputs=obj.output_labels,
@@ -738,7 +738,9 @@ def _common(sys1, sys2):
     period = periodic[0].period
     for s in periodic[1:]:
         period = _merge_period(period, s.period)
-    dt = next((s.dt for s in (sys1, sys2) if isinstance(s, LTPStateSpace)), 0.0)
+    # timebase of the dynamic operands (static gains fit any)
+    dt = next((s.dt for s in (sys1, sys2) if isinstance(s, ct.InputOutputSystem)
+               and s.nstates and s.dt not in (None, True)), 0.0)
     s1 = _to_ltp(sys1, period, dt)
     s2 = _to_ltp(sys2, period, dt)
     if isinstance(sys2, (int, float)) and s1.noutputs != 1:
