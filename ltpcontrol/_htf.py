@@ -552,33 +552,15 @@ class _HarmonicStateSpace:
         c = np.arange(self.G.shape[1]) if cols is None else np.concatenate(
             [np.arange((k + K) * nu, (k + K + 1) * nu) for k in cols])
         self._ensure_modal(len(x))
-        budget = float(config.defaults['htf.max_memory'])
-        nF, nr, nc = self.F.shape[0], len(r), len(c)
-        out_bytes = _BYTES * len(x) * nr * nc
         if self.modal is not None:
-            lam, HV, VG = self.modal
+            lam = self.modal[0]
             gap_small = np.abs(x[:, None] - lam[None, :]) <= 1e-13 * np.maximum(1.0, np.abs(lam))
             if np.any(gap_small):
                 raise ValueError("the HTF is not defined at a Floquet exponent "
                                  "(evaluation point is a pole)")
-            # residue matrix R_{q,(ij)} = HV_iq VG_qj, formed once, when it fits
-            use_residues = _BYTES * nF * nr * nc <= budget / 2
-            fixed = _BYTES * nF * nr * nc if use_residues else 0
-            per_point = _BYTES * (2 * nF + 2 * nr * nc + (0 if use_residues else nr * nF))
-        else:
-            fixed = 0
-            per_point = _BYTES * (2 * nF ** 2 + 2 * nF * nc + 2 * nr * nc)
-        room = budget - fixed - out_bytes
-        if room < per_point:
-            raise MemoryError(
-                f"evaluating the HTF at {len(x)} points needs about "
-                f"{_size(fixed + out_bytes + per_point)} (result {_size(out_bytes)}, "
-                f"harmonic state space of {nF} states), more than "
-                f"ltp.config.defaults['htf.max_memory'] = {_size(budget)}; evaluate fewer "
-                "points or components, or raise the limit")
-        chunk = max(1, int(room // per_point))
+        chunk, use_residues = self._plan(len(x), len(r), len(c))
         J = self.J[np.ix_(r, c)]
-        out = np.empty((len(x), nr, nc), complex)
+        out = np.empty((len(x), len(r), len(c)), complex)
         starts = range(0, len(x), chunk)
         for a in tqdm(starts, desc="HTF", unit="chunk", leave=False,
                       disable=not config._get('htf.progress', progress) or len(starts) < 2):
@@ -590,6 +572,30 @@ class _HarmonicStateSpace:
             if J.any():
                 out[sl] += J
         return out
+
+    def _plan(self, npoints, nr, nc):
+        """Chunk length and modal variant that keep the working memory in budget."""
+        budget = float(config.defaults['htf.max_memory'])
+        nF = self.F.shape[0]
+        out_bytes = _BYTES * npoints * nr * nc
+        use_residues = False
+        if self.modal is not None:
+            # residue matrix R_{q,(ij)} = HV_iq VG_qj, formed once, when it fits
+            use_residues = _BYTES * nF * nr * nc <= budget / 2
+            fixed = _BYTES * nF * nr * nc if use_residues else 0
+            per_point = _BYTES * (2 * nF + 2 * nr * nc + (0 if use_residues else nr * nF))
+        else:
+            fixed = 0
+            per_point = _BYTES * (2 * nF ** 2 + 2 * nF * nc + 2 * nr * nc)
+        room = budget - fixed - out_bytes
+        if room < per_point:
+            raise MemoryError(
+                f"evaluating the HTF at {npoints} points needs about "
+                f"{_size(fixed + out_bytes + per_point)} (result {_size(out_bytes)}, "
+                f"harmonic state space of {nF} states), more than "
+                f"ltp.config.defaults['htf.max_memory'] = {_size(budget)}; evaluate fewer "
+                "points or components, or raise the limit")
+        return max(1, int(room // per_point)), use_residues
 
     def _modal_chunk(self, x, r, c, rows, cols, use_residues):
         # H(x)_{ij} = Σ_q HV_iq VG_qj / (x - λ_q)

@@ -132,16 +132,18 @@ class LTPStateSpace(NonlinearIOSystem):
         return self._repr_info_()
 
     def __str__(self):
-        lines = [f"<LTPStateSpace>: {self.name}",
-                 f"Inputs ({self.ninputs}): {self.input_labels}",
-                 f"Outputs ({self.noutputs}): {self.output_labels}",
-                 f"States ({self.nstates}): {self.state_labels}",
-                 f"period = {self.period:g}"]
-        if self.isdtime():
-            lines.append(f"dt = {self.dt:g} ({self.nsteps} steps per period)")
-        for label, M in (('A', self.A), ('B', self.B), ('C', self.C), ('D', self.D)):
-            lines.append(f"{label}: {M!r}")
-        return "\n".join(lines)
+        from ._display import text
+        return text(self)
+
+    def _repr_html_(self):
+        """Info line and LaTeX equations (python-control's notebook display).
+
+        As for `control.StateSpace`, ``_repr_latex_`` returns None so that
+        Jupyter uses this form, and None is returned when the system is
+        larger than ``ct.config.defaults['statesp.latex_maxsize']``.
+        """
+        from ._display import html
+        return html(self)
 
     #
     # Conversions

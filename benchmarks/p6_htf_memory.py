@@ -1,0 +1,178 @@
+"""P6: memory and time of HTF evaluation for larger plants.
+
+Workload: seeded random plants with a time-varying ``A(t) = A_0 + A_1 cos ω_p t``
+(no Floquet structure to exploit), one input, one output, evaluated on a
+grid of frequencies.  ``ltp.htf`` chooses its internal truncation (``K_i =
+K + 10`` plus a convergence check at ``K_i + 8``), so the harmonic state
+space has ``(2K_i + 1) n`` states: 820 for n = 20, K = 10.
+
+* P6a: ``ltp.htf(sys, 10)`` and ``H(jω)`` (method 'auto') on 1000
+  frequencies, n = 20, against the same request with ``method='modal'``;
+  target: within 2x of the modal time with peak memory <= 1.5 GB.
+* P6b: ``ltp.bode_htf`` of all 21 components on the same grid, against the
+  modal evaluation of the full HTF; same targets.
+* P6c: the dense path (``method='solve'``) on the same request: it must be
+  chunked, not refused, with peak memory <= 1.5 GB (default budget
+  ``ltp.config.defaults['htf.max_memory'] = 1 GB``).  It is timed on every
+  10th frequency and extrapolated.
+* P6d: ``htf`` + evaluation on 200 frequencies for n = 4, 20, 50 and
+  K = 5, 10, 20 ('auto'); a request whose harmonic state space cannot fit
+  the budget is refused with its estimated size (reported as such).
+
+Every case runs in a fresh subprocess, which reports its CPU time, the
+peak of `tracemalloc` (NumPy buffers; LAPACK workspace is not traced) and
+the growth of the peak resident-set size (``ru_maxrss``) during the work.
+Accuracy: the largest relative deviation from the other evaluation path
+(dense resolvent solves for the modal results, the modal form for the
+dense ones) at the same truncation, on 5 frequencies; tolerance 1e-8.
+"""
+
+import json
+import os
+import subprocess
+import sys
+
+from _common import row
+
+TOL = 1e-8
+LIMIT = 1.5e9
+FULL = dict(n=20, K=10, npoints=1000, stride=10, grid_n=(4, 20, 50), grid_K=(5, 10, 20),
+            grid_points=200)
+QUICK = dict(n=4, K=3, npoints=100, stride=10, grid_n=(4,), grid_K=(5,), grid_points=50)
+
+
+def run(quick=False, log=print):
+    cfg = QUICK if quick else FULL
+    n, K, npts = cfg['n'], cfg['K'], cfg['npoints']
+    work = f"HTF n={n} K={K}, {npts} freqs"
+    log(f"P6: {work}: auto, modal, bode_htf, solve")
+    auto = _measure('htf', n, K, npts, 'auto')
+    modal = _measure('htf', n, K, npts, 'modal')
+    bode = _measure('bode', n, K, npts, 'auto')
+    solve = _measure('htf', n, K, npts, 'solve', stride=cfg['stride'])
+    rows = []
+    for rid, res, ours in (('P6a', auto, "ltp.htf 'auto' + H(jω)"),
+                           ('P6b', bode, 'ltp.bode_htf, all 2K+1 components')):
+        ratio = res['time'] / modal['time']
+        rows.append(row(
+            rid, work, ours=ours, peer="ltp.htf method='modal' + H(jω)",
+            t_ours=res['time'], t_peer=modal['time'], metric='time/modal', value=ratio,
+            target='<= 2x modal, <= 1.5 GB', target_met=ratio <= 2 and res['rss'] <= LIMIT,
+            err_ours=res['err'], err_peer=modal['err'], tol=TOL,
+            checks={'ours <= tol': res['err'] <= TOL, 'peak RSS <= 1.5 GB': res['rss'] <= LIMIT},
+            notes=_mem_note(res), extra=dict(ours=res, peer=modal)))
+    rows.append(row(
+        'P6c', work, ours="ltp.htf method='solve' (dense, chunked)", t_ours=solve['time'],
+        metric='peak GB', value=solve['rss'] / 1e9, target='chunked, <= 1.5 GB',
+        target_met=solve['rss'] <= LIMIT and solve['chunks'] > 1, err_ours=solve['err'],
+        tol=TOL, checks={'not refused': solve['status'] == 'ok',
+                         'peak RSS <= 1.5 GB': solve['rss'] <= LIMIT},
+        notes=_mem_note(solve) + f", {solve['chunks']} chunks; timed on every "
+        f"{cfg['stride']}th frequency, extrapolated", extra=solve))
+    for nn in cfg['grid_n']:
+        for KK in cfg['grid_K']:
+            log(f"P6d: n={nn} K={KK}")
+            res = _measure('htf', nn, KK, cfg['grid_points'], 'auto')
+            wl = f"HTF n={nn} K={KK}, {cfg['grid_points']} freqs"
+            if res['status'] != 'ok':
+                rows.append(row(f"P6d n{nn} K{KK}", wl, ours="ltp.htf 'auto'",
+                                metric='refused', value=res['estimate'] / 1e9,
+                                target='fits or refused', target_met=True,
+                                checks={'refusal names the size': 'GB' in res['status']},
+                                notes=res['status'], extra=res))
+                continue
+            rows.append(row(
+                f"P6d n{nn} K{KK}", wl, ours="ltp.htf 'auto'", t_ours=res['time'],
+                metric='peak GB', value=res['rss'] / 1e9, target='<= 1.5 GB',
+                target_met=res['rss'] <= LIMIT, err_ours=res['err'], tol=TOL,
+                checks={'ours <= tol': res['err'] <= TOL}, notes=_mem_note(res), extra=res))
+    return rows
+
+
+def _mem_note(res):
+    return (f"peak RSS +{res['rss'] / 1e6:.0f} MB, tracemalloc {res['traced'] / 1e6:.0f} MB, "
+            f"{res['states']} harmonic states")
+
+
+def _measure(kind, n, K, npoints, method, stride=1):
+    """Run one case in a fresh interpreter (clean peak-memory counters)."""
+    args = [sys.executable, os.path.abspath(__file__), kind, str(n), str(K), str(npoints),
+            method, str(stride)]
+    proc = subprocess.run(args, capture_output=True, text=True, timeout=1800)
+    if proc.returncode != 0:
+        raise RuntimeError(f"P6 case {args[2:]} failed:\n{proc.stderr[-3000:]}")
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def make_system(n, seed=0, period=1.0):
+    import numpy as np
+    import ltpcontrol as ltp
+    rng = np.random.default_rng(seed)
+    A0 = rng.standard_normal((n, n)) / np.sqrt(n)
+    A0 -= (np.max(np.linalg.eigvals(A0).real) + 1.0) * np.eye(n)
+    A1 = 0.3 * rng.standard_normal((n, n)) / np.sqrt(n)
+    w = 2 * np.pi / period
+    return ltp.ltpss(lambda t: A0 + A1 * np.cos(w * t), rng.standard_normal((n, 1)),
+                     rng.standard_normal((1, n)), 0, period=period, name=f'random{n}')
+
+
+def _case(kind, n, K, npoints, method, stride):
+    import resource
+    import time
+    import tracemalloc
+    import warnings
+    import matplotlib
+    matplotlib.use('Agg')
+    import numpy as np
+    import ltpcontrol as ltp
+    from _common import CLOCK
+    warnings.simplefilter('ignore', UserWarning)
+    sys_ = make_system(n)
+    omega = np.linspace(0.05, 4 * K, npoints) * sys_.omega_p
+    pts = omega[::stride]
+    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    tracemalloc.start()
+    t0 = CLOCK['fn']()
+    out = dict(status='ok', chunks=1)
+    try:
+        H = ltp.htf(sys_, K, method=method)
+        if kind == 'bode':
+            cplt = ltp.bode_htf(H, omega, harmonics=range(-K, K + 1))
+            G = np.array([[line.get_ydata() for line in cell] for cell in cplt.lines.flat])
+            value = None
+        else:
+            value = H(1j * pts)
+    except MemoryError as exc:
+        out.update(status=str(exc), time=CLOCK['fn']() - t0, rss=0, traced=0, err=None,
+                   states=None, estimate=float(str(exc).split('about ')[1].split(' GB')[0]) * 1e9)
+        return out
+    elapsed = (CLOCK['fn']() - t0) * len(omega) / len(pts)
+    traced = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024 - rss0
+    nF = H._hss.F.shape[0]
+    # accuracy against dense solves at the same truncation, on 5 frequencies
+    check = np.linspace(0, len(omega) - 1, 5).astype(int)
+    other = 'modal' if method == 'solve' else 'solve'
+    ref = ltp.htf(sys_, K, method=other, internal_harmonics=H._hss.Ki)
+    if kind == 'bode':
+        _, comps = H.components(omega[check])
+        refc = ref.components(omega[check])[1]
+        err = np.abs(comps - refc).max() / np.abs(refc).max()
+        del G
+    else:
+        got = value[np.searchsorted(pts, omega[check]).clip(0, len(pts) - 1)]
+        want = ref(1j * pts[np.searchsorted(pts, omega[check]).clip(0, len(pts) - 1)])
+        err = np.abs(got - want).max() / np.abs(want).max()
+    if kind == 'htf':
+        chunk = H._hss._plan(len(pts), 2 * K + 1, 2 * K + 1)[0]
+        out['chunks'] = -(-len(pts) // chunk)
+    out.update(time=elapsed, rss=float(rss), traced=float(traced), err=float(err),
+               states=int(nF), modal=H._hss.modal is not None)
+    return out
+
+
+if __name__ == '__main__':
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    kind, n, K, npoints, method, stride = sys.argv[1:7]
+    print(json.dumps(_case(kind, int(n), int(K), int(npoints), method, int(stride))))
