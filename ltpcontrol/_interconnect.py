@@ -20,8 +20,7 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
-from ._ltpsys import LTPStateSpace, _loop_inverse, _merge_period, _to_ltp, append
-from ._periodic_matrix import PeriodicMatrix
+from ._ltpsys import LTPStateSpace, _loop_inverse, _period_and_dt, _to_ltp, append
 
 __all__ = ['interconnect']
 
@@ -81,7 +80,7 @@ def interconnect(syslist, connections=None, inplist=None, outlist=None, **kwargs
         raise ControlArgument(f"interconnect: LTP blocks have no parameters, got {params!r}")
     if not isinstance(syslist, (list, tuple)):
         raise ControlArgument("interconnect: syslist must be a list of systems")
-    period, dt = _period_and_dt(syslist)
+    period, dt = _period_and_dt(syslist, "interconnect")
     blocks = []
     for i, s in enumerate(syslist):
         if isinstance(s, ct.TransferFunction):
@@ -114,19 +113,3 @@ def interconnect(syslist, connections=None, inplist=None, outlist=None, **kwargs
     D = (Pw @ big.D + Pv) @ Uu
     return LTPStateSpace(A, B, C, D, period, dt=dt, name=ic.name, inputs=ic.input_labels,
                          outputs=ic.output_labels, states=ic.state_labels)
-
-
-def _period_and_dt(syslist):
-    periodic = [s for s in syslist if isinstance(s, (LTPStateSpace, PeriodicMatrix))]
-    if not periodic:
-        raise ControlArgument("interconnect: no block is periodic (LTPStateSpace or "
-                              "PeriodicMatrix); use control.interconnect")
-    period = periodic[0].period
-    for s in periodic[1:]:
-        period = _merge_period(period, s.period)
-    # static blocks (no states) fit any timebase
-    dts = {s.dt for s in syslist if isinstance(s, ct.InputOutputSystem)
-           and s.dt not in (None, True) and s.nstates}
-    if len(dts) > 1:
-        raise ValueError(f"interconnect: blocks have incompatible timebases {sorted(dts)}")
-    return period, (dts.pop() if dts else 0.0)

@@ -576,13 +576,7 @@ def append(*systems, **kwargs):
     """
     if not systems:
         raise ValueError("append needs at least one system")
-    ref = next((s for s in systems if isinstance(s, LTPStateSpace)), None)
-    if ref is None:
-        raise ControlArgument("append: at least one system must be an LTPStateSpace")
-    period, dt = ref.period, ref.dt
-    for s in systems:
-        if isinstance(s, LTPStateSpace):
-            period = _merge_period(period, s.period)
+    period, dt = _period_and_dt(systems, "append")
     systems = [_to_ltp(s, period, dt) for s in systems]
     out = systems[0]
     for s in systems[1:]:
@@ -732,17 +726,25 @@ def _to_ltp_or_none(obj, ref):
     return None
 
 
-def _common(sys1, sys2):
-    periodic = [s for s in (sys1, sys2) if isinstance(s, (LTPStateSpace, PeriodicMatrix))]
+def _period_and_dt(systems, where):
+    """Common period of the periodic operands and timebase of the dynamic ones."""
+    periodic = [s for s in systems if isinstance(s, (LTPStateSpace, PeriodicMatrix))]
     if not periodic:
-        raise ControlArgument("at least one system must be an LTPStateSpace or a "
+        raise ControlArgument(f"{where}: at least one system must be an LTPStateSpace or a "
                               "PeriodicMatrix gain")
     period = periodic[0].period
     for s in periodic[1:]:
         period = _merge_period(period, s.period)
-    # timebase of the dynamic operands (static gains fit any)
-    dt = next((s.dt for s in (sys1, sys2) if isinstance(s, ct.InputOutputSystem)
-               and s.nstates and s.dt not in (None, True)), 0.0)
+    # static operands (no states) fit any timebase
+    dts = {s.dt for s in systems if isinstance(s, ct.InputOutputSystem)
+           and s.dt not in (None, True) and s.nstates}
+    if len(dts) > 1:
+        raise ValueError(f"{where}: systems have incompatible timebases {sorted(dts)}")
+    return period, (dts.pop() if dts else 0.0)
+
+
+def _common(sys1, sys2):
+    period, dt = _period_and_dt((sys1, sys2), "block diagram")
     s1 = _to_ltp(sys1, period, dt)
     s2 = _to_ltp(sys2, period, dt)
     if isinstance(sys2, (int, float)) and s1.noutputs != 1:

@@ -9,21 +9,12 @@ import pytest
 
 import ltpcontrol as ltp
 from ltpcontrol import _htf
+from systems import random_periodic_plant
 
 matplotlib.use('Agg')
 
 
-def _plant(n=4, seed=0, period=1.0):
-    rng = np.random.default_rng(seed)
-    A0 = rng.standard_normal((n, n)) / np.sqrt(n)
-    A0 -= (np.max(np.linalg.eigvals(A0).real) + 1.0) * np.eye(n)
-    A1 = 0.3 * rng.standard_normal((n, n)) / np.sqrt(n)
-    w = 2 * np.pi / period
-    return ltp.ltpss(lambda t: A0 + A1 * np.cos(w * t), rng.standard_normal((n, 2)),
-                     rng.standard_normal((1, n)), 0, period=period)
-
-
-SYS = _plant()
+SYS = random_periodic_plant(4, ninputs=2)
 S = 1j * np.linspace(0.1, 20, 97)
 
 

@@ -142,7 +142,7 @@ def test_feedback_with_periodic_gain_is_pointwise():
 
 def test_interconnect_errors():
     P, C, G = _blocks()
-    with pytest.raises(ControlArgument, match="no block is periodic"):
+    with pytest.raises(ControlArgument, match="at least one system must be an LTPStateSpace"):
         ltp.interconnect([ct.ss(C)], inplist='e', outlist='v')
     nl = ct.nlsys(lambda t, x, u, p: -x + u, lambda t, x, u, p: x ** 2, states=1,
                   inputs='y', outputs='w', name='nl')
