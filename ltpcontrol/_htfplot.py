@@ -133,6 +133,8 @@ def bode_htf(htfs, omega=None, *fmt, harmonics=(-1, 0, 1), omega_limits=None,
             raise ValueError(f"label must have {len(frds)} entries, got {len(labels)}")
     if title is None:
         title = "HTF components of " + ", ".join(H.name for H in htfs)
+    if label is None and frds[0].noutputs * frds[0].ninputs > 1:
+        labels = None           # MIMO: python-control's labels from the FRD names (G_k)
     return ct.bode_plot(frds, None, *fmt, plot_phase=plot_phase, label=labels, ax=ax,
                         title=title, **kwargs)
 

@@ -425,7 +425,7 @@ def ltpss(*args, **kwargs):
 def series(*systems, **kwargs):
     """series(sys1, sys2[, ..., sysn])
 
-    Series connection ``y = sysn(...sys2(sys1(u)))``.
+    Series connection: the output of each system drives the next, ``y = sys2(sys1(u))``.
 
     Parameters
     ----------
@@ -467,7 +467,7 @@ def _series(sys1, sys2, **kwargs):
 def parallel(*systems, **kwargs):
     """parallel(sys1, sys2[, ..., sysn])
 
-    Parallel connection ``y = sys1(u) + sys2(u) + ... + sysn(u)``.
+    Parallel connection: the outputs of all systems are summed, ``y = sys1(u) + sys2(u)``.
 
     Parameters
     ----------

@@ -91,6 +91,14 @@ def test_bode_htf_evaluates_the_block_row_once(monkeypatch):
     matplotlib.pyplot.close(cplt.figure)
 
 
+def test_bode_htf_of_a_mimo_system():
+    cplt = ltp.bode_htf(ltp.htf(SYS, 1), S.imag[:20], harmonics=(0, 1))
+    assert cplt.axes.shape == (2, 2)                     # magnitude and phase x 2 inputs
+    labels = [line.get_label() for line in cplt.lines[0, 1]]
+    assert len(labels) == 2 and 'G_0' in labels[0] and 'G_1' in labels[1]
+    matplotlib.pyplot.close(cplt.figure)
+
+
 def test_progress_setting_shows_a_bar(capsys):
     H = ltp.htf(SYS, 3, method='solve')
     with ltp.config.defaults_context({'htf.max_memory': 2e6, 'htf.progress': True}):

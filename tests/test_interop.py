@@ -181,7 +181,7 @@ HOOK_CALLS = {
     'zeros': lambda m: m.zeros(P),
     'norm': lambda m: m.norm(P[0, 0], 2),
     'lqr': lambda m: m.lqr(P, np.eye(3), np.eye(2)),
-    'lqe': lambda m: m.lqe(P, np.eye(2), np.eye(2), np.eye(2)),
+    'lqe': lambda m: m.lqe(P, np.eye(2), np.eye(2)),
     'gram': lambda m: m.gram(P, 'c'),
     'lyap': lambda m: m.lyap(P, np.eye(3)),
 }
@@ -194,7 +194,13 @@ def test_analysis_entry_points_dispatch_or_name_the_ltp_function(name):
         with pytest.raises(ControlArgument, match=rf"ltp\.{name}\b"):
             call(ct)
         return
-    ours, theirs = call(ltp), call(ct)
+    try:
+        ours = call(ltp)
+    except Exception as exc:            # the same refusal through python-control's name
+        with pytest.raises(type(exc)):
+            call(ct)
+        return
+    theirs = call(ct)
     for a, b in zip(np.atleast_1d(ours) if not isinstance(ours, tuple) else ours,
                     np.atleast_1d(theirs) if not isinstance(theirs, tuple) else theirs):
         np.testing.assert_allclose(np.asarray(b, complex), np.asarray(a, complex),
