@@ -552,12 +552,6 @@ class _HarmonicStateSpace:
         c = np.arange(self.G.shape[1]) if cols is None else np.concatenate(
             [np.arange((k + K) * nu, (k + K + 1) * nu) for k in cols])
         self._ensure_modal(len(x))
-        if self.modal is not None:
-            lam = self.modal[0]
-            gap_small = np.abs(x[:, None] - lam[None, :]) <= 1e-13 * np.maximum(1.0, np.abs(lam))
-            if np.any(gap_small):
-                raise ValueError("the HTF is not defined at a Floquet exponent "
-                                 "(evaluation point is a pole)")
         chunk, use_residues = self._plan(len(x), len(r), len(c))
         J = self.J[np.ix_(r, c)]
         out = np.empty((len(x), len(r), len(c)), complex)
@@ -600,7 +594,11 @@ class _HarmonicStateSpace:
     def _modal_chunk(self, x, r, c, rows, cols, use_residues):
         # H(x)_{ij} = Σ_q HV_iq VG_qj / (x - λ_q)
         lam, HV, VG = self.modal
-        inv_gap = 1.0 / (x[:, None] - lam[None, :])
+        gap = x[:, None] - lam[None, :]
+        if np.any(np.abs(gap) <= 1e-13 * np.maximum(1.0, np.abs(lam))):
+            raise ValueError("the HTF is not defined at a Floquet exponent "
+                             "(evaluation point is a pole)")
+        inv_gap = 1.0 / gap
         if not use_residues:
             return (HV[r][None] * inv_gap[:, None, :]) @ VG[:, c]
         key = (None if rows is None else tuple(rows), None if cols is None else tuple(cols))

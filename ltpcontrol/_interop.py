@@ -59,7 +59,7 @@ def _time_response(name):
         bound = inspect.signature(orig).bind(*args, **kwargs)
         arg = dict(bound.arguments)
         arg.update(arg.pop('kwargs', {}))
-        sysdata = arg.pop('sysdata', None) if 'sysdata' in arg else arg.pop('sys')
+        sysdata = arg.pop('sysdata') if 'sysdata' in arg else arg.pop('sys')
         if isinstance(sysdata, (list, tuple)):
             return ct.TimeResponseList([_dispatch(name, orig, s, **arg) for s in sysdata])
         return _simulate(name, sysdata, arg)
@@ -88,8 +88,8 @@ def _simulate(name, sys, arg):
         # exact simulation: solver settings do not apply
         for key in ('ignore_errors', 'solve_ivp_kwargs', 'solve_ivp_method', 'method'):
             arg.pop(key, None)
-        if not (isinstance(arg.get('evaluation_times', 'T'), str)
-                and arg.pop('evaluation_times', 'T') == 'T'):
+        times = arg.pop('evaluation_times', 'T')
+        if not (isinstance(times, str) and times == 'T'):
             raise ControlArgument("input_output_response: an LTPStateSpace is evaluated at "
                                   "timepts (evaluation_times='T')")
         name = 'forced_response'
@@ -97,10 +97,6 @@ def _simulate(name, sys, arg):
     if ret is None:
         arg['return_states'] = bool(ct.config.defaults.get(f'{name}.return_x', False))
     return _ltp_function(name)(sys, **arg)
-
-
-def _io_response(orig, *args, **kwargs):
-    return _time_response('input_output_response')(orig, *args, **kwargs)
 
 
 #
@@ -114,8 +110,7 @@ def _supported_block(obj):
 
 def _blocks(name):
     def route(orig, *args, **kwargs):
-        systems = list(args[0]) if name == 'interconnect' else list(args[:2] if name == 'feedback'
-                                                                     else args)
+        systems = list(args[0]) if name == 'interconnect' else list(args)
         if not all(_supported_block(s) for s in systems):
             return orig(*args, **kwargs)        # a nonlinear block: python-control's system
         return _ltp_function(name)(*args, **kwargs)
@@ -128,7 +123,7 @@ ROUTES = {
     'step_response': _time_response('step_response'),
     'initial_response': _time_response('initial_response'),
     'impulse_response': _time_response('impulse_response'),
-    'input_output_response': _io_response,
+    'input_output_response': _time_response('input_output_response'),
     'feedback': _blocks('feedback'),
     'series': _blocks('series'),
     'parallel': _blocks('parallel'),
