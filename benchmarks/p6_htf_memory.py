@@ -62,7 +62,8 @@ def run(quick=False, log=print):
             t_ours=res['time'], t_peer=modal['time'], metric='time/modal', value=ratio,
             target='<= 2x modal, <= 1.5 GB', target_met=ratio <= 2 and _peak(res) <= LIMIT,
             err_ours=res['err'], err_peer=modal['err'], tol=TOL,
-            checks={'ours <= tol': res['err'] <= TOL, 'peak memory <= 1.5 GB': _peak(res) <= LIMIT},
+            checks={'ours <= tol': res['err'] <= TOL,
+                    'peak memory <= 1.5 GB': _peak(res) <= LIMIT},
             notes=_mem_note(res), extra=dict(ours=res, peer=modal)))
     rows.append(row(
         'P6c', work, ours="ltp.htf method='solve' (dense, chunked)", t_ours=solve['time'],
