@@ -4,13 +4,9 @@ Continuous-time systems are simulated exactly for inputs that are linear
 between samples (first-order hold, as `control.forced_response`) or constant
 (zero-order hold).  On a uniform grid whose step divides the period, the
 transition data of one period, ``x_{k+1} = Φ_k x_k + Γ0_k u_k + Γ1_k (u_{k+1} - u_k)``
-(see ``_transition``), is computed once and reused; the march is vectorised
-over periods and input traces:
-
-1. ``z_p = Σ_k Φ(T, t_{k+1}) w_{p,k}``: response to one period of forcing from
-   zero (loop over the N steps, all periods and traces at once);
-2. ``x_{(p+1)N} = Φ_T x_{pN} + z_p`` (loop over periods);
-3. the states inside every period (loop over the N steps again).
+(see ``_transition``), is computed once and reused: the states and outputs
+of all samples and traces then come from blocks of steps as matrix products
+(``_march``).
 
 A reference path (``method='solve_ivp'``) integrates with
 `scipy.integrate.solve_ivp` between switching instants.
@@ -24,6 +20,7 @@ from control.exception import ControlArgument, ControlDimension
 from scipy.integrate import solve_ivp
 
 from ._ltpsys import LTPStateSpace
+from ._march import periodic_march
 from ._transition import step_transitions
 from ._validation import check_kwargs, real_array
 
@@ -82,8 +79,7 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
     t = _time_vector(sys, timepts)
     u, ntraces = _input_array(sys, inputs, len(t))
     x0 = _initial_state(sys, initial_state, ntraces)
-    x = _simulate(sys, t, u, x0, method, input_hold, rtol)
-    y = _outputs(sys, t, x, u)
+    x, y = _simulate(sys, t, u, x0, method, input_hold, rtol)
     multi = u.shape[1] > 1 or np.ndim(inputs) == 3
     if not multi:
         x, y, u = x[:, 0], y[:, 0], u[:, 0]
@@ -244,7 +240,7 @@ def impulse_response(sys, timepts=None, input_indices=None, output_indices=None,
 #
 
 def _simulate(sys, t, u, x0, method, hold, rtol):
-    """States (nstates, ntraces, len(t)) by the requested engine."""
+    """States (nstates, ntraces, len(t)) and outputs by the requested engine."""
     if method not in ('transition', 'solve_ivp'):
         raise ValueError(f"method must be 'transition' or 'solve_ivp', got {method!r}")
     if hold not in ('foh', 'zoh'):
@@ -253,76 +249,43 @@ def _simulate(sys, t, u, x0, method, hold, rtol):
     if sys.isdtime():
         return _march_discrete(sys, t, u, x0)
     if method == 'solve_ivp':
-        return _solve_ivp(sys, t, u, x0, hold, rtol)
+        x = _solve_ivp(sys, t, u, x0, hold, rtol)
+        return x, _outputs(sys, t, x, u)
     return _march_continuous(sys, t, u, x0, hold, rtol)
 
 
 def _march_continuous(sys, t, u, x0, hold, rtol):
     h = np.diff(t)
-    n = sys.nstates
     if len(t) == 1:
-        return x0[:, :, None].copy()
+        x = x0[:, :, None].copy()
+        return x, _outputs(sys, t, x, u)
     nper = sys.period / h[0]
     uniform = np.allclose(h, h[0], rtol=1e-10, atol=0)
     if uniform and abs(nper - round(nper)) < 1e-9 * nper and round(nper) <= len(h):
-        N = int(round(nper))
-        Phi, G0, G1 = step_transitions(sys.A, sys.B, t[0] + h[0] * np.arange(N), h[0], rtol)
-        if hold == 'zoh':
-            G1 = np.zeros_like(G1)
-        return _march_periodic(Phi, G0, G1, u, x0)
+        # the step data and C, D at the samples repeat with the period
+        tk = t[0] + h[0] * np.arange(int(round(nper)))
+        Phi, G0, G1 = step_transitions(sys.A, sys.B, tk, h[0], rtol)
+        F = None if hold == 'zoh' else G1
+        E = G0 if hold == 'zoh' else G0 - G1
+        return periodic_march(Phi, E, F, sys.C(tk), sys.D(tk), u, x0)
+    # x_{k+1} = Φ_k x_k + Γ0_k u_k + Γ1_k (u_{k+1} - u_k) on an arbitrary grid
     Phi, G0, G1 = step_transitions(sys.A, sys.B, t[:-1], h, rtol)
     if hold == 'zoh':
         G1 = np.zeros_like(G1)
-    x = np.empty((n,) + u.shape[1:])
+    x = np.empty((sys.nstates,) + u.shape[1:])
     x[:, :, 0] = x0
     du = np.diff(u, axis=2)
     for k in range(len(h)):
         x[:, :, k + 1] = Phi[k] @ x[:, :, k] + G0[k] @ u[:, :, k] + G1[k] @ du[:, :, k]
-    return x
-
-
-def _march_periodic(Phi, G0, G1, u, x0):
-    """Exact march with periodic step data (see the module docstring)."""
-    N, n = Phi.shape[0], Phi.shape[1]
-    nu, R, L = u.shape
-    P = -(-(L - 1) // N)
-    # pad the input to P whole periods (the extra samples are discarded) and
-    # lay it out as (step in period, input, trace x period)
-    upad = np.concatenate([u, np.repeat(u[:, :, -1:], P * N + 1 - L, axis=2)], axis=2)
-    ustep = upad[:, :, :-1].reshape(nu, R, P, N).transpose(3, 0, 1, 2).reshape(N, nu, R * P)
-    unext = upad[:, :, 1:].reshape(nu, R, P, N).transpose(3, 0, 1, 2).reshape(N, nu, R * P)
-    # forcing w_k = Γ0_k u_k + Γ1_k (u_{k+1} - u_k), shape (N, n, R*P)
-    w = (G0 - G1) @ ustep + G1 @ unext
-    # 1. response to one period of forcing from zero, all periods at once
-    z = np.zeros((n, R * P))
-    PhiT = np.eye(n)
-    for k in range(N):
-        z = Phi[k] @ z + w[k]
-        PhiT = Phi[k] @ PhiT
-    # 2. period-start states x_{(p+1)N} = Φ_T x_{pN} + z_p
-    z = z.reshape(n, R, P)
-    starts = np.empty((n, R, P))
-    xp = x0
-    for p in range(P):
-        starts[:, :, p] = xp
-        xp = PhiT @ xp + z[:, :, p]
-    # 3. states inside every period
-    x = np.empty((N, n, R * P))
-    xk = starts.reshape(n, R * P)
-    for k in range(N):
-        x[k] = xk
-        xk = Phi[k] @ xk + w[k]
-    x = x.reshape(N, n, R, P).transpose(1, 2, 3, 0).reshape(n, R, P * N)
-    return np.concatenate([x, xp[:, :, None]], axis=2)[:, :, :L]
+    return x, _outputs(sys, t, x, u)
 
 
 def _march_discrete(sys, t, u, x0):
     N = sys.nsteps
     k0 = int(round(t[0] / sys.dt))
     phase = (k0 + np.arange(N)) % N
-    Ak = sys.A.sample(N)[phase]
-    Bk = sys.B.sample(N)[phase]
-    return _march_periodic(Ak, Bk, np.zeros_like(Bk), u, x0)
+    A, B, C, D = (M.sample(N)[phase] for M in (sys.A, sys.B, sys.C, sys.D))
+    return periodic_march(A, B, None, C, D, u, x0)
 
 
 def _solve_ivp(sys, t, u, x0, hold, rtol):
@@ -471,8 +434,8 @@ def _trace_response(sys, t, u, x0, ins, outs, trace_type, title, return_states,
     hold = kwargs.pop('input_hold', 'foh')
     rtol = kwargs.pop('rtol', 1e-12)
     check_kwargs(kwargs, title.split()[0].lower() + '_response')
-    x = _simulate(sys, t, u, x0, method, hold, rtol)
-    y = _outputs(sys, t, x, u)[outs]
+    x, y = _simulate(sys, t, u, x0, method, hold, rtol)
+    y = y[outs]
     return ct.TimeResponseData(
         t, y, x, u, issiso=len(outs) == 1 and len(ins) == 1,
         output_labels=[sys.output_labels[i] for i in outs], input_labels=sys.input_labels,

@@ -143,18 +143,28 @@ def _magnus(A, B, a, b, step_t0, step_h, nsub, n, m, d):
     return E
 
 
-# Padé(13) coefficients and the 1-norm bound θ13 of Higham's scaling-and-squaring
-_PADE13 = np.array([64764752532480000., 32382376266240000., 7771770303897600.,
-                    1187353796428800., 129060195264000., 10559470521600., 670442572800.,
-                    33522128640., 1323241920., 40840800., 960960., 16380., 182., 1.])
-_THETA13 = 5.371920351148152
+# Padé [m/m] coefficients and Higham's 1-norm bounds θ_m (degrees 3, 5, 7, 9, 13):
+# below θ_m the degree-m approximant is exact to double precision without scaling
+_PADE = {
+    3: np.array([120., 60., 12., 1.]),
+    5: np.array([30240., 15120., 3360., 420., 30., 1.]),
+    7: np.array([17297280., 8648640., 1995840., 277200., 25200., 1512., 56., 1.]),
+    9: np.array([17643225600., 8821612800., 2075673600., 302702400., 30270240., 2162160.,
+                 110880., 3960., 90., 1.]),
+    13: np.array([64764752532480000., 32382376266240000., 7771770303897600.,
+                  1187353796428800., 129060195264000., 10559470521600., 670442572800.,
+                  33522128640., 1323241920., 40840800., 960960., 16380., 182., 1.]),
+}
+_THETA = {3: 1.495585217958292e-2, 5: 2.539398330063230e-1, 7: 9.504178996162932e-1,
+          9: 2.097847961257068, 13: 5.371920351148152}
 
 
 def expm_batch(X):
     """Matrix exponential of a stack of small matrices, shape (S, d, d).
 
-    Scaling and squaring with the [13/13] Padé approximant, vectorised over
-    the stack: ``e^X = (r13(X / 2^s))^{2^s}`` with ``‖X‖₁ / 2^s <= θ13``.
+    Higham's scaling and squaring, vectorised over the stack: each matrix
+    gets the lowest Padé degree m in (3, 5, 7, 9) with ``‖X‖₁ <= θ_m``;
+    the others ``e^X = (r13(X / 2^s))^{2^s}`` with ``‖X‖₁ / 2^s <= θ13``.
 
     Examples
     --------
@@ -164,19 +174,43 @@ def expm_batch(X):
     array([[1., 1.],
            [0., 1.]])
     """
-    d = X.shape[-1]
+    X = np.asarray(X, float)
     norms = np.abs(X).sum(axis=-2).max(axis=-1)
-    s = np.maximum(0, np.ceil(np.log2(np.maximum(norms, 1e-300) / _THETA13))).astype(int)
-    Xs = X / (2.0 ** s)[:, None, None]
-    b = _PADE13
-    ident = np.eye(d)
-    X2 = Xs @ Xs
-    X4 = X2 @ X2
-    X6 = X4 @ X2
-    U = Xs @ (X6 @ (b[13] * X6 + b[11] * X4 + b[9] * X2)
-              + b[7] * X6 + b[5] * X4 + b[3] * X2 + b[1] * ident)
-    V = X6 @ (b[12] * X6 + b[10] * X4 + b[8] * X2) \
-        + b[6] * X6 + b[4] * X4 + b[2] * X2 + b[0] * ident
+    E = np.empty_like(X)
+    degree = np.full(len(X), 13)
+    for m in (9, 7, 5, 3):
+        degree[norms <= _THETA[m]] = m
+    for m in (3, 5, 7, 9, 13):
+        sel = np.flatnonzero(degree == m)
+        if sel.size:
+            E[sel] = _pade(X[sel], norms[sel], m)
+    return E
+
+
+def _pade(X, norms, m):
+    """r_m(X / 2^s)^(2^s); s = 0 unless m = 13."""
+    d = X.shape[-1]
+    s = np.zeros(len(X), int)
+    if m == 13:
+        s = np.maximum(0, np.ceil(np.log2(np.maximum(norms, 1e-300) / _THETA[13]))).astype(int)
+        X = X / (2.0 ** s)[:, None, None]
+    b = _PADE[m]
+    ident = np.broadcast_to(np.eye(d), X.shape)
+    X2 = X @ X
+    if m == 13:
+        X4 = X2 @ X2
+        X6 = X4 @ X2
+        U = X @ (X6 @ (b[13] * X6 + b[11] * X4 + b[9] * X2)
+                 + b[7] * X6 + b[5] * X4 + b[3] * X2 + b[1] * ident)
+        V = X6 @ (b[12] * X6 + b[10] * X4 + b[8] * X2) \
+            + b[6] * X6 + b[4] * X4 + b[2] * X2 + b[0] * ident
+    else:
+        # U = X Σ b_{2j+1} X^{2j},  V = Σ b_{2j} X^{2j}
+        powers = [ident, X2]
+        while len(powers) < (m + 1) // 2:
+            powers.append(powers[-1] @ X2)
+        U = X @ sum(b[2 * j + 1] * P for j, P in enumerate(powers))
+        V = sum(b[2 * j] * P for j, P in enumerate(powers))
     E = np.linalg.solve(V - U, V + U)
     for j in range(int(s.max()) if len(s) else 0):
         sel = s > j

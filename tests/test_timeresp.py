@@ -26,6 +26,9 @@ def reference(f, t, x0, breaks=()):
 
 
 def test_lti_limit_equals_python_control():
+    # seeded: ct.rss occasionally draws ‖A‖ ~ 1e6 with slow poles, where the
+    # step exponential itself is conditioned worse than the 1e-9 asked here
+    np.random.seed(11)
     G = ct.rss(4, 2, 2, strictly_proper=False)
     sys = ltp.ltpss(G, 0.37)
     t = np.linspace(0, 10, 1001)
