@@ -48,7 +48,7 @@ sphinx_gallery_conf = {
     'examples_dirs': '../examples',
     'gallery_dirs': 'auto_examples',
     'ignore_pattern': r'(^|/)(?!plot_)[^/]+\.py$',
-    'filename_pattern': r'/plot_(mathieu_htf|hopper_htf|switching_mathieu)\.py$',
+    'filename_pattern': r'/plot_(mathieu_htf|hopper_htf|switching_mathieu|analysis)\.py$',
     'within_subsection_order': 'FileNameSortKey',
     'download_all_examples': False,
     'show_memory': False,

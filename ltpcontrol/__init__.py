@@ -30,6 +30,10 @@ from ._hybrid_ls import hybrid_ls, HybridLSResult
 from ._realization import floquet_realization, FloquetRealization
 from ._canonical import to_canonical, matrix_errors, MatrixErrors
 from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
+from ._lyapunov import lyap, dlyap, gram
+from ._norms import norm
+from ._zeros import zeros
+from ._harmonic_ss import harmonic_ss
 
 __version__ = "0.1.0"
 
@@ -59,6 +63,8 @@ __all__ = [
     'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
+    # analysis: Lyapunov equations, gramians, zeros, norms
+    'lyap', 'dlyap', 'gram', 'norm', 'zeros', 'harmonic_ss',
 ]
 
 # python-control's entry points dispatch LTP systems to ltpcontrol (see _interop)

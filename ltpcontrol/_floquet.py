@@ -28,6 +28,7 @@ import scipy.sparse.linalg as spla
 from control.exception import ControlArgument
 
 from ._periodic_matrix import PeriodicMatrix
+from ._steps import step_grid
 from ._transition import expm_batch, step_transitions
 from ._validation import check_kwargs, check_positive_int, steps_per_period
 
@@ -347,17 +348,7 @@ def _factors(sys, nsteps):
         return np.arange(nper + 1) * sys.dt, A.sample(nper)
     if n == 0:
         return np.array([0.0, T]), np.zeros((1, 0, 0))
-    if nsteps is None:
-        probe = np.concatenate([np.arange(256) * T / 256, A.breakpoints])
-        norm = np.max(np.linalg.norm(A(probe), ord=2, axis=(1, 2)), initial=0.0)
-        nsteps = int(np.clip(np.ceil(T * norm), 16, 4096))
-    grid = np.union1d(np.linspace(0, T, nsteps + 1), A.breakpoints)
-    # drop grid points that nearly coincide with a switching instant
-    keep = np.concatenate([[True], np.diff(grid) > 1e-9 * T / nsteps])
-    keep[-1] = True
-    grid = grid[keep]
-    grid = grid[np.concatenate([np.diff(grid) > 0, [True]])]
-    grid[-1] = T
+    grid = step_grid(A, nsteps=nsteps)
     zero = PeriodicMatrix.constant(np.zeros((n, 0)), T)
     phi, _, _ = step_transitions(A, zero, grid[:-1], np.diff(grid))
     return grid, phi

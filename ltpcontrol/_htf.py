@@ -263,6 +263,12 @@ class HTF:
         return ct.frd(data, omega, name=name or self.name, inputs=inputs,
                       outputs=self.output_labels, dt=self.dt if self.dt else 0)
 
+    # -- harmonic state space (implemented in _harmonic_ss) --
+    def to_ss(self, name=None):
+        """Real harmonic state space of a model HTF; see `ltpcontrol.harmonic_ss`."""
+        from ._harmonic_ss import htf_to_ss
+        return htf_to_ss(self, name)
+
     def predict(self, u, t):
         """Output predicted by the HTF for an input signal (steady state).
 

@@ -34,7 +34,8 @@ from ._validation import check_kwargs, check_positive_int
 __all__ = ['lift']
 
 
-def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, **kwargs):
+def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, start=0,
+         **kwargs):
     """Lift a discrete-time LTP system to an equivalent LTI system.
 
     Parameters
@@ -59,6 +60,10 @@ def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, **kwar
         A truncated model neglects the coupling with the dropped harmonics.
     name : str, optional
         Name of the result (default: the name of `sysd` with '$lifted').
+    start : int, optional
+        Step ``k0`` in 0..N-1 at which the lifted periods begin: the result
+        lifts the shifted system ``A[k0 + k], B[k0 + k], ...`` (time
+        lifting: ``x_L[p] = x[pN + k0]``).  Default 0.
 
     Returns
     -------
@@ -102,6 +107,8 @@ def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, **kwar
     >>> Lt = ltp.lift(sysd, method='time')
     >>> Lt.shape, Lt.dt
     ((4, 4), 1.0)
+    >>> ltp.lift(sysd, method='time', start=1).B[0, 0]     # Φ(5, 2) B[1]
+    np.float64(0.0625)
     """
     check_kwargs(kwargs, 'lift')
     if not isinstance(sysd, LTPStateSpace):
@@ -114,9 +121,12 @@ def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, **kwar
     if not isinstance(real, (bool, np.bool_)):
         raise ControlArgument(f"real must be True or False, got {real!r}")
     N = sysd.nsteps
+    start = check_positive_int(start, 'start', minimum=0)
+    if start >= N:
+        raise ValueError(f"start={start} must be a step of the period, 0..{N - 1}")
     if name is None:
         name = sysd.name + '$lifted'
-    samples = [M.sample(N) for M in (sysd.A, sysd.B, sysd.C, sysd.D)]
+    samples = [np.roll(M.sample(N), -start, axis=0) for M in (sysd.A, sysd.B, sysd.C, sysd.D)]
     if method == 'time':
         if nharmonics is not None:
             raise ValueError("nharmonics only applies to method='frequency'")

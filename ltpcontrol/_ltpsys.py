@@ -271,6 +271,23 @@ class LTPStateSpace(NonlinearIOSystem):
         """
         return self.floquet_exponents()
 
+    # -- LTI-only requests: a clear pointer to the LTP counterpart --
+    def frequency_response(self, omega=None, squeeze=None):
+        """Not defined for an LTP system: its frequency response is the HTF (`ltpcontrol.htf`)."""
+        raise ControlArgument(f"{self.name} is time-periodic: it has no LTI frequency "
+                              "response; use ltp.htf(sys, nharmonics) (or "
+                              "ltp.harmonic_ss) for its harmonic transfer function")
+
+    def dcgain(self, warn_infinite=False):
+        """Not defined for an LTP system; see `ltpcontrol.htf`."""
+        raise ControlArgument(f"{self.name} is time-periodic: it has no DC gain; use "
+                              "ltp.htf(sys, nharmonics)(0) for its harmonic DC response")
+
+    def zeros(self, nharmonics=None, *, rtol=1e-8):
+        """Transmission zeros; see `ltpcontrol.zeros` (so `control.zeros` works)."""
+        from ._zeros import zeros
+        return zeros(self, nharmonics, rtol=rtol)
+
     def is_stable(self, **kwargs):
         """True when all Floquet multipliers lie inside the unit circle."""
         from ._floquet import is_stable

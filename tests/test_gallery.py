@@ -14,6 +14,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / 'examples'
     ('plot_mathieu_htf.py', 'mathieu_htf.png'),
     ('plot_hopper_htf.py', 'hopper_htf.png'),
     ('plot_switching_mathieu.py', 'switching_mathieu.png'),
+    ('plot_analysis.py', 'analysis.png'),
 ])
 def test_gallery_script_runs(script, figure, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)

@@ -1,0 +1,334 @@
+"""Periodic Lyapunov equations and gramians.
+
+Continuous time, on the step grid ``0 = t_0 < ... < t_M = T`` (`_steps`):
+
+    forward  Ẋ = A X + X Aᵀ + Q:     X_{k+1} = Φ_k X_k Φ_kᵀ + W_k,
+    adjoint −Ẋ = Aᵀ X + X A + Q:     X_k = Φ_kᵀ X_{k+1} Φ_k + V_k,
+
+with the per-step factors ``Φ_k`` and Van Loan integrals ``W_k, V_k``.
+Discrete time the same recursions hold with ``Φ_k = A[k]`` and
+``W_k = V_k = Q[k]``.  The M unknowns ``X_0..X_{M-1}`` (``X_M = X_0``)
+are coupled cyclically; the cyclic system
+
+    vec X_{k+1} − (Φ_k ⊗ Φ_k) vec X_k = vec W_k,   k = 0..M−1,
+
+is solved at once by a sparse LU factorisation (block bidiagonal plus the
+corner block), never by iterating the period map, so the solve is exact
+also for stiff or unstable A.  It is nonsingular iff no two Floquet
+multipliers satisfy ``μ_i μ_j = 1``, which is checked first from the
+periodic Schur form of the factors.  Values between grid points come from
+the step formula over the partial step.
+"""
+
+import warnings
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from control.exception import ControlArgument, ControlDimension
+
+from ._periodic_matrix import PeriodicMatrix, as_periodic
+from ._steps import step_grid, step_integrals
+from ._validation import check_kwargs, real_array
+
+__all__ = ['lyap', 'dlyap', 'gram']
+
+# |μ_i μ_j − 1| below which the periodic solution is taken as not unique,
+# and below which it is reported as ill-conditioned
+_SINGULAR = 1e-10
+_ILLCOND = 1e-6
+
+
+def lyap(A, Q, *, adjoint=False, period=None, nsteps=None):
+    """Periodic solution of a continuous-time periodic Lyapunov equation.
+
+    Forward (default) ``dX/dt = A(t) X + X A(t)ᵀ + Q(t)``; adjoint
+    ``−dX/dt = A(t)ᵀ X + X A(t) + Q(t)``.  An LTI ``A, Q`` gives the
+    solution of ``A X + X Aᵀ + Q = 0`` (`control.lyap`).
+
+    Parameters
+    ----------
+    A : PeriodicMatrix, callable or array_like, shape (n, n)
+        Periodic state matrix (a callable or constant array needs `period`).
+    Q : PeriodicMatrix, callable or array_like, shape (n, n)
+        Symmetric periodic weight; its period must divide that of `A`.
+    adjoint : bool, optional
+        Solve the adjoint (backward) equation.
+    period : float, optional
+        Period T when `A` is not a `PeriodicMatrix`.
+    nsteps : int, optional
+        Uniform steps of the period grid (switching instants are added);
+        default ``ceil(T max‖A‖)`` clipped to [16, 4096].
+
+    Returns
+    -------
+    X : PeriodicMatrix
+        The unique T-periodic solution; evaluating it between grid points
+        propagates the nearest grid value exactly.
+
+    Raises
+    ------
+    ValueError
+        If there is no unique periodic solution (Floquet multipliers with
+        ``μ_i μ_j = 1``), Q is not symmetric, or the periods do not match.
+    ControlDimension
+        If A is not square or Q does not have the shape of A.
+
+    Examples
+    --------
+    An LTI equation gives `control.lyap`:
+
+    >>> A, Q = np.array([[-1.0, 2.0], [0.0, -3.0]]), np.eye(2)
+    >>> X = ltp.lyap(A, Q, period=1.0)
+    >>> np.allclose(X(0.3), ct.lyap(A, Q))
+    True
+    """
+    A, Q = _pair(A, Q, period, 'lyap')
+    _check_bool(adjoint, 'adjoint')
+    grid = step_grid(A, [Q], nsteps)
+    weights = {'Qa': Q} if adjoint else {'Qf': Q}
+    Phi, W, V, _ = step_integrals(A, grid[:-1], np.diff(grid), **weights)
+    X = cyclic_lyap(Phi, V if adjoint else W, adjoint)
+    return periodic_solution(A, Q, grid, X, adjoint)
+
+
+def dlyap(A, Q, *, adjoint=False):
+    """Periodic solution of a discrete-time periodic Lyapunov equation.
+
+    Forward (default) ``X[k+1] = A[k] X[k] A[k]ᵀ + Q[k]``; adjoint
+    ``X[k] = A[k]ᵀ X[k+1] A[k] + Q[k]``, indices modulo N.  An LTI
+    ``A, Q`` gives `control.dlyap`.
+
+    Parameters
+    ----------
+    A : array_like, shape (N, n, n) or (n, n)
+        The N matrices of one period (a 2D array: N = 1, or N from `Q`).
+    Q : array_like, shape (N, n, n) or (n, n)
+        Symmetric weights (a 2D array is the same at every step).
+    adjoint : bool, optional
+        Solve the adjoint (backward) equation.
+
+    Returns
+    -------
+    X : ndarray, shape (N, n, n)
+        ``X[k]`` for k = 0..N−1.
+
+    Raises
+    ------
+    ValueError
+        If there is no unique periodic solution (``μ_i μ_j = 1``) or Q is
+        not symmetric.
+    ControlDimension
+        For inconsistent shapes or numbers of steps.
+
+    Examples
+    --------
+    >>> A = np.array([[[0.5, 1.0], [0.0, 0.2]], [[0.1, 0.0], [1.0, -0.3]]])
+    >>> X = ltp.dlyap(A, np.eye(2))
+    >>> np.allclose(X[1], A[0] @ X[0] @ A[0].T + np.eye(2))
+    True
+    """
+    _check_bool(adjoint, 'adjoint')
+    A = real_array(A, 'A', ndim=(2, 3))
+    Q = real_array(Q, 'Q', ndim=(2, 3))
+    if A.shape[-1] != A.shape[-2]:
+        raise ControlDimension(f"A must hold square matrices, got shape {A.shape}")
+    n = A.shape[-1]
+    if Q.shape[-2:] != (n, n):
+        raise ControlDimension(f"Q must hold {n}x{n} matrices like A, got shape {Q.shape}")
+    N = max(A.shape[0] if A.ndim == 3 else 1, Q.shape[0] if Q.ndim == 3 else 1)
+    for M, name in ((A, 'A'), (Q, 'Q')):
+        if M.ndim == 3 and M.shape[0] != N:
+            raise ControlDimension(f"{name} has {M.shape[0]} steps but the period has {N}")
+    A = np.broadcast_to(A, (N, n, n))
+    Q = np.broadcast_to(Q, (N, n, n))
+    _check_symmetric(Q, 'Q')
+    return cyclic_lyap(A, Q, adjoint)
+
+
+def gram(sys, type):
+    """Periodic controllability or observability gramian.
+
+    Controllability (``'c'``): the forward solution with ``Q = B Bᵀ``;
+    observability (``'o'``): the adjoint solution with ``Q = Cᵀ C``
+    (`lyap`, `dlyap`).  ``P(t)`` is the gramian of the input on
+    ``(−∞, t]`` and ``Q(t)`` that of the output on ``[t, ∞)``.  An LTI
+    system gives `control.gram`.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        Stable continuous- or discrete-time LTP system.
+    type : {'c', 'o'}
+        Which gramian.
+
+    Returns
+    -------
+    PeriodicMatrix
+        Continuous time: the gramian as a function of t.  Discrete time:
+        a piecewise-constant matrix with value ``X[k]`` on ``[k dt, (k+1) dt)``
+        (``.sample(N)`` returns the stack).
+
+    Raises
+    ------
+    ValueError
+        If the system is unstable or `type` is unknown.
+
+    Examples
+    --------
+    >>> G = ct.rss(3, 1, 1, strictly_proper=True)
+    >>> P = ltp.gram(ltp.ltpss(G, period=2.0), 'c')
+    >>> np.allclose(P(0.7), ct.gram(G, 'c'))
+    True
+    """
+    from ._ltpsys import LTPStateSpace
+    if not isinstance(sys, LTPStateSpace):
+        raise ControlArgument(f"sys must be an LTPStateSpace, got {sys.__class__.__name__}")
+    if type not in ('c', 'o'):
+        raise ValueError(f"type must be 'c' or 'o', got {type!r}")
+    if not sys.is_stable():
+        raise ValueError("gram: the system is unstable; gramians exist for stable "
+                         "systems only")
+    adjoint = type == 'o'
+    Q = sys.C.T @ sys.C if adjoint else sys.B @ sys.B.T
+    if sys.isdtime():
+        N = sys.nsteps
+        X = dlyap(sys.A.sample(N), Q.sample(N), adjoint=adjoint)
+        return PeriodicMatrix.from_samples(X, sys.period, kind='hold')
+    return lyap(sys.A, Q, adjoint=adjoint)
+
+
+#
+# Shared solvers (also used by the norms)
+#
+
+def cyclic_lyap(Phi, W, adjoint=False, check=True):
+    """Solve the cyclic periodic discrete Lyapunov equation (module notes).
+
+    ``X_{k+1} = Φ_k X_k Φ_kᵀ + W_k`` (forward) or ``X_k = Φ_kᵀ X_{k+1}
+    Φ_k + W_k`` (adjoint), k = 0..M−1 cyclic; returns ``X_0..X_{M−1}``.
+    ``check=False`` skips the uniqueness test (for callers that know the
+    factors are stable).
+
+    Examples
+    --------
+    >>> from ltpcontrol._lyapunov import cyclic_lyap
+    >>> X = cyclic_lyap(np.array([[[0.5]], [[3.0]]]), np.ones((2, 1, 1)))
+    >>> X[:, 0, 0]          # X1 = X0/4 + 1, X0 = 9 X1 + 1
+    array([-8., -1.])
+    """
+    M, n = Phi.shape[0], Phi.shape[1]
+    if n == 0:
+        return np.zeros((M, 0, 0))
+    if check:
+        check_unique(Phi)
+    nn = n * n
+    K = np.einsum('kia,kjb->kijab', Phi, Phi).reshape(M, nn, nn)   # Φ ⊗ Φ
+    if adjoint:
+        K = np.swapaxes(K, 1, 2)                   # Φᵀ ⊗ Φᵀ
+    blocks = np.arange(M)
+    nxt = (blocks + 1) % M
+    # equation k: row block r_k, identity on x_{out}, −K_k on x_{in}
+    out_blk, in_blk = (blocks, nxt) if adjoint else (nxt, blocks)
+    row_blk = out_blk
+    i = np.arange(nn)
+    shape = (M, nn, nn)
+    rows = np.concatenate([(row_blk[:, None] * nn + i).ravel(), np.broadcast_to(
+        row_blk[:, None, None] * nn + i[None, :, None], shape).ravel()])
+    cols = np.concatenate([(out_blk[:, None] * nn + i).ravel(), np.broadcast_to(
+        in_blk[:, None, None] * nn + i[None, None, :], shape).ravel()])
+    vals = np.concatenate([np.ones(M * nn), -K.ravel()])
+    L = sp.csc_matrix((vals, (rows, cols)), shape=(M * nn, M * nn))
+    rhs = np.empty(M * nn)
+    rhs[(row_blk[:, None] * nn + i).ravel()] = W.reshape(M, nn).ravel()
+    X = spla.splu(L).solve(rhs).reshape(M, n, n)
+    return 0.5 * (X + np.swapaxes(X, 1, 2))
+
+
+def check_unique(Phi):
+    """Raise if ``μ_i μ_j = 1`` for two multipliers of ``Φ_{M−1} ... Φ_0``.
+
+    Examples
+    --------
+    >>> from ltpcontrol._lyapunov import check_unique
+    >>> check_unique(np.array([[[2.0, 0.0], [0.0, 0.5]]]))
+    Traceback (most recent call last):
+    ...
+    ValueError: the periodic Lyapunov equation has no unique periodic solution: two Floquet multipliers satisfy mu_i mu_j = 1 (|mu_i mu_j - 1| = 0.0e+00)
+    """
+    from ._floquet import _log_multipliers
+    logmod, arg = _log_multipliers(None, None, grid=None, factors=Phi)
+    s = logmod[:, None] + logmod[None, :]
+    with np.errstate(over='ignore', invalid='ignore'):
+        gap = np.abs(np.exp(np.minimum(s, 50.0) + 1j * (arg[:, None] + arg[None, :])) - 1)
+    worst = np.min(np.where(np.isnan(gap), np.inf, gap))
+    if worst <= _SINGULAR:
+        raise ValueError("the periodic Lyapunov equation has no unique periodic solution: "
+                         "two Floquet multipliers satisfy mu_i mu_j = 1 "
+                         f"(|mu_i mu_j - 1| = {worst:.1e})")
+    if worst <= _ILLCOND:
+        warnings.warn("the periodic Lyapunov equation is ill-conditioned: two Floquet "
+                      f"multipliers nearly satisfy mu_i mu_j = 1 (|mu_i mu_j - 1| = "
+                      f"{worst:.1e})", UserWarning, stacklevel=3)
+
+
+def periodic_solution(A, Q, grid, X, adjoint):
+    """PeriodicMatrix evaluating the solution from the grid values `X`."""
+    T, n = A.period, A.shape[0]
+    starts, ends = grid[:-1], grid[1:]
+    Xn = np.concatenate([X, X[:1]])              # X_M = X_0
+
+    def evaluate(t):
+        tau = np.mod(np.asarray(t, float), T)
+        k = np.clip(np.searchsorted(starts, tau, side='right') - 1, 0, len(starts) - 1)
+        if adjoint:
+            # X(τ) = Φ(t_{k+1}, τ)ᵀ X_{k+1} Φ(t_{k+1}, τ) + V(τ, t_{k+1})
+            Phi, _, V, _ = step_integrals(A, tau, ends[k] - tau, Qa=Q)
+            return np.swapaxes(Phi, 1, 2) @ Xn[k + 1] @ Phi + V
+        # X(τ) = Φ(τ, t_k) X_k Φ(τ, t_k)ᵀ + W(t_k, τ)
+        Phi, W, _, _ = step_integrals(A, starts[k], tau - starts[k], Qf=Q)
+        return Phi @ X[k] @ np.swapaxes(Phi, 1, 2) + W
+
+    breaks = np.concatenate([A.breakpoints, Q.breakpoints])
+    return PeriodicMatrix._new(T, (n, n), func=evaluate, breakpoints=breaks)
+
+
+#
+# Input handling
+#
+
+def _pair(A, Q, period, where):
+    if isinstance(A, PeriodicMatrix):
+        if period is not None and abs(period - A.period) > 1e-12 * period:
+            A = as_periodic(A, period, 'A')
+    else:
+        if period is None:
+            raise ControlArgument(f"{where}: A is not a PeriodicMatrix; give its period")
+        A = as_periodic(A, period, 'A')
+    if A.shape[0] != A.shape[1]:
+        raise ControlDimension(f"A must be square, got shape {A.shape}")
+    if isinstance(Q, PeriodicMatrix):
+        try:
+            Q = Q.with_period(A.period)
+        except ValueError:
+            raise ValueError(f"Q has period {Q.period}, which does not divide the period "
+                             f"{A.period} of A") from None
+    else:
+        Q = as_periodic(Q, A.period, 'Q')
+    if Q.shape != A.shape:
+        raise ControlDimension(f"Q must have the shape {A.shape} of A, got {Q.shape}")
+    probe = np.concatenate([np.linspace(0, A.period, 17)[:-1] + 0.0123 * A.period,
+                            Q.breakpoints])
+    _check_symmetric(Q(probe), 'Q')
+    return A, Q
+
+
+def _check_symmetric(Q, name):
+    scale = max(1.0, np.abs(Q).max(initial=0.0))
+    if np.abs(Q - np.swapaxes(Q, -1, -2)).max(initial=0.0) > 1e-10 * scale:
+        raise ValueError(f"{name} must be symmetric")
+
+
+def _check_bool(value, name):
+    if not isinstance(value, (bool, np.bool_)):
+        raise ControlArgument(f"{name} must be True or False, got {value!r}")

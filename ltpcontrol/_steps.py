@@ -1,0 +1,120 @@
+"""Per-step transition factors and Van Loan integrals over a period grid.
+
+The period is split into steps ``0 = t_0 < t_1 < ... < t_M = T`` that
+contain every switching instant (`step_grid`).  Periodic matrix equations
+(Lyapunov, Riccati, norms) reduce to recursions over these steps whose
+data are, per step ``[t_k, t_k + h]`` with ``Φ = Φ(t_k + h, t_k)``,
+
+    W = ∫ Φ(t_k + h, s) Qf(s) Φ(t_k + h, s)ᵀ ds      (forward integral),
+    V = ∫ Φ(s, t_k)ᵀ Qa(s) Φ(s, t_k) ds               (adjoint integral),
+    S = ∫ tr(Qa(r) P(r)) dr,  P(r) = ∫_{t_k}^r Φ(r, s) Qf(s) Φ(r, s)ᵀ ds,
+
+so that ``X(t_k + h) = Φ X(t_k) Φᵀ + W`` solves ``Ẋ = AX + XAᵀ + Qf`` and
+``Y(t_k) = Φᵀ Y(t_k + h) Φ + V`` solves ``-Ẏ = AᵀY + YA + Qa`` (S is the
+within-step part of ``∫ tr(Qa X)``, used by the H2 norm).  All of them are
+blocks of the transition matrix Ψ of the block upper-triangular generator
+(Van Loan)
+
+    M(t) = [[-Aᵀ, Qa, 0], [0, A, Qf], [0, 0, -Aᵀ]]:
+    Φ = Ψ22,  W = Ψ23 Φᵀ,  V = Φᵀ Ψ12,  S = tr(Φᵀ Ψ13),
+
+computed by the library's Magnus integrator (`_transition.step_transitions`)
+for every step at once.  Only the blocks that are asked for are built.
+The steps are short (``h ‖A‖ <= 1`` by default), so the growing blocks
+``e^{-Aᵀh}`` stay moderate even for stiff A.
+"""
+
+import numpy as np
+
+from ._periodic_matrix import PeriodicMatrix
+from ._transition import step_transitions
+from ._validation import check_positive_int
+
+__all__ = []
+
+
+def step_grid(A, others=(), nsteps=None):
+    """Grid ``t_0 = 0 < ... < t_M = T`` of one period of `A`.
+
+    Uniform steps refined at every switching instant of `A` and `others`.
+    By default ``nsteps = ceil(T max_t ‖A(t)‖₂)`` clipped to [16, 4096], so
+    that every step factor is well conditioned.
+
+    Examples
+    --------
+    >>> from ltpcontrol._steps import step_grid
+    >>> A = ltp.PeriodicMatrix.switching([[[-1.0]], [[-2.0]]], [0, 0.3], 1.0)
+    >>> step_grid(A, nsteps=2)
+    array([0. , 0.3, 0.5, 1. ])
+    """
+    T = A.period
+    breaks = np.unique(np.mod(np.concatenate(
+        [A.breakpoints] + [M.breakpoints for M in others]), T))
+    if nsteps is None:
+        probe = np.concatenate([np.arange(256) * T / 256, breaks])
+        norm = np.max(np.linalg.norm(A(probe), ord=2, axis=(1, 2)), initial=0.0)
+        nsteps = int(np.clip(np.ceil(T * norm), 16, 4096))
+    else:
+        nsteps = check_positive_int(nsteps, 'nsteps')
+    grid = np.union1d(np.linspace(0, T, nsteps + 1), breaks)
+    # drop grid points that nearly coincide with a switching instant
+    keep = np.concatenate([[True], np.diff(grid) > 1e-9 * T / nsteps])
+    keep[-1] = True
+    grid = grid[keep]
+    grid = grid[np.concatenate([np.diff(grid) > 0, [True]])]
+    grid[-1] = T
+    return grid
+
+
+def step_integrals(A, t0, h, Qf=None, Qa=None):
+    """Transition factors and Van Loan integrals of many steps (module notes).
+
+    Parameters
+    ----------
+    A : PeriodicMatrix, shape (n, n)
+    t0, h : ndarray
+        Step starts and lengths (1D, same length; h > 0).
+    Qf, Qa : PeriodicMatrix, shape (n, n), optional
+        Forward and adjoint weights.
+
+    Returns
+    -------
+    Phi : ndarray, shape (S, n, n)
+    W, V : ndarray, shape (S, n, n), or None when `Qf` (`Qa`) is None
+    S : ndarray, shape (S,), or None unless both weights are given
+
+    Examples
+    --------
+    Scalar ``ẋ = -x``: ``W = ∫_0^h e^{-2(h-s)} ds = (1 - e^{-2h})/2``.
+
+    >>> from ltpcontrol._steps import step_integrals
+    >>> A = ltp.PeriodicMatrix.constant([[-1.0]], 1.0)
+    >>> Q = ltp.PeriodicMatrix.constant([[1.0]], 1.0)
+    >>> Phi, W, V, S = step_integrals(A, np.array([0.0]), np.array([0.5]), Qf=Q)
+    >>> bool(np.isclose(W[0, 0, 0], (1 - np.exp(-1.0)) / 2)), V, S
+    (True, None, None)
+    """
+    n = A.shape[0]
+    Z = np.zeros((n, n))
+    At = -A.T
+    # rows/cols of the 3n generator that are needed: [adjoint, state, forward]
+    use = [Qa is not None, True, Qf is not None]
+    full = [[At, Qa if Qa is not None else Z, Z],
+            [Z, A, Qf if Qf is not None else Z],
+            [Z, Z, At]]
+    keep = [i for i in range(3) if use[i]]
+    M = PeriodicMatrix.block([[full[i][j] for j in keep] for i in keep])
+    zero = PeriodicMatrix.constant(np.zeros((M.shape[0], 0)), M.period)
+    Psi, _, _ = step_transitions(M, zero, np.asarray(t0, float), np.asarray(h, float))
+    blk = {k: slice(j * n, (j + 1) * n) for j, k in enumerate(keep)}
+    Phi = Psi[:, blk[1], blk[1]]
+    W = V = S = None
+    if Qf is not None:
+        W = Psi[:, blk[1], blk[2]] @ np.swapaxes(Phi, 1, 2)
+        W = 0.5 * (W + np.swapaxes(W, 1, 2))
+    if Qa is not None:
+        V = np.swapaxes(Phi, 1, 2) @ Psi[:, blk[0], blk[1]]
+        V = 0.5 * (V + np.swapaxes(V, 1, 2))
+    if Qf is not None and Qa is not None:
+        S = np.einsum('kji,kji->k', Phi, Psi[:, blk[0], blk[2]])
+    return Phi, W, V, S

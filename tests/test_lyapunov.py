@@ -1,0 +1,173 @@
+"""Periodic Lyapunov equations and gramians against independent truth."""
+
+import numpy as np
+import pytest
+import control as ct
+from control.exception import ControlDimension
+
+import ltpcontrol as ltp
+from analysis_systems import stable_rss, transformed
+
+RNG = np.random.default_rng(2024)
+
+
+def _scalar_ok(f):
+    # callables of the tests are vectorised; a scalar t gives one matrix
+    def g(t):
+        out = f(np.atleast_1d(t))
+        return out[0] if np.ndim(t) == 0 else out
+    return g
+
+
+@_scalar_ok
+def _stiff_A(t):
+    # exponents -0.5 and -24.5 (the stiff example of floquet_exponents, shifted)
+    t = np.atleast_1d(t)
+    out = np.zeros((len(t), 2, 2))
+    out[:, 0, 0], out[:, 0, 1] = -0.5, 1.0
+    out[:, 1, 0], out[:, 1, 1] = -10 * np.cos(t), -24.5 - 10 * np.sin(t)
+    return out
+
+
+@_scalar_ok
+def _X(t):
+    t = np.atleast_1d(t)
+    out = np.empty((len(t), 2, 2))
+    out[:, 0, 0], out[:, 1, 1] = 2 + np.sin(t), 1 + 0.5 * np.cos(t)
+    out[:, 0, 1] = out[:, 1, 0] = 0.3 * np.cos(2 * t)
+    return out
+
+
+@_scalar_ok
+def _dX(t):
+    t = np.atleast_1d(t)
+    out = np.empty((len(t), 2, 2))
+    out[:, 0, 0], out[:, 1, 1] = np.cos(t), -0.5 * np.sin(t)
+    out[:, 0, 1] = out[:, 1, 0] = -0.6 * np.sin(2 * t)
+    return out
+
+
+@pytest.mark.parametrize('T', [0.7, 2.0, 5.3])
+@pytest.mark.parametrize('kind', ['c', 'o'])
+def test_gram_lti_continuous(T, kind):
+    G = stable_rss(4, 2, 3, seed=int(10 * T))
+    P = ltp.gram(ltp.ltpss(G, period=T), kind)
+    ref = ct.gram(G, kind)
+    ts = RNG.uniform(0, 2 * T, 5)
+    assert np.abs(P(ts) - ref).max() <= 1e-9 * np.abs(ref).max()
+
+
+@pytest.mark.parametrize('N', [1, 4, 5])
+@pytest.mark.parametrize('kind', ['c', 'o'])
+def test_gram_lti_discrete(N, kind):
+    G = stable_rss(3, 2, 2, seed=N, dt=0.1)
+    P = ltp.gram(ltp.ltpss(G, period=0.1 * N), kind).sample(N)
+    ref = ct.dlyap(G.A, G.B @ G.B.T) if kind == 'c' else ct.dlyap(G.A.T, G.C.T @ G.C)
+    assert np.abs(P - ref).max() <= 1e-9 * np.abs(ref).max()
+
+
+def test_lyap_dlyap_lti_equal_python_control():
+    A = np.array([[-1.0, 2.0, 0.0], [0.0, -3.0, 1.0], [0.5, 0.0, -2.0]])
+    Q = np.array([[2.0, 0.5, 0.0], [0.5, 1.0, 0.2], [0.0, 0.2, 3.0]])
+    for adjoint, ref in ((False, ct.lyap(A, Q)), (True, ct.lyap(A.T, Q))):
+        X = ltp.lyap(A, Q, adjoint=adjoint, period=1.3)
+        assert np.abs(X(np.array([0.0, 0.41, 1.0])) - ref).max() <= 1e-9 * np.abs(ref).max()
+    Ad = 0.4 * A
+    for N in (2, 3):
+        for adjoint, ref in ((False, ct.dlyap(Ad, Q)), (True, ct.dlyap(Ad.T, Q))):
+            X = ltp.dlyap(np.stack([Ad] * N), Q, adjoint=adjoint)
+            assert np.abs(X - ref).max() <= 1e-9 * np.abs(ref).max()
+
+
+@pytest.mark.parametrize('T, seed', [(1.0, 7), (3.0, 8), (0.4, 9)])
+def test_gram_lyapunov_transformed(T, seed):
+    G = stable_rss(3, 1, 2, seed=seed, strictly_proper=True)
+    sys, P = transformed(G, T)
+    ts = RNG.uniform(0, T, 4)
+    Pc, Po = ltp.gram(sys, 'c'), ltp.gram(sys, 'o')
+    Xc, Xo = ct.gram(G, 'c'), ct.gram(G, 'o')
+    Pt = P(ts)
+    Pinv = np.swapaxes(Pt, 1, 2)
+    assert np.abs(Pc(ts) - Pt @ Xc @ np.swapaxes(Pt, 1, 2)).max() <= 1e-9 * np.abs(Xc).max()
+    assert np.abs(Po(ts) - np.swapaxes(Pinv, 1, 2) @ Xo @ Pinv).max() \
+        <= 1e-9 * np.abs(Xo).max()
+
+
+@pytest.mark.parametrize('adjoint', [False, True])
+def test_lyap_manufactured_stiff(adjoint):
+    T = 2 * np.pi
+    A = ltp.PeriodicMatrix.from_function(_stiff_A, T)
+    At = lambda t: np.swapaxes(_stiff_A(t), -1, -2)
+    if adjoint:
+        Q = lambda t: -_dX(t) - At(t) @ _X(t) - _X(t) @ _stiff_A(t)
+    else:
+        Q = lambda t: _dX(t) - _stiff_A(t) @ _X(t) - _X(t) @ At(t)
+    X = ltp.lyap(A, Q, adjoint=adjoint)
+    ts = RNG.uniform(-T, 2 * T, 8)
+    assert np.abs(X(ts) - _X(ts)).max() <= 1e-9
+
+
+@pytest.mark.parametrize('adjoint', [False, True])
+def test_lyap_manufactured_switching(adjoint):
+    # A jumps at 0.4 (and Q with it): X smooth, Q = ±Ẋ - A X - X Aᵀ piecewise
+    T = 2 * np.pi
+    A1, A2 = np.array([[-1.0, 2.0], [0.0, -3.0]]), np.array([[-2.0, 0.0], [1.0, 0.5]])
+    S = ltp.PeriodicMatrix.switching([A1, A2], [0, 0.4 * T], T)
+
+    def Q(t):
+        a = S(t)
+        if adjoint:
+            return -_dX(t) - np.swapaxes(a, -1, -2) @ _X(t) - _X(t) @ a
+        return _dX(t) - a @ _X(t) - _X(t) @ np.swapaxes(a, -1, -2)
+    Qp = ltp.PeriodicMatrix._new(T, (2, 2), func=Q, breakpoints=[0.0, 0.4 * T])
+    X = ltp.lyap(S, Qp, adjoint=adjoint)
+    ts = np.concatenate([RNG.uniform(0, T, 6), [0.4 * T, 0.4 * T + 1e-9]])
+    assert np.abs(X(ts) - _X(ts)).max() <= 1e-9
+
+
+@pytest.mark.parametrize('N', [3, 4])
+@pytest.mark.parametrize('adjoint', [False, True])
+def test_dlyap_manufactured_unstable_factor(N, adjoint):
+    # one factor is expanding: the cyclic solve must not iterate the map
+    A = RNG.standard_normal((N, 3, 3))
+    A[0] *= 3.0
+    L = RNG.standard_normal((N, 3, 3))
+    X = L @ np.swapaxes(L, 1, 2) + np.eye(3)
+    Xn = np.roll(X, -1, axis=0)
+    if adjoint:
+        Q = X - np.swapaxes(A, 1, 2) @ Xn @ A
+    else:
+        Q = Xn - A @ X @ np.swapaxes(A, 1, 2)
+    assert np.abs(ltp.dlyap(A, Q, adjoint=adjoint) - X).max() <= 1e-9 * np.abs(X).max()
+
+
+def test_lyap_no_unique_solution():
+    # multipliers e^{±1}: μ1 μ2 = 1
+    with pytest.raises(ValueError, match="no unique periodic solution"):
+        ltp.lyap([[1.0, 0.0], [0.0, -1.0]], np.eye(2), period=1.0)
+    with pytest.raises(ValueError, match="no unique periodic solution"):
+        ltp.dlyap(np.array([[[2.0, 0.0], [0.0, 1.0]], [[1.0, 0.0], [0.0, 0.5]]]), np.eye(2))
+
+
+def test_lyap_bad_input():
+    A = ltp.PeriodicMatrix.constant(-np.eye(2), 1.0)
+    with pytest.raises(ControlDimension, match="Q must have the shape"):
+        ltp.lyap(A, np.eye(3))
+    with pytest.raises(ControlDimension, match="A must be square"):
+        ltp.lyap(np.ones((2, 3)), np.eye(2), period=1.0)
+    with pytest.raises(ValueError, match="Q has period 0.3"):
+        ltp.lyap(A, ltp.PeriodicMatrix.constant(np.eye(2), 0.3) + ltp.PeriodicMatrix(
+            np.zeros((3, 2, 2)), 0.3))
+    with pytest.raises(ValueError, match="Q must be symmetric"):
+        ltp.lyap(A, [[1.0, 1.0], [0.0, 1.0]])
+    with pytest.raises(TypeError, match="give its period"):
+        ltp.lyap(-np.eye(2), np.eye(2))
+    with pytest.raises(ControlDimension, match="steps"):
+        ltp.dlyap(np.zeros((3, 2, 2)), np.zeros((2, 2, 2)))
+    with pytest.raises(TypeError, match="adjoint"):
+        ltp.dlyap(np.zeros((2, 2)), np.eye(2), adjoint='yes')
+    unstable = ltp.ltpss([[0.5]], [[1.0]], [[1.0]], 0, period=1.0)
+    with pytest.raises(ValueError, match="unstable"):
+        ltp.gram(unstable, 'c')
+    with pytest.raises(ValueError, match="type must be"):
+        ltp.gram(ltp.ltpss([[-0.5]], [[1.0]], [[1.0]], 0, period=1.0), 'x')
