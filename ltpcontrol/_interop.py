@@ -136,7 +136,8 @@ ROUTES = {
 HOOKS = ('zeros', 'norm', 'lyap', 'dlyap', 'gram', 'lqr', 'dlqr', 'lqe', 'dlqe',
          'place', 'h2syn', 'hinfsyn', 'hankel_singular_values')
 
-_HTF = "ltp.htf(sys, nharmonics) (then HTF.component(k, omega) or ltp.htf_response)"
+_HTF = ("ltp.htf(sys, nharmonics) (or ltp.harmonic_ss) for the harmonic transfer function; "
+        "HTF.component(k, omega) or ltp.htf_response give its components")
 _LTI = ("sys.to_ss() for constant matrices, sys.average(), sys.linearize(t=...) or "
         "ltp.lift(sys) for an LTI view")
 
@@ -171,6 +172,11 @@ REFUSED = {
 }
 
 
+def refusal(name):
+    """The error for python-control's `name` (function or method) on an LTP system."""
+    return _refusal(name, REFUSED[name])
+
+
 def _refusal(what, hint):
     return ControlArgument(f"{what} does not apply to a linear time-periodic system "
                            f"(LTPStateSpace): use {hint}")
@@ -181,7 +187,7 @@ def _hook(name):
         fn = _ltp_function(name)
         if fn is None:
             raise ControlArgument(
-                f"control.{name} does not apply to a linear time-periodic system "
+                f"{name} does not apply to a linear time-periodic system "
                 f"(LTPStateSpace) and its periodic counterpart ltp.{name} is not "
                 "available in this version of ltpcontrol")
         return fn(*args, **kwargs)
@@ -190,7 +196,7 @@ def _hook(name):
 
 def _refuse(name, hint):
     def route(orig, *args, **kwargs):
-        raise _refusal(f"control.{name}", hint)
+        raise _refusal(name, hint)
     return route
 
 

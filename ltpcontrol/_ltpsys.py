@@ -274,14 +274,13 @@ class LTPStateSpace(NonlinearIOSystem):
     # -- LTI-only requests: a clear pointer to the LTP counterpart --
     def frequency_response(self, omega=None, squeeze=None):
         """Not defined for an LTP system: its frequency response is the HTF (`ltpcontrol.htf`)."""
-        raise ControlArgument(f"{self.name} is time-periodic: it has no LTI frequency "
-                              "response; use ltp.htf(sys, nharmonics) (or "
-                              "ltp.harmonic_ss) for its harmonic transfer function")
+        from ._interop import refusal
+        raise refusal('frequency_response')
 
     def dcgain(self, warn_infinite=False):
         """Not defined for an LTP system; see `ltpcontrol.htf`."""
-        raise ControlArgument(f"{self.name} is time-periodic: it has no DC gain; use "
-                              "ltp.htf(sys, nharmonics)(0) for its harmonic DC response")
+        from ._interop import refusal
+        raise refusal('dcgain')
 
     def zeros(self, nharmonics=None, *, rtol=1e-8):
         """Transmission zeros; see `ltpcontrol.zeros` (so `control.zeros` works)."""

@@ -259,8 +259,14 @@ def test_every_refused_entry_point_is_tested():
 
 @pytest.mark.parametrize('name', sorted(REFUSED_CALLS))
 def test_refused_entry_points_name_the_ltp_way(name):
-    with pytest.raises(ControlArgument, match=rf"control\.{name} does not apply.*: use \S"):
+    with pytest.raises(ControlArgument, match=rf"^{name} does not apply.*: use \S"):
         REFUSED_CALLS[name]()
+
+
+def test_methods_python_control_calls_give_the_same_errors():
+    for name in ('frequency_response', 'dcgain'):
+        with pytest.raises(ControlArgument, match=rf"^{name} does not apply.*ltp\.htf"):
+            getattr(P, name)()
 
 
 def test_bode_alias_and_lti_calls_untouched():
