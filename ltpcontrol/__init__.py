@@ -21,6 +21,8 @@ from ._discretize import sample_system, d2c
 from ._lifting import lift
 from ._hybrid import HybridMode, HybridPlant, simulate_hybrid, saltation_matrix
 from ._orbits import PeriodicOrbit, periodic_orbit, period_map, linearize_orbit
+from ._autonomous import limit_cycle, poincare_map
+from ._continuation import Bifurcation, OrbitBranch, orbit_continuation
 from ._excitation import Excitation, chirp_replicas, multisine, sine_experiments
 from ._htf_estimate import estimate_htf
 from ._htf_fit import HTFFit, DelayEstimate, fit_htf, estimate_delays
@@ -29,11 +31,20 @@ from ._fdsubspace import fdsubspace, FDSubspaceInfo
 from ._hybrid_ls import hybrid_ls, HybridLSResult
 from ._realization import floquet_realization, FloquetRealization
 from ._canonical import to_canonical, matrix_errors, MatrixErrors
+from ._canonical import compare_ltp, LTPComparison
+from ._structure import select_structure, StructureSelection
 from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
 from ._lyapunov import lyap, dlyap, gram
 from ._norms import norm
 from ._zeros import zeros
 from ._harmonic_ss import harmonic_ss
+from ._riccati import care, dare
+from ._design import lqr, dlqr, lqe, dlqe, lqg
+from ._place import place
+from ._lmi import lmi_statefbk, LMIDesign
+from ._reduction import hsvd, balred, minreal
+from ._refine import refine_ltp, RefineInfo
+from ._montecarlo import monte_carlo, MonteCarloResult
 
 __version__ = "0.1.0"
 
@@ -56,6 +67,7 @@ __all__ = [
     # rhythmic plants and their orbits
     'HybridMode', 'HybridPlant', 'simulate_hybrid', 'saltation_matrix',
     'PeriodicOrbit', 'periodic_orbit', 'period_map', 'linearize_orbit',
+    'limit_cycle', 'poincare_map', 'Bifurcation', 'OrbitBranch', 'orbit_continuation',
     # identification
     'Excitation', 'chirp_replicas', 'multisine', 'sine_experiments',
     'estimate_htf', 'HTFFit', 'DelayEstimate', 'fit_htf', 'estimate_delays',
@@ -63,8 +75,14 @@ __all__ = [
     'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
+    'compare_ltp', 'LTPComparison', 'select_structure', 'StructureSelection',
     # analysis: Lyapunov equations, gramians, zeros, norms
     'lyap', 'dlyap', 'gram', 'norm', 'zeros', 'harmonic_ss',
+    # control design
+    'care', 'dare', 'lqr', 'dlqr', 'lqe', 'dlqe', 'lqg', 'place',
+    'lmi_statefbk', 'LMIDesign', 'hsvd', 'balred', 'minreal',
+    # noisy data and Monte-Carlo studies
+    'refine_ltp', 'RefineInfo', 'monte_carlo', 'MonteCarloResult',
 ]
 
 # python-control's entry points dispatch LTP systems to ltpcontrol (see _interop)

@@ -24,11 +24,12 @@ from typing import NamedTuple
 
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
+from scipy.optimize import linear_sum_assignment
 
 from ._ltpsys import LTPStateSpace, ltpss
-from ._validation import check_kwargs, check_positive_int
+from ._validation import check_kwargs, check_positive_int, real_array
 
-__all__ = ['to_canonical', 'matrix_errors', 'MatrixErrors']
+__all__ = ['to_canonical', 'matrix_errors', 'MatrixErrors', 'compare_ltp', 'LTPComparison']
 
 # Controllability matrices with a larger condition number are treated as singular.
 _COND_MAX = 1e12
@@ -53,6 +54,15 @@ def to_canonical(sys, input=0, name=None, **kwargs):
         Same system with ``A`` in companion form (last row ``[-a_n, ...,
         -a_1]``), ``B̄_0[:, input] = e_n``, ``B(t) = Q^{-1} B(t)`` and
         ``C(t) = C(t) Q`` (module notes), as in thesis eqs. (4.122)-(4.124).
+
+    Notes
+    -----
+    The form removes constant changes of state only.  Two Floquet forms of
+    one system may differ by the branch of their exponents (``λ -> λ +
+    jkω_p`` with a periodic change of state, which also moves the
+    harmonics of B(t) and C(t)); their canonical forms then differ by
+    O(ω_p) in A.  Compare identified models with `compare_ltp` (HTFs and
+    exponents modulo ``jω_p``), or bring both to the same branch first.
 
     Raises
     ------
@@ -173,18 +183,7 @@ def matrix_errors(est, true, nsamples=512, **kwargs):
     (0.1, 0.0, 0.0)
     """
     check_kwargs(kwargs, 'matrix_errors')
-    for label, s in (('est', est), ('true', true)):
-        if not isinstance(s, LTPStateSpace):
-            raise ControlArgument(f"{label} must be an LTPStateSpace, got {type(s).__name__}")
-    if (est.nstates, est.ninputs, est.noutputs) != (true.nstates, true.ninputs, true.noutputs):
-        raise ControlDimension(
-            f"est has (states, inputs, outputs) = {(est.nstates, est.ninputs, est.noutputs)} "
-            f"but true has {(true.nstates, true.ninputs, true.noutputs)}")
-    if not np.isclose(est.period, true.period, rtol=1e-9, atol=0):
-        raise ValueError(f"est and true have different periods ({est.period} and {true.period})")
-    if est.isdtime(strict=True) != true.isdtime(strict=True) or (
-            est.isdtime(strict=True) and not np.isclose(est.dt, true.dt, rtol=1e-9, atol=0)):
-        raise ValueError(f"est and true have different timebases (dt={est.dt} and {true.dt})")
+    _check_pair(est, true)
     nsamples = true.nsteps if true.isdtime(strict=True) else \
         check_positive_int(nsamples, 'nsamples')
     errors = []
@@ -206,3 +205,128 @@ def _mean(P, sys):
     if sys.isdtime(strict=True):
         return P.sample(sys.nsteps).mean(axis=0)
     return P.fourier(0)[0].real
+
+
+class LTPComparison(NamedTuple):
+    """Basis- and branch-invariant distance between two LTP systems (`compare_ltp`).
+
+    Attributes
+    ----------
+    htf_error : float
+        ``max_ω ‖H_est(jω) - H_true(jω)‖_F / max_ω ‖H_true(jω)‖_F`` of the
+        HTF blocks with harmonics -K..K.
+    exponent_error : float
+        Largest distance ``min_k |λ_est - λ_true - jkω_p|`` between matched
+        Floquet exponents (absolute, in 1/s; z-plane per-step exponents in
+        discrete time, compared modulo ``e^{j2π/N}``).
+    exponents : ndarray
+        Floquet exponents of `est`, ordered to match ``exponents_true`` and
+        moved to the branch nearest to them.
+    exponents_true : ndarray
+        Floquet exponents of `true`.
+
+    Examples
+    --------
+    >>> LTPComparison(1e-6, 1e-7, np.array([-1.0]), np.array([-1.0])).htf_error
+    1e-06
+    """
+
+    htf_error: float
+    exponent_error: float
+    exponents: np.ndarray
+    exponents_true: np.ndarray
+
+
+def compare_ltp(est, true, omega, nharmonics=1, **kwargs):
+    """Compare two LTP systems by their HTFs and Floquet exponents.
+
+    Both quantities are invariant under any (periodic) change of state
+    coordinates, so an identified model can be compared with the truth
+    without aligning bases.  `to_canonical` with `matrix_errors` is not
+    such a comparison: the Floquet form of a system is unique only up to
+    the branch of the exponents (``λ -> λ + jkω_p`` with a periodic change
+    of state that shifts the harmonics of ``B(t)`` and ``C(t)``), and a
+    branch change alters the canonical A by O(ω_p) although the systems
+    are identical.
+
+    Parameters
+    ----------
+    est, true : LTPStateSpace
+        Systems with equal sizes, periods and timebases.
+    omega : array_like
+        Frequencies (rad/s) at which the HTFs are compared, e.g. lines not
+        used for identification.
+    nharmonics : int, optional
+        Harmonics -K..K of the compared HTF blocks (default 1).
+
+    Returns
+    -------
+    LTPComparison
+        ``(htf_error, exponent_error, exponents, exponents_true)``.
+
+    Raises
+    ------
+    ControlArgument
+        If `est` or `true` is not an `LTPStateSpace`.
+    ControlDimension
+        If the sizes differ.
+    ValueError
+        If the periods or timebases differ or `omega` is empty.
+    TypeError
+        For unknown keyword arguments.
+
+    Examples
+    --------
+    A system and the same system in other coordinates, ``x = S z``:
+
+    >>> B = ltp.PeriodicMatrix([[[0.0], [0.2]], [[0.0], [1.0]], [[0.0], [0.2]]], 1.0)
+    >>> true = ltp.ltpss([[-1.0, 2.0], [0.0, -3.0]], B, [[1.0, 0.0]], 0, period=1.0)
+    >>> S = np.array([[2.0, 1.0], [0.0, 1.0]])
+    >>> est = ltp.ltpss(np.linalg.solve(S, true.A(0) @ S), np.linalg.inv(S) @ B,
+    ...                 true.C(0) @ S, 0, period=1.0)
+    >>> cmp = ltp.compare_ltp(est, true, [0.5, 1.5])
+    >>> cmp.htf_error < 1e-12, cmp.exponent_error < 1e-12
+    (True, True)
+    """
+    check_kwargs(kwargs, 'compare_ltp')
+    _check_pair(est, true)
+    from ._floquet import floquet_exponents
+    from ._htf import htf
+    omega = real_array(omega, 'omega', ndim=(0, 1)).ravel()
+    if omega.size == 0:
+        raise ValueError("omega must hold at least one frequency")
+    K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
+    s = np.exp(1j * omega * true.dt) if true.isdtime(strict=True) else 1j * omega
+    Ht, He = htf(true, K)(s), htf(est, K)(s)
+    scale = max(np.linalg.norm(Ht, axis=(1, 2)).max(), np.finfo(float).tiny)
+    htf_error = float(np.linalg.norm(He - Ht, axis=(1, 2)).max() / scale)
+    lt, le = floquet_exponents(true), floquet_exponents(est)
+    if true.isdtime(strict=True):
+        # per-step exponents ρ are defined up to e^{j2πk/N}
+        rot = np.exp(2j * np.pi / true.nsteps)
+        k = np.round(np.angle(lt[:, None] / le[None, :]) / np.angle(rot))
+        moved = le[None, :] * rot ** k
+    else:
+        wp = 2 * np.pi / true.period
+        k = np.round((lt[:, None] - le[None, :]).imag / wp)
+        moved = le[None, :] + 1j * wp * k
+    dist = np.abs(moved - lt[:, None])
+    rows, cols = linear_sum_assignment(dist)
+    return LTPComparison(htf_error, float(dist[rows, cols].max()) if lt.size else 0.0,
+                         moved[rows, cols], lt)
+
+
+def _check_pair(est, true):
+    """Both LTPStateSpace of equal sizes, periods and timebases."""
+    for label, s in (('est', est), ('true', true)):
+        if not isinstance(s, LTPStateSpace):
+            raise ControlArgument(f"{label} must be an LTPStateSpace, got {type(s).__name__}")
+    if (est.nstates, est.ninputs, est.noutputs) != (true.nstates, true.ninputs, true.noutputs):
+        raise ControlDimension(
+            f"est has (states, inputs, outputs) = {(est.nstates, est.ninputs, est.noutputs)} "
+            f"but true has {(true.nstates, true.ninputs, true.noutputs)}")
+    if not np.isclose(est.period, true.period, rtol=1e-9, atol=0):
+        raise ValueError(f"est and true have different periods ({est.period} and {true.period})")
+    if est.isdtime(strict=True) != true.isdtime(strict=True) or (
+            est.isdtime(strict=True) and not np.isclose(est.dt, true.dt, rtol=1e-9, atol=0)):
+        raise ValueError(f"est and true have different timebases (dt={est.dt} and {true.dt})")

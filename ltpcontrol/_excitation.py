@@ -92,8 +92,38 @@ def _warn_half_multiples(omega, period, tol, what):
     return bad
 
 
+def _replicas(nreplicas, nharmonics, plant_harmonics, what):
+    """Number R of time-shifted replicas; warn when components alias.
+
+    Replica r shifts the cycle phase by r T/R, which multiplies the HTF
+    component ``G_k`` by ``e^{-j2πkr/R}``: components whose indices differ
+    by a multiple of R cannot be separated.  Components ``|k| <= K`` are
+    free of the plant's harmonics ``|k'| <= K_p`` when ``R >= K + K_p + 1``.
+    """
+    K = None if nharmonics is None else check_positive_int(nharmonics, "nharmonics",
+                                                          minimum=0)
+    Kp = None if plant_harmonics is None else check_positive_int(
+        plant_harmonics, "plant_harmonics", minimum=0)
+    if nreplicas is None:
+        if K is None:
+            raise ValueError(f"{what}: give the number of replicas or nharmonics")
+        Kp = 2 * K if Kp is None else max(Kp, K)
+        return K + Kp + 1
+    R = check_positive_int(nreplicas, what)
+    if K is not None:
+        Kp = K if Kp is None else max(Kp, K)
+        aliased = sorted({k for k in range(-K, K + 1) for kk in range(-Kp, Kp + 1)
+                          if kk != k and (kk - k) % R == 0})
+        if aliased:
+            warnings.warn(f"{what}={R} leaves the HTF components {aliased} aliased with "
+                          f"plant harmonics up to {Kp}; use at least {K + Kp + 1}",
+                          UserWarning, stacklevel=3)
+    return R
+
+
 def chirp_replicas(period, nreplicas, duration, f0, f1, *, dt,
-                   amplitude=1.0, gap=0.0, **kwargs):
+                   amplitude=1.0, gap=0.0, nharmonics=None, plant_harmonics=None,
+                   **kwargs):
     """Phase-shifted replicas of a linear chirp for HTF identification.
 
     Replica ``r = 0..R-1`` occupies its own record window
@@ -111,9 +141,11 @@ def chirp_replicas(period, nreplicas, duration, f0, f1, *, dt,
     ----------
     period : float
         Period T of the system (s).
-    nreplicas : int
-        Number R of replicas; use ``R >= 2K+1`` to identify K harmonics
-        without regularisation.
+    nreplicas : int or None
+        Number R of replicas; ``R >= 2K+1`` identifies K harmonics of a
+        plant without further harmonics, ``R >= K + K_p + 1`` keeps the
+        plant's harmonics up to ``K_p`` from aliasing into them.  None:
+        ``K + K_p + 1`` from `nharmonics` and `plant_harmonics`.
     duration : float
         Chirp duration D (s).
     f0, f1 : float
@@ -126,6 +158,12 @@ def chirp_replicas(period, nreplicas, duration, f0, f1, *, dt,
     gap : float, optional
         Minimum quiet time after each chirp (s, default 0).  Choose several
         settling times of the system for leakage-free estimates.
+    nharmonics : int, optional
+        Harmonics K to be estimated.  With it, a warning names the
+        components that `nreplicas` leaves aliased.
+    plant_harmonics : int, optional
+        Harmonics ``K_p`` the plant's HTF is expected to hold (default
+        ``2K`` when `nreplicas` is None, else K).
 
     Returns
     -------
@@ -154,7 +192,7 @@ def chirp_replicas(period, nreplicas, duration, f0, f1, *, dt,
     """
     check_kwargs(kwargs, "chirp_replicas")
     period = check_period(period)
-    nrep = check_positive_int(nreplicas, "nreplicas")
+    nrep = _replicas(nreplicas, nharmonics, plant_harmonics, "nreplicas")
     duration = check_period(duration, "duration")
     dt, nper = _check_dt(dt, period)
     f0 = _check_frequency(f0, "f0")
@@ -255,15 +293,16 @@ def _check_common(period, dt, nperiods, settle):
 
 
 def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
-                     amplitude=1.0, **kwargs):
+                     amplitude=1.0, unusable='warn', **kwargs):
     """One sinusoid per experiment, on the DFT grid of the analysis window.
 
     Experiment ``e`` is ``amplitude · cos(ω_e t)`` for
     ``(settle + nperiods)`` periods; the analysis window is the last
     `nperiods` periods.  Each ``ω_e`` is rounded to the nearest multiple of
     ``2π / (nperiods T)`` so that the window holds whole periods of both the
-    system and the input (leakage-free steady state).  A UserWarning is
-    issued for frequencies at multiples of ``ω_p/2``.
+    system and the input (leakage-free steady state).  Frequencies at
+    multiples of ``ω_p/2`` cannot identify neighbouring HTF components;
+    they are kept with a warning or dropped (`unusable`).
 
     Parameters
     ----------
@@ -279,6 +318,9 @@ def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
         Periods simulated before the window to let transients decay.
     amplitude : float, optional
         Amplitude of each sinusoid.
+    unusable : {'warn', 'drop'}, optional
+        Keep frequencies at multiples of ``ω_p/2`` with a UserWarning
+        (default) or drop them (also with a warning).
 
     Returns
     -------
@@ -301,7 +343,16 @@ def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
     if np.max(omega) >= np.pi / dt:
         raise ValueError(f"frequencies reach the Nyquist frequency {np.pi / dt:.6g} "
                          f"rad/s of dt={dt}")
-    _warn_half_multiples(omega, period, 1e-9 * np.max(omega), "frequencies")
+    if unusable not in ('warn', 'drop'):
+        raise ValueError(f"unusable must be 'warn' or 'drop', got {unusable!r}")
+    bad = _warn_half_multiples(omega, period, 1e-9 * np.max(omega), "frequencies")
+    if unusable == 'drop' and bad.any():
+        omega = omega[~bad]
+        warnings.warn(f"dropped {int(bad.sum())} frequencies at multiples of omega_p/2",
+                      UserWarning, stacklevel=2)
+        if omega.size == 0:
+            raise ValueError("no frequency is left after dropping the multiples of "
+                             "omega_p/2")
 
     def signal(t):
         t = np.asarray(t, dtype=float)
@@ -312,8 +363,9 @@ def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
     return Excitation(time, signal(time), segments, signal, omega)
 
 
-def multisine(frequencies, period, *, dt, nperiods, nexperiments=1, settle=0,
-              amplitude=1.0, phases='schroeder', seed=None, **kwargs):
+def multisine(frequencies, period, *, dt, nperiods, nexperiments=None, settle=0,
+              amplitude=1.0, phases='schroeder', seed=None, nharmonics=None,
+              plant_harmonics=None, **kwargs):
     """Multisine experiments time-shifted by fractions of the period.
 
     All experiments share the multisine
@@ -335,7 +387,8 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=1, settle=0,
     nperiods : int
         Number of periods in the analysis window.
     nexperiments : int, optional
-        Number R of time-shifted experiments (default 1).
+        Number R of time-shifted experiments.  Default: ``K + K_p + 1``
+        when `nharmonics` is given (see `chirp_replicas`), else 1.
     settle : int, optional
         Periods applied before the window to reach steady state.
     amplitude : float, optional
@@ -347,6 +400,10 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=1, settle=0,
         Random source for ``phases='random'``: None (fresh entropy), a
         non-negative int, or a `numpy.random.Generator` (a `BitGenerator`
         or `SeedSequence` is accepted as well).
+    nharmonics, plant_harmonics : int, optional
+        Harmonics K to be estimated and ``K_p`` expected in the plant, as
+        for `chirp_replicas`: they set the default `nexperiments` and a
+        warning names the components a given `nexperiments` leaves aliased.
 
     Returns
     -------
@@ -364,7 +421,8 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=1, settle=0,
     """
     check_kwargs(kwargs, "multisine")
     period, dt, nperiods, settle = _check_common(period, dt, nperiods, settle)
-    nexp = check_positive_int(nexperiments, "nexperiments")
+    nexp = _replicas(1 if nexperiments is None and nharmonics is None else nexperiments,
+                     nharmonics, plant_harmonics, "nexperiments")
     amplitude = float(real_array(amplitude, "amplitude", ndim=0))
     rng = _check_seed(seed)
     window = nperiods * period

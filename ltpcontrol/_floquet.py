@@ -164,8 +164,13 @@ def floquet_exponents(sys, nsteps=None):
     return (logmod + 1j * arg) / sys.period
 
 
-def is_stable(sys, tol=1e-10, nsteps=None):
+def is_stable(sys, tol=1e-10, nsteps=None, *, autonomous=False):
     """True when every Floquet multiplier satisfies ``|μ| < 1 - tol``.
+
+    With ``autonomous=True``, `sys` is the linearisation about an orbit of
+    an autonomous plant (see `limit_cycle`): the multiplier nearest 1
+    belongs to the phase direction and is left out, so the verdict is
+    orbital stability.
 
     Parameters
     ----------
@@ -177,6 +182,9 @@ def is_stable(sys, tol=1e-10, nsteps=None):
         as stable.
     nsteps : int, optional
         Continuous time only; see `monodromy`.
+    autonomous : bool, optional
+        Leave out the phase multiplier of an autonomous orbit (default
+        False).
 
     Returns
     -------
@@ -191,8 +199,17 @@ def is_stable(sys, tol=1e-10, nsteps=None):
     if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, numbers.Real) \
             or not 0 <= tol < 1:
         raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
-    logmod, _ = _log_multipliers(sys, nsteps)
+    logmod, arg = _log_multipliers(sys, nsteps)
+    if autonomous:
+        logmod = _without_phase_multiplier(logmod, arg)
     return bool(logmod.size == 0 or np.max(logmod) < np.log1p(-tol))
+
+
+def _without_phase_multiplier(logmod, arg):
+    """Log-moduli without the multiplier nearest 1 (phase of an autonomous orbit)."""
+    if logmod.size == 0:
+        raise ValueError("autonomous=True needs at least one multiplier (the phase one)")
+    return np.delete(logmod, np.argmin(np.hypot(logmod, arg)))
 
 
 def floquet_transform(sys, real=True, nsteps=None, **kwargs):
@@ -538,6 +555,37 @@ def _assemble(sys, grid, G, E, R):
     return sysF, P
 
 
+def chebyshev_nodes(degree):
+    """Chebyshev points ``(1 - cos(jπ/D))/2``, j = 0..D, on [0, 1]."""
+    return 0.5 * (1 - np.cos(np.pi * np.arange(degree + 1) / degree))
+
+
+def piecewise_chebyshev(grid, values):
+    """Callable interpolating matrix values given on every grid interval.
+
+    ``values[k, j]`` is the value at ``t_k + h_k c_j`` (`chebyshev_nodes`);
+    evaluation (at times taken modulo ``grid[-1]``) is by the barycentric
+    formula on the interval that contains t.
+    """
+    period, starts, h = grid[-1], grid[:-1], np.diff(grid)
+    degree = values.shape[1] - 1
+    cheb = chebyshev_nodes(degree)
+    bary = (-1.0) ** np.arange(degree + 1)
+    bary[[0, -1]] *= 0.5
+
+    def evaluate(t):
+        tau = np.mod(np.atleast_1d(np.asarray(t, float)), period)
+        k = np.clip(np.searchsorted(starts, tau, side='right') - 1, 0, len(starts) - 1)
+        xi = np.clip((tau - starts[k]) / h[k], 0.0, 1.0)
+        diff = xi[:, None] - cheb[None, :]
+        hit = diff == 0
+        with np.errstate(divide='ignore'):
+            weights = np.where(hit.any(axis=1, keepdims=True), hit.astype(float), bary / diff)
+        weights /= weights.sum(axis=1, keepdims=True)
+        return np.einsum('sj,sj...->s...', weights, values[k])
+    return evaluate
+
+
 def _chebyshev_transform(A, grid, G, E, R):
     """Callable P(t) interpolating exact values on every grid interval.
 
@@ -547,9 +595,7 @@ def _chebyshev_transform(A, grid, G, E, R):
     """
     n = G.shape[1]
     period, starts, h = grid[-1], grid[:-1], np.diff(grid)
-    cheb = 0.5 * (1 - np.cos(np.pi * np.arange(_CHEB_DEG + 1) / _CHEB_DEG))
-    bary = (-1.0) ** np.arange(_CHEB_DEG + 1)
-    bary[[0, -1]] *= 0.5
+    cheb = chebyshev_nodes(_CHEB_DEG)
     zero = PeriodicMatrix.constant(np.zeros((n, 0)), A.period)
     nodes = starts[:, None] + h[:, None] * cheb                        # (M, D+1)
     # Φ(s_j, t_k) = Φ(s_j, s_{j-1}) ... Φ(s_1, s_0): short steps, chained
@@ -569,16 +615,7 @@ def _chebyshev_transform(A, grid, G, E, R):
                       f"number up to {cond:.1e}): B_F = P^{{-1}} B is large and the "
                       "Floquet form amplifies rounding errors", UserWarning, stacklevel=4)
 
-    def transform(t):
-        tau = np.mod(np.atleast_1d(np.asarray(t, float)), period)
-        k = np.clip(np.searchsorted(starts, tau, side='right') - 1, 0, len(starts) - 1)
-        xi = np.clip((tau - starts[k]) / h[k], 0.0, 1.0)
-        diff = xi[:, None] - cheb[None, :]
-        hit = diff == 0
-        with np.errstate(divide='ignore'):
-            weights = np.where(hit.any(axis=1, keepdims=True), hit.astype(float), bary / diff)
-        weights /= weights.sum(axis=1, keepdims=True)
-        return np.einsum('sj,sjab->sab', weights, values[k])
+    transform = piecewise_chebyshev(grid, values)
 
     # check the interpolant against exact values inside every interval
     probe = starts + 0.3717 * h

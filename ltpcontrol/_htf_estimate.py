@@ -35,6 +35,7 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 import scipy.sparse as sp
+import scipy.stats
 from control.exception import ControlArgument, ControlDimension
 from control.timeresp import TimeResponseData
 from tqdm.auto import tqdm
@@ -49,6 +50,10 @@ __all__ = ['estimate_htf']
 _COND_WARN = 1e8
 # relative α grid searched by generalised cross-validation
 _GCV_GRID = np.logspace(-8, 6, 15)
+# unmodelled-harmonics test: significance level and the smallest noise-variance
+# inflation (variance ratio) worth a warning
+_HARMONIC_PVALUE = 1e-3
+_HARMONIC_RATIO = 1.1
 
 
 @dataclass
@@ -91,6 +96,11 @@ class HTFEstimate:
     identified : ndarray of bool, shape (2K+1, ny, nu, F)
         True where the shifted input ``U(ω - kω_p)`` of input j is excited,
         i.e. where the data determine ``G_k(jω)``.
+    harmonic_test : dict or None
+        Test for unmodelled harmonics (`_harmonic_test`): ``statistic``,
+        ``pvalue`` and ``variance_ratio`` (noise variance without over with
+        ``G_{±(K+1)}``; 0, 1, 1 for an exact fit); None when too few
+        windows.
     """
 
     components: np.ndarray
@@ -105,6 +115,7 @@ class HTFEstimate:
     gcv: float
     nrecords: int
     identified: np.ndarray
+    harmonic_test: dict | None = None
     labels: dict = field(default_factory=dict, repr=False)
 
 
@@ -339,6 +350,46 @@ def _gcv_search(phi, Yb, penalty, scale, progress):
     return float(10.0 ** (res.x if res.fun <= scores[best] else logs[best]))
 
 
+def _harmonic_test(U, Y, bins, L, K, excited):
+    """F test of the inputs shifted by ±(K+1)ω_p on the per-frequency residual.
+
+    Per frequency the least-squares fit with the components |k| <= K (p₀
+    excited columns) is compared with the fit that adds ``G_{±(K+1)}`` (q
+    more excited columns), over the frequencies with more windows than
+    ``p₀ + q``.  Without unmodelled harmonics and with white noise,
+    ``F = ((RSS₀ - RSS₁)/Q) / (RSS₁/N₁) ~ F(2Q, 2N₁)`` (complex data),
+    Q and N₁ summed over frequencies and outputs.  Returns None when no
+    frequency has enough windows.
+    """
+    nrec, nu, ns = U.shape
+    ks = np.arange(-K - 1, K + 2)
+    idx = (bins[:, None] - ks[None, :] * L) % ns                 # (F, 2K+3)
+    mask = np.transpose(excited[:, idx], (1, 2, 0)).reshape(bins.size, -1)
+    phi = np.transpose(U[:, :, idx], (0, 2, 3, 1)).reshape(nrec, bins.size, -1) * mask
+    outer = np.zeros(mask.shape[1], bool)
+    outer[:nu], outer[-nu:] = True, True                        # k = ∓(K+1) columns
+    p0 = (mask & ~outer).sum(axis=1)
+    p1 = mask.sum(axis=1)
+    use = (nrec > p1) & (p1 > p0)
+    if not np.any(use):
+        return None
+    Yb = np.transpose(Y[:, :, bins[use]], (0, 2, 1))
+    rss = []
+    for cols in (mask[use] & ~outer, mask[use]):
+        g, _, _ = _solve_bins(phi[:, use] * cols, Yb)
+        rss.append(float(_residual(phi[:, use] * cols, Yb, g).sum()))
+    if rss[0] <= 1e-24 * float(np.sum(np.abs(Yb) ** 2)):
+        return {"statistic": 0.0, "pvalue": 1.0, "variance_ratio": 1.0}   # exact fit
+    ny = Y.shape[1]
+    q = ny * int(np.sum(p1[use] - p0[use]))
+    dof0 = ny * int(np.sum(nrec - p0[use]))
+    dof1 = ny * int(np.sum(nrec - p1[use]))
+    stat = (rss[0] - rss[1]) / q / (rss[1] / dof1)
+    return {"statistic": float(stat),
+            "pvalue": float(scipy.stats.f.sf(stat, 2 * q, 2 * dof1)),
+            "variance_ratio": float((rss[0] / dof0) / (rss[1] / dof1))}
+
+
 # ------------------------------------------------------------- public API
 def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
               omega_limits=None, threshold=1e-2, progress=True):
@@ -450,6 +501,23 @@ def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
     dof = n - trace
     has_dof = dof > 1e-6 * n
     noise_var = sq / dof if has_dof else np.full(sq.shape, np.nan)
+    test = _harmonic_test(U, Y, bins, L, K, excited)
+    if test is not None and (test["pvalue"] < _HARMONIC_PVALUE
+                             and test["variance_ratio"] > _HARMONIC_RATIO):
+        warnings.warn(
+            f"unmodelled harmonics: the inputs shifted by ±{K + 1}ω_p explain the "
+            f"residual (F = {test['statistic']:.3g}, p = {test['pvalue']:.2g}), so the "
+            f"plant has components G_k with |k| > {K}; they are counted as noise (noise "
+            f"variance about {test['variance_ratio']:.3g}× too large, std inflated) or "
+            f"alias into the estimate; increase nharmonics", UserWarning, stacklevel=3)
+    elif test is None and alpha == 0:
+        warnings.warn(
+            f"too few windows to test for unmodelled harmonics ({nrec} windows, "
+            f"{need} components per frequency): components G_k with |k| > {K} would "
+            f"alias undetected into the estimate (with {nrec} phase-shifted replicas "
+            f"G_{K + 1} into G_{K + 1 - nrec} and G_{-K - 1} into G_{nrec - K - 1}); use at "
+            f"least {need + 2 * nu + 1} windows to test for them",
+            UserWarning, stacklevel=3)
     # reported: identified pairs (α = 0); for α > 0 also the penalty's bridge across
     # gaps between a component's first and last identified frequency, not its
     # linear extrapolation beyond them, which no data support
@@ -472,7 +540,7 @@ def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
         components=comps, omega=bins * wgrid, period=period, std=std, cond=cond,
         residual=np.sqrt(sq / n), noise_var=noise_var, alpha=float(alpha),
         dof=float(dof), gcv=float(n * sq.sum() / dof ** 2) if has_dof else np.inf,
-        nrecords=nrec, identified=identified, labels=labels)
+        nrecords=nrec, identified=identified, harmonic_test=test, labels=labels)
 
 
 def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
@@ -531,12 +599,14 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     HTF
         Data HTF on the estimated grid, with ``std`` (standard deviation of
         each component, NaN where the component is; None when the residual
-        has no degrees of freedom, e.g. exactly ``(2K+1)·nu`` windows) and ``diagnostics`` holding ``identified`` (bool, shape
-        of the components: True where ``U(ω - kω_p)`` of the input is
-        excited, so that the data determine ``G_k(jω)``), ``cond`` (of
+        has no degrees of freedom, e.g. exactly ``(2K+1)·nu`` windows) and
+        ``diagnostics`` holding ``identified`` (bool, shape of the
+        components: True where ``U(ω - kω_p)`` of the input is excited, so
+        that the data determine ``G_k(jω)``), ``cond`` (of
         ``Φ_UU`` over the identified components per frequency, NaN where
         there are none), ``residual`` (RMS per output), ``noise_var``,
-        ``alpha``, ``dof``, ``gcv`` and ``nrecords``.  A component that is
+        ``alpha``, ``dof``, ``gcv``, ``nrecords`` and ``harmonic_test`` (see
+        Notes; None when there are too few windows).  A component that is
         not determined at a frequency is NaN in the HTF: with ``alpha=0``
         where it is not identified, with ``alpha > 0`` outside the range
         from its first to its last identified frequency (inside, the
@@ -551,7 +621,10 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     UserWarning
         Ill-conditioned ``Φ_UU`` with ``alpha=0``; windows of unequal length;
         unexcited frequencies inside `omega_limits`; GCV minimum at the edge
-        of the searched range.
+        of the searched range; unmodelled harmonics (see Notes); with
+        ``alpha=0``, too few windows to test for them (e.g. the minimum of
+        ``2K+1`` replicas for one input), so that harmonics beyond K would
+        alias into the estimate undetected (the message names them).
 
     Notes
     -----
@@ -559,13 +632,24 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     windows are treated as independent.  The penalty acts on the grid
     ``2π/(L T)``, so α depends on the record length.
 
+    *Unmodelled harmonics.*  A plant with components ``G_k``, ``|k| > K``,
+    leaves ``Σ_{|k|>K} G_k U(ω - kω_p)`` in the residual, which the
+    estimator counts as noise (``std`` too large) or, when the windows do
+    not separate them, aliases into the estimate.  The per-frequency
+    least-squares fit is therefore repeated with ``G_{±(K+1)}`` added,
+    wherever there are enough windows, and an F test on the decrease of
+    the residual (``diagnostics['harmonic_test']``: statistic, p-value and
+    the ratio of the two noise-variance estimates) warns when it is
+    significant (p < 1e-3) and inflates the noise variance by more than
+    10 %.
+
     Examples
     --------
     A memoryless periodic gain ``y = (1 + cos ω_p t) u`` has
     ``G_0 = 1`` and ``G_{±1} = 1/2``:
 
     >>> T, dt = 1.0, 0.01
-    >>> exc = ltp.chirp_replicas(T, 3, 8.0, 0.1, 20.0, dt=dt)
+    >>> exc = ltp.chirp_replicas(T, 6, 8.0, 0.1, 20.0, dt=dt)
     >>> y = (1 + np.cos(2 * np.pi * exc.time / T)) * exc.inputs
     >>> H = ltp.estimate_htf((exc.time, exc.inputs, y), T, 1,
     ...                      segments=exc.segments)
@@ -579,7 +663,7 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     diagnostics = {"identified": est.identified, "cond": est.cond,
                    "residual": est.residual, "noise_var": est.noise_var,
                    "alpha": est.alpha, "dof": est.dof, "gcv": est.gcv,
-                   "nrecords": est.nrecords}
+                   "nrecords": est.nrecords, "harmonic_test": est.harmonic_test}
     # NaN marks components the data leave undetermined (U(ω - kω_p) not excited);
     # std is None only when the residual has no degrees of freedom
     std = None if np.all(np.isnan(est.std[est.identified])) else est.std

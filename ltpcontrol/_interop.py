@@ -131,10 +131,11 @@ ROUTES = {
     'interconnect': _blocks('interconnect'),
 }
 
-#: python-control names whose LTP counterpart is the same-named ltpcontrol
-#: function with the same arguments (analysis and synthesis)
-HOOKS = ('zeros', 'norm', 'lyap', 'dlyap', 'gram', 'lqr', 'dlqr', 'lqe', 'dlqe',
-         'place', 'h2syn', 'hinfsyn', 'hankel_singular_values')
+#: python-control name -> ltpcontrol function with the same arguments (analysis,
+#: synthesis, reduction), reached when this version of ltpcontrol provides it
+HOOKS = {name: name for name in ('zeros', 'norm', 'lyap', 'dlyap', 'gram', 'lqr', 'dlqr',
+                                 'lqe', 'dlqe', 'place', 'h2syn', 'hinfsyn', 'minreal')}
+HOOKS.update(hankel_singular_values='hsvd', balanced_reduction='balred')
 
 _HTF = ("ltp.htf(sys, nharmonics) (or ltp.harmonic_ss) for the harmonic transfer function; "
         "HTF.component(k, omega) or ltp.htf_response give its components")
@@ -161,8 +162,6 @@ REFUSED = {
     'root_locus_map': "ltp.floquet_exponents of the closed loops",
     'root_locus_plot': "ltp.floquet_exponents of the closed loops",
     'step_info': "ct.step_info(ltp.step_response(sys, T).outputs, T)",
-    'minreal': "sys.to_ss().minreal() for constant matrices",
-    'balanced_reduction': _LTI,
     'similarity_transform': "ltp.floquet_transform or ltp.to_canonical",
     'canonical_form': "ltp.to_canonical",
     'ss': _LTI,
@@ -182,13 +181,13 @@ def _refusal(what, hint):
                            f"(LTPStateSpace): use {hint}")
 
 
-def _hook(name):
+def _hook(name, target):
     def route(orig, *args, **kwargs):
-        fn = _ltp_function(name)
+        fn = _ltp_function(target)
         if fn is None:
             raise ControlArgument(
                 f"{name} does not apply to a linear time-periodic system "
-                f"(LTPStateSpace) and its periodic counterpart ltp.{name} is not "
+                f"(LTPStateSpace) and its periodic counterpart ltp.{target} is not "
                 "available in this version of ltpcontrol")
         return fn(*args, **kwargs)
     return route
@@ -202,7 +201,7 @@ def _refuse(name, hint):
 
 def _routes():
     table = dict(ROUTES)
-    table.update({name: _hook(name) for name in HOOKS})
+    table.update({name: _hook(name, target) for name, target in HOOKS.items()})
     table.update({name: _refuse(name, hint) for name, hint in REFUSED.items()})
     return table
 

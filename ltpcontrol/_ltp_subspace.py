@@ -37,10 +37,10 @@ from tqdm.auto import tqdm
 
 from ._discretize import d2c
 from ._fdsubspace import fdsubspace, FDSubspaceInfo
+from ._floquet_fit import _harmonic_response, fit_floquet
 from ._lifting import _harmonic_labels, _real_basis
-from ._ltpsys import LTPStateSpace
-from ._periodic_matrix import PeriodicMatrix
 from ._realization import FloquetRealization, floquet_realization
+from ._refine import refine_ltp
 from ._validation import (check_kwargs, check_period, check_positive_int,
                           real_array, steps_per_period)
 
@@ -56,7 +56,8 @@ _CONVERSIONS = ('refit', 'log', 'tustin')
 
 def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
                               transient=0.0, input_hold=None, hold_step=None, real=True,
-                              batch_size=64, progress=False, name=None, **kwargs):
+                              unusable='raise', batch_size=64, progress=False, name=None,
+                              **kwargs):
     r"""Lifted frequency response of an LTP system from sine experiments.
 
     Each experiment applies one real sinusoid (single sine) or a sum of
@@ -107,6 +108,10 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
         labels ``'<y>_c0', '<y>_c1', '<y>_s1', ...`` as in `ltpcontrol.lift`.
         False: the complex harmonics ``G_n``, n = -K..K (labels
         ``'<y>_h<n>'``).
+    unusable : {'raise', 'skip'}, optional
+        What to do with lines within one DFT bin of a multiple of ``ω_p/2``
+        (the responses to ``±Ω`` share their output frequencies there):
+        'raise' (default) a ValueError, or 'skip' them with a warning.
     batch_size : int, optional
         Number of input lines (experiments, for single sines) analysed at
         once; bounds the memory use (default 64).
@@ -128,8 +133,9 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
         If ``T/Ts`` is not an integer, the time points are not uniform, the
         window is shorter than one period, the lines of an input window
         are not on its DFT grid and `frequencies` is not given, a line lies within one DFT bin
-        of a multiple of ``ω_p/2`` (the responses to ``±Ω`` then share
-        their output frequencies), two lines of one experiment produce
+        of a multiple of ``ω_p/2`` (with ``unusable='raise'``; the
+        responses to ``±Ω`` then share their output frequencies), no
+        usable line is left, two lines of one experiment produce
         overlapping harmonics, a line is not below the Nyquist frequency,
         or an input has no line.
     ControlDimension
@@ -141,8 +147,8 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     Warns
     -----
     UserWarning
-        If a given frequency is off the DFT grid of the window: leakage
-        biases the response.
+        If a given frequency is off the DFT grid of the window (leakage
+        biases the response), or when lines are skipped (``unusable='skip'``).
 
     Notes
     -----
@@ -180,6 +186,8 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
         raise ControlArgument(f"real must be True or False, got {real!r}")
     hold_step = dt if hold_step is None else check_period(hold_step, 'hold_step')
     batch_size = check_positive_int(batch_size, 'batch_size')
+    if unusable not in ('raise', 'skip'):
+        raise ValueError(f"unusable must be 'raise' or 'skip', got {unusable!r}")
     transient = float(real_array(transient, 'transient', ndim=0))
     if transient < 0:
         raise ValueError(f"transient must be >= 0, got {transient}")
@@ -194,7 +202,7 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     start = L - P * N
     tw, uw, yw = t[start:], u[:, start:], y[:, :, start:]
     window = P * period
-    lines = _lines(uw, frequencies, nexp, window, dt, period)
+    lines = _lines(uw, frequencies, nexp, window, dt, period, unusable == 'skip')
 
     # Output harmonics: Y_n = (1/L) Σ_k y[k] e^{-jΩt_k} e^{-jnω_p t_k}, where the
     # second factor repeats every period (N samples).
@@ -257,7 +265,11 @@ class LTPSubspaceInfo:
         Continuous-time conversion used ('refit', 'log' or 'tustin').
     relative_residual : float
         ``‖G - Ĝ‖ / ‖G‖`` of the continuous-time model on the continuous
-        harmonic response ``G_n(jΩ)`` (all lines, harmonics -K..K).
+        harmonic response ``G_n(jΩ)`` (all lines, harmonics -K..K; those of
+        the model for 'log' and 'tustin').
+    realized_harmonics : int
+        Harmonics of the realized lifted model: K, or fewer when the
+        K-harmonic model had no eigenvalue ladders.
 
     Examples
     --------
@@ -271,10 +283,12 @@ class LTPSubspaceInfo:
     realization: FloquetRealization
     conversion: str
     relative_residual: float
+    realized_harmonics: int
 
 
 def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
                  realization='direct', realization_options=None, refit_a=True,
+                 refine=None, refine_options=None,
                  estimate_d=True,
                  seed=None, progress=False,
                  return_info=False, name=None, **kwargs):
@@ -330,6 +344,13 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         ``B``, ``C``, ``D`` (default True, which makes the result independent
         of `q`); False keeps the 'log' ``A`` and refits ``B``, ``C``, ``D``
         given ``A`` only.
+    refine : {None, 'ml'}, optional
+        'ml': finish with `ltpcontrol.refine_ltp` on the lifted data (the
+        maximum-likelihood fit of the Floquet-form model, equal weights
+        unless ``refine_options`` gives ``std``); default None.
+    refine_options : dict, optional
+        Keywords of `ltpcontrol.refine_ltp` (``std``, ``stable``,
+        ``harmonics``, ...).
     estimate_d : bool, optional
         Estimate a feedthrough (default True); False forces ``D = 0``.
     seed : int, optional
@@ -353,9 +374,10 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     ------
     ValueError
         If there are too few frequencies for the order ``(2K+1) n_p`` and
-        `q`, the data do not have ``2K+1`` harmonics per output, or an
-        option is unknown (and for the data errors of
-        `lifted_frequency_response`).
+        `q`, the data do not have ``2K+1`` harmonics per output, an option
+        is unknown, no lifted model of harmonics -k..k (k <= K) has a
+        Floquet realization (repeated eigenvalues), or for the data errors
+        of `lifted_frequency_response`.
     ControlArgument
         If `data` has the wrong type or is not discrete-time.
     TypeError
@@ -364,9 +386,12 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     Warns
     -----
     UserWarning
-        If the realization does not find the Floquet structure (the model
-        is then returned but is not trustworthy), or if the refit stops
-        before converging.
+        With 'refit': if the returned model misses the data by more than
+        the realization's ``fit_tol`` (default 0.05, relative residual) or
+        the refit stops before converging.  With 'log' or 'tustin': if the
+        realization does not find the Floquet structure or had to use
+        fewer harmonics.  Lines of time records at multiples of ``ω_p/2``
+        are skipped with a warning.
 
     Notes
     -----
@@ -379,10 +404,23 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         \qquad n = -K..K,
 
     bilinear in (B, C) and linear in D.  'refit' minimises
-    ``Σ |G_n - Ĝ_n|²`` over all lines and harmonics by Gauss-Newton steps
-    (minimum-norm steps absorb the similarity freedom left by a fixed A).
-    The identified model and the true system are related by a similarity:
-    compare them in a canonical form (`ltpcontrol.to_canonical`).
+    ``Σ |G_n - Ĝ_n|²`` over all lines and harmonics by Levenberg-Marquardt
+    steps (minimum-norm Gauss-Newton steps absorb the similarity freedom).
+    The pipeline is robust to imperfect lifted models: the eigenvalue
+    ladders are found by optimal matching with members weighted by their
+    contribution (`ltpcontrol.floquet_realization`), and if the K-harmonic
+    lifted model has no ladders at all (its outermost members absorb the
+    truncation error of a plant with periodic A(t)) the data of fewer
+    harmonics are realized and the refit restores all K.  A plant whose
+    A(t) is periodic has infinitely many harmonics in Floquet form; the
+    truncation error of a K-harmonic model decays quickly with K (see the
+    identification guide).
+
+    The identified model and the true system are related by a periodic
+    change of state: compare them with `ltpcontrol.compare_ltp` (HTFs and
+    Floquet exponents modulo ``jω_p``).  `ltpcontrol.to_canonical` removes
+    only constant similarities, so it also depends on the branch of the
+    exponents.
 
     Examples
     --------
@@ -409,13 +447,54 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
     if conversion not in _CONVERSIONS:
         raise ValueError(f"conversion must be one of {_CONVERSIONS}, got {conversion!r}")
+    if refine not in (None, 'ml'):
+        raise ValueError(f"refine must be None or 'ml', got {refine!r}")
+    # 1. lifted frequency response
+    G = _lifted_data(data, period, K, progress, lfr_kwargs)
+    ny, N = _check_lifted_data(G, period, K, nstates, q)
+    name = 'ltp_subspace' if name is None else name
+    labels = dict(name=name, inputs=[G.input_labels[0].rsplit('_', 1)[0]],
+                  outputs=[lab.rsplit('_', 1)[0] for lab in G.output_labels[:ny]])
+    Gc = _harmonic_data(G, K, N, ny)
+    # 2-4. subspace model, Floquet realization (fewer harmonics if better), continuous time
+    lifted, sinfo, real, Kr, sysc = _realize(
+        G, Gc, period, K, N, nstates, ny, q, estimate_d, realization, seed, progress,
+        realization_options, conversion, labels)
+    # 5. structured refinement: the Floquet-form model fitted to the harmonic data
+    if conversion == 'refit':
+        sysc, _, converged = fit_floquet(sysc, Gc, G.omega, K, estimate_d=estimate_d,
+                                         fit_a=refit_a, **labels)
+        if not converged:
+            warnings.warn("the least-squares refit did not converge", UserWarning,
+                          stacklevel=2)
+    # 6. optional maximum-likelihood refinement weighted by the data's uncertainty
+    if refine == 'ml':
+        sysc = _ml_refine(sysc, G, refine_options)
+    resid = _harmonic_response(sysc, G.omega, min(K, Kr) if conversion != 'refit' else K)
+    Gk = Gc if conversion == 'refit' else _harmonic_data(G, min(K, Kr), N, ny)
+    relres = float(np.linalg.norm(resid - Gk) / np.linalg.norm(Gk))
+    _warn_quality(real, Kr, K, conversion, relres, realization_options)
+    if not return_info:
+        return sysc
+    info = LTPSubspaceInfo(data=G, lifted=lifted, subspace=sinfo, realization=real,
+                           conversion=conversion, relative_residual=relres,
+                           realized_harmonics=Kr)
+    return sysc, info
+
+
+def _lifted_data(data, period, K, progress, lfr_kwargs):
+    """Step 1: the real lifted response, given or computed from time records."""
     if isinstance(data, ct.FrequencyResponseData):
         if lfr_kwargs:
             raise TypeError(f"identify_ltp: {sorted(lfr_kwargs)} only apply to time "
                             "records, not to frequency-response data")
-        G = data
-    else:
-        G = lifted_frequency_response(data, period, K, progress=progress, **lfr_kwargs)
+        return data
+    return lifted_frequency_response(data, period, K, progress=progress,
+                                     unusable='skip', **lfr_kwargs)
+
+
+def _check_lifted_data(G, period, K, nstates, q):
+    """Validate the lifted data; return (outputs, steps per period)."""
     H = 2 * K + 1
     if not G.dt or G.dt is True:
         raise ControlArgument("data must be discrete-time frequency-response data "
@@ -424,51 +503,76 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     if G.ninputs != 1 or G.noutputs % H:
         raise ValueError(f"data must have one input and (2K+1) = {H} lifted outputs per "
                          f"system output, got shape {G.frdata.shape[:2]}")
-    ny = G.noutputs // H
-    Ts = float(G.dt)
-    N = steps_per_period(period, Ts, 'the sampling time of data')
-    order = H * nstates
-    M = G.omega.size
+    N = steps_per_period(period, float(G.dt), 'the sampling time of data')
+    order, M = H * nstates, G.omega.size
     # fdsubspace needs 2M >= q + order with q > order: at least order + 1 lines.
     if 2 * M < 2 * order + 1 or (q is not None and 2 * M < q + order):
         raise ValueError(
             f"too few frequencies: {M} lines for the lifted order (2K+1)*nstates = "
             f"{order}{'' if q is None else f' and q={q}'}; need at least "
             f"{order + 1 if q is None else -(-(q + order) // 2)} distinct lines")
+    return G.noutputs // H, N
 
-    lifted, sinfo = fdsubspace(G, order=order, q=q, estimate_d=estimate_d,
-                               return_info=True)
-    real = floquet_realization(lifted, K, N, period=period, method=realization,
-                               input_harmonics='zero', seed=seed, progress=progress,
-                               **(realization_options or {}))
-    if real.sys is None:
+
+def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, progress,
+             options, conversion, labels):
+    """Steps 2-4: subspace model of order (2k+1) n_p, Floquet realization, continuous time.
+
+    The outermost ladder members of a K-harmonic lifted model absorb the
+    truncation error of a plant with periodic A(t); its ladders may then be
+    poor or missing.  For the refit, the realizations of the data of
+    harmonics -k..k, k = K, K-1, K-2, are therefore all formed and the one
+    whose continuous model fits the K-harmonic data best starts the refit.
+    Otherwise k = K, with k < K only when K has no realization.
+    """
+    best = None
+    for k in range(K, -1, -1):
+        Gk = G if k == K else ct.frd(G.frdata[:(2 * k + 1) * ny], G.omega, G.dt)
+        order = (2 * k + 1) * nstates
+        if 2 * Gk.omega.size < (q or order + 1) + order:
+            continue
+        lifted, sinfo = fdsubspace(Gk, order=order, q=q, estimate_d=estimate_d,
+                                   return_info=True)
+        real = floquet_realization(lifted, k, N, period=period, method=method,
+                                   input_harmonics='zero', seed=seed, progress=progress,
+                                   **(options or {}))
+        if real.sys is None:
+            continue
+        sysc = d2c(real.sys, 'tustin' if conversion == 'tustin' else 'log', **labels)
+        with np.errstate(all='ignore'):
+            miss = np.linalg.norm(_harmonic_response(sysc, G.omega, K) - Gc)
+        miss = miss if np.isfinite(miss) else np.inf
+        if best is None or miss < best[0]:
+            best = (miss, lifted, sinfo, real, k, sysc)
+        if conversion != 'refit' or k <= K - 2:
+            break
+    if best is None:
         raise ValueError(f"the Floquet realization failed: {real.message}")
-    if not real.success:
-        hint = ("the refit starts from it: check info.relative_residual"
-                if conversion == 'refit' else "the model is not trustworthy")
-        warnings.warn(f"{real.message}; {hint} (or try another realization method, "
-                      "seed or q)", UserWarning, stacklevel=2)
-    sysd = real.sys
-    name = 'ltp_subspace' if name is None else name
-    labels = dict(inputs=[G.input_labels[0].rsplit('_', 1)[0]],
-                  outputs=[lab.rsplit('_', 1)[0] for lab in G.output_labels[:ny]])
-    # Continuous harmonic data G_n(jΩ), n = -K..K (undo the real transform).
+    return best[1:]
+
+
+def _harmonic_data(G, K, N, ny):
+    """Continuous harmonic data G_n(jΩ), n = -K..K (undo the real transform)."""
     V, _ = _real_basis(np.arange(-K, K + 1), N)
-    Gc = (np.kron(V, np.eye(ny)) @ G.frdata[:, 0, :]).reshape(H, ny, M)
-    if conversion == 'tustin':
-        sysc = d2c(sysd, 'tustin', name=name, **labels)
-    else:
-        sysc = d2c(sysd, 'log', name=name, **labels)
-        if conversion == 'refit':
-            sysc = _refit(sysc, Gc, G.omega, K, estimate_d, refit_a, name, labels)
-    if not return_info:
-        return sysc
-    resid = _harmonic_response(sysc, G.omega, K) - Gc
-    info = LTPSubspaceInfo(data=G, lifted=lifted, subspace=sinfo, realization=real,
-                           conversion=conversion,
-                           relative_residual=float(np.linalg.norm(resid)
-                                                   / np.linalg.norm(Gc)))
-    return sysc, info
+    H = 2 * K + 1
+    return (np.kron(V, np.eye(ny)) @ G.frdata[:H * ny, 0, :]).reshape(H, ny, -1)
+
+
+def _warn_quality(real, Kr, K, conversion, relres, options):
+    """Warn when the returned model is doubtful (see `identify_ltp`, Warns)."""
+    if Kr < K and conversion != 'refit':
+        warnings.warn(f"the lifted model of {K} harmonics has no eigenvalue ladders; "
+                      f"realized with {Kr} harmonics instead: the model has {Kr} "
+                      "harmonics", UserWarning, stacklevel=3)
+    fit_tol = (options or {}).get('fit_tol', 0.05)
+    if conversion == 'refit':
+        if relres > fit_tol:
+            warnings.warn(f"the identified model misses the data: relative residual "
+                          f"{relres:.3g} > {fit_tol:g} (realization: {real.message}); "
+                          "try other nstates, nharmonics or q", UserWarning, stacklevel=3)
+    elif not real.success:
+        warnings.warn(f"{real.message}; the model is not trustworthy (try another "
+                      "realization method, seed or q)", UserWarning, stacklevel=3)
 
 
 #
@@ -523,8 +627,8 @@ def _uniform_step(t):
     return dt
 
 
-def _lines(uw, frequencies, nexp, window, dt, period):
-    """Input lines (rad/s) of every experiment, validated."""
+def _lines(uw, frequencies, nexp, window, dt, period, skip=False):
+    """Input lines (rad/s) of every experiment, validated (unusable ones skipped)."""
     bin_ = 2 * np.pi / window
     Lw = uw.shape[1]
     if frequencies is None:
@@ -557,6 +661,7 @@ def _lines(uw, frequencies, nexp, window, dt, period):
                           "the response", UserWarning, stacklevel=3)
         lines = list(f)
     half = np.pi / period                                 # ω_p / 2
+    skipped = []
     for e, Om in enumerate(lines):
         if np.any(Om <= 0) or np.any(Om >= np.pi / dt):
             raise ValueError(f"frequencies of experiment {e} must lie in (0, π/Ts) = "
@@ -564,7 +669,10 @@ def _lines(uw, frequencies, nexp, window, dt, period):
         # ±Ω share output frequencies when 2Ω ≡ 0 (mod ω_p); lines l, l' when
         # Ω_l ± Ω_l' ≡ 0 (mod ω_p).
         dist = np.abs(Om - np.round(Om / half) * half)
-        if np.any(dist < 0.49 * bin_):
+        if skip and np.any(dist < 0.49 * bin_):
+            skipped.extend(Om[dist < 0.49 * bin_])
+            Om = lines[e] = Om[dist >= 0.49 * bin_]
+        elif np.any(dist < 0.49 * bin_):
             raise ValueError(
                 f"frequencies {np.round(Om[dist < 0.49 * bin_], 6).tolist()} rad/s of "
                 f"experiment {e} are multiples of omega_p/2 = {half:.6g} rad/s (within "
@@ -578,6 +686,14 @@ def _lines(uw, frequencies, nexp, window, dt, period):
             if np.any(d < 0.49 * bin_):
                 raise ValueError(f"two lines of experiment {e} differ or sum to a "
                                  "multiple of omega_p: their output harmonics overlap")
+    if skipped:
+        warnings.warn(f"skipped the lines {np.round(np.unique(skipped), 6).tolist()} rad/s "
+                      f"at multiples of omega_p/2 = {half:.6g} rad/s: the responses to +Ω "
+                      "and -Ω fall on the same output frequencies there",
+                      UserWarning, stacklevel=4)
+        if not any(Om.size for Om in lines):
+            raise ValueError("no usable line is left after skipping the multiples of "
+                             "omega_p/2")
     return lines
 
 
@@ -589,121 +705,6 @@ def _hold_factor(omega, dt, hold):
     return x ** 2 if hold == 'foh' else x * np.exp(-0.5j * omega * dt)
 
 
-def _resolvents(A, omega, wp, K):
-    """``R_m(Ω) = (j(Ω + mω_p) I - A)^{-1}``, shape (M, 2K+1, n, n)."""
-    n = A.shape[0]
-    s = 1j * (omega[:, None] + wp * np.arange(-K, K + 1)[None, :])
-    return np.linalg.inv(s[..., None, None] * np.eye(n) - A)
-
-
-def _model_response(R, Bc, Cc, Dc, K):
-    """``G_n = Σ_m C_{n-m} R_m B_m + D_n`` for n = -K..K, shape (2K+1, ny, M)."""
-    X = np.einsum('wmij,mj->wmi', R, Bc[:, :, 0])                 # R_m B_m
-    idx = np.arange(-K, K + 1)
-    Cnm = Cc[(idx[:, None] - idx[None, :]) + 2 * K]               # (n, m, ny, nx)
-    return np.einsum('nmoi,wmi->now', Cnm, X) + Dc[:, :, 0, None]
-
-
-def _harmonic_response(sys, omega, K):
-    """Continuous harmonic response G_n(jΩ), n = -K..K, of a Floquet-form model."""
-    wp = 2 * np.pi / sys.period
-    R = _resolvents(sys.A(0.0), omega, wp, K)
-    nb = max(K, sys.B.nharmonics or 0, 1)
-    nc = max(2 * K, sys.C.nharmonics or 0, 1)
-    Bc = _pad(sys.B.fourier(nb), K)
-    Cc = _pad(sys.C.fourier(nc), 2 * K)
-    Dc = _pad(sys.D.fourier(max(K, sys.D.nharmonics or 0)), K)
-    return _model_response(R, Bc, Cc, Dc, K)
-
-
-def _pad(coeffs, K):
-    """Central harmonics -K..K of a coefficient array (2J+1, ...)."""
-    J = coeffs.shape[0] // 2
-    return coeffs[J - K:J + K + 1]
-
-
-def _conj_map(H, size):
-    """Real parameters → complex coefficients ``P_h``, h = -H..H, P_{-h} = conj(P_h)."""
-    # real vector [Re P_0, Re P_1, Im P_1, ..., Re P_H, Im P_H] (each `size` long)
-    T = np.zeros(((2 * H + 1) * size, (2 * H + 1) * size), complex)
-    eye = np.eye(size)
-    T[H * size:(H + 1) * size, :size] = eye
-    for h in range(1, H + 1):
-        re, im = slice((2 * h - 1) * size, 2 * h * size), slice(2 * h * size, (2 * h + 1) * size)
-        for sign in (1, -1):
-            rows = slice((H + sign * h) * size, (H + sign * h + 1) * size)
-            T[rows, re] = eye
-            T[rows, im] = sign * 1j * eye
-    return T
-
-
-def _refit(sys, Gc, omega, K, estimate_d, refit_a, name, labels, maxiter=30,
-           tol=1e-13):
-    """Gauss-Newton refit of B_m, C_l, D_n (and A) (see `identify_ltp`)."""
-    A = sys.A(0.0)
-    nx, ny = A.shape[0], Gc.shape[1]
-    wp = 2 * np.pi / sys.period
-    idx = np.arange(-K, K + 1)
-    Tb, Tc, Td = _conj_map(K, nx), _conj_map(2 * K, ny * nx), _conj_map(K, ny)
-    T = np.zeros((Tb.shape[0] + Tc.shape[0] + Td.shape[0],) * 2, complex)
-    nb, nc = Tb.shape[0], Tc.shape[0]
-    T[:nb, :nb], T[nb:nb + nc, nb:nb + nc], T[nb + nc:, nb + nc:] = Tb, Tc, Td
-    keep = np.ones(T.shape[1], bool)
-    if not estimate_d:
-        keep[nb + nc:] = False
-    T = T[:, keep]
-    theta = np.linalg.lstsq(T, np.concatenate([
-        _pad(sys.B.fourier(max(K, sys.B.nharmonics or 0)), K).ravel(),
-        _pad(sys.C.fourier(max(2 * K, sys.C.nharmonics or 0)), 2 * K).ravel(),
-        _pad(sys.D.fourier(max(K, sys.D.nharmonics or 0)), K).ravel()
-        * float(estimate_d)]), rcond=None)[0].real
-
-    ncoef = theta.size
-    if refit_a:
-        theta = np.concatenate([theta, A.ravel()])
-
-    def unpack(th):
-        c = T @ th[:ncoef]
-        return (c[:nb].reshape(2 * K + 1, nx, 1), c[nb:nb + nc].reshape(4 * K + 1, ny, nx),
-                c[nb + nc:].reshape(2 * K + 1, ny, 1),
-                th[ncoef:].reshape(nx, nx) if refit_a else A)
-
-    M = omega.size
-    for _ in range(maxiter):
-        Bc, Cc, Dc, Ak = unpack(theta)
-        R = _resolvents(Ak, omega, wp, K)
-        r = (_model_response(R, Bc, Cc, Dc, K) - Gc).ravel()       # (n, o, w)
-        # Jacobian w.r.t. the complex coefficients, rows (n, o, w).
-        Cnm = Cc[(idx[:, None] - idx[None, :]) + 2 * K]            # (n, m, o, i)
-        CR = np.einsum('nmoi,wmij->nowmj', Cnm, R)                 # C_{n-m} R_m
-        JB = CR.reshape(-1, nb)
-        X = np.einsum('wmij,mj->wmi', R, Bc[:, :, 0])              # (w, m, i)
-        # dG_n = Σ_l dC_l X_{n-l}, |n-l| <= K
-        Xsel = np.zeros((2 * K + 1, 4 * K + 1, M, nx), complex)
-        for a, n in enumerate(idx):
-            Xsel[a, n - idx + 2 * K] = X.transpose(1, 0, 2)
-        eye = np.eye(ny)
-        JC = np.einsum('oq,nlwi->nowlqi', eye, Xsel).reshape(-1, nc)
-        JD = np.einsum('na,oq,w->nowaq', np.eye(2 * K + 1), eye,
-                       np.ones(M)).reshape(-1, Td.shape[0])
-        J = np.hstack([JB, JC, JD]) @ T
-        if refit_a:
-            # dR_m = R_m dA R_m:  dG_n = Σ_m C_{n-m} R_m dA R_m B_m
-            JA = np.einsum('nowmi,wmj->nowij', CR, X).reshape(-1, nx * nx)
-            J = np.hstack([J, JA])
-        Jr = np.vstack([J.real, J.imag])
-        scale = np.linalg.norm(Jr, axis=0)
-        scale[scale == 0] = 1.0
-        step = np.linalg.lstsq(Jr / scale, -np.concatenate([r.real, r.imag]),
-                               rcond=None)[0] / scale
-        theta = theta + step
-        if np.linalg.norm(step) <= tol * max(1.0, np.linalg.norm(theta)):
-            break
-    else:
-        warnings.warn(f"the least-squares refit did not converge in {maxiter} "
-                      "iterations", UserWarning, stacklevel=3)
-    Bc, Cc, Dc, A = unpack(theta)
-    period = sys.period
-    return LTPStateSpace(A, PeriodicMatrix(Bc, period), PeriodicMatrix(Cc, period),
-                         PeriodicMatrix(Dc, period), period, name=name,
-                         states=sys.state_labels, **labels)
+def _ml_refine(sys, data, options):
+    """``refine='ml'`` of `identify_ltp`: `refine_ltp` on the lifted data."""
+    return refine_ltp(sys, data, **(options or {}))

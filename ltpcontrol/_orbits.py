@@ -29,7 +29,8 @@ __all__ = ['PeriodicOrbit', 'periodic_orbit', 'period_map', 'linearize_orbit']
 class PeriodicOrbit:
     """T-periodic steady state of a forced (hybrid) plant.
 
-    Returned by `periodic_orbit`; not meant to be built directly.  Calling
+    Returned by `periodic_orbit` (and, for autonomous plants, by
+    `limit_cycle`); not meant to be built directly.  Calling
     the object, ``orbit(t)``, evaluates ``x̄(t mod T)`` from the solver's
     dense output (shape ``(n,)`` for scalar t, ``(n, len(t))`` otherwise).
 
@@ -59,13 +60,32 @@ class PeriodicOrbit:
     multipliers : ndarray
         Eigenvalues of `monodromy` (Floquet multipliers).
     is_stable : bool
-        True when all multipliers lie strictly inside the unit circle.
+        True when all `stability_multipliers` lie strictly inside the unit
+        circle.
+    autonomous : bool
+        True for an orbit of an autonomous plant (`limit_cycle`), whose
+        period is an unknown and whose monodromy has the multiplier 1 along
+        the flow.
+    phase_multiplier : float or None
+        Autonomous orbits: the multiplier of the phase direction (1 up to
+        the residual); None otherwise.
+    stability_multipliers : ndarray
+        The multipliers that decide (orbital) stability: all of them for a
+        forced plant, all but the phase multiplier for an autonomous one.
+    section : callable or None
+        Autonomous orbits: the Poincaré section ``section(x) = 0`` used as
+        phase condition (``x0`` lies on it); None otherwise.
+    poincare_jacobian : ndarray or None
+        Autonomous orbits: Jacobian ``(I − f ∇sᵀ / (∇s·f)) Φ`` of the
+        return map to the section at ``x0``; its eigenvalues are the
+        stability multipliers and 0 (along the flow).  None otherwise.
     residual : float
         Final relative residual ``‖P(x0) − x0‖∞ / (1 + ‖x0‖∞)``.
     iterations : int
         Newton iterations of the successful attempt.
     periods_simulated : int
-        Periods of forward simulation used before convergence.
+        Periods of forward simulation (returns to the section for an
+        autonomous orbit) used before convergence.
     plant : HybridPlant
         The plant as a hybrid plant (a smooth system becomes one mode).
     params : dict
@@ -89,7 +109,7 @@ class PeriodicOrbit:
     """
 
     def __init__(self, plant, period, flow, x0, mode0, npoints, params, u0,
-                 residual, iterations, periods):
+                 residual, iterations, periods, phase_direction=None):
         self.plant, self.period, self._flow = plant, period, flow
         self.x0, self.mode0, self.params, self.u0 = np.array(x0), mode0, params, u0
         self.time = np.arange(npoints) * period / npoints
@@ -99,7 +119,14 @@ class PeriodicOrbit:
         self.saltation_matrices = list(flow.saltations)
         self.monodromy = flow.phi
         self.multipliers = np.linalg.eigvals(self.monodromy)
-        self.is_stable = bool(np.all(np.abs(self.multipliers) < 1))
+        self.autonomous = phase_direction is not None
+        self.phase_multiplier, self.stability_multipliers = None, self.multipliers
+        self.section = self.poincare_jacobian = None
+        if self.autonomous:
+            k = _phase_index(self.monodromy, self.multipliers, phase_direction)
+            self.phase_multiplier = float(self.multipliers[k].real)
+            self.stability_multipliers = np.delete(self.multipliers, k)
+        self.is_stable = bool(np.all(np.abs(self.stability_multipliers) < 1))
         self.residual, self.iterations, self.periods_simulated = residual, iterations, periods
 
     def __call__(self, t):
@@ -109,8 +136,25 @@ class PeriodicOrbit:
 
     def __repr__(self):
         mags = ', '.join(f'{abs(m):.4g}' for m in self.multipliers)
-        return (f"<PeriodicOrbit period={self.period:g}, {len(self.switching_times)} events, "
+        kind = "autonomous, " if self.autonomous else ""
+        return (f"<PeriodicOrbit {kind}period={self.period:g}, {len(self.switching_times)} events, "
                 f"|multipliers|=[{mags}], stable={self.is_stable}>")
+
+
+def _phase_index(monodromy, multipliers, direction):
+    """Index of the multiplier whose eigenvector is the flow direction.
+
+    ``Φ f(x̄(0)) = f(x̄(0))``: among the multipliers near 1 take the one whose
+    eigenvector is best aligned with the vector field (several multipliers
+    equal 1 when the plant conserves a quantity, e.g. energy).
+    """
+    near = np.flatnonzero(np.abs(multipliers - 1) < 1e-3)
+    if near.size <= 1:
+        return int(np.argmin(np.abs(multipliers - 1)))
+    _, vecs = np.linalg.eig(monodromy)
+    unit = direction / np.linalg.norm(direction)
+    align = np.abs(vecs[:, near].conj().T @ unit) / np.linalg.norm(vecs[:, near], axis=0)
+    return int(near[np.argmax(align)])
 
 
 def _as_hybrid(plant, jacobian):
@@ -135,23 +179,35 @@ def _as_hybrid(plant, jacobian):
                        params=plant.params, name=plant.name)
 
 
-def _check_periodicity(plant, period, x0, u0, params):
-    """Raise when a vector field or guard is not T-periodic in t."""
-    probes = period * np.array([0.1234567, 0.5, 0.8765432])
+def _time_mismatch(plant, x0, u0, params, pairs):
+    """First vector field or guard that differs between the times of a pair.
+
+    Compares at `x0` and a perturbed state; returns ``(label, mode name,
+    t_a, t_b, largest difference)`` or None.
+    """
     bumps = np.linspace(-1.0, 1.0, plant.nstates) * 0.1 * (1 + np.abs(x0))
     for i, mode in enumerate(plant.modes):
         checks = [('updfcn', lambda t, x: plant._f(i, t, x, u0, params))]
         if mode.guard is not None:
             checks.append(('guard', lambda t, x: plant._g(i, t, x, u0, params)))
         for label, func in checks:
-            for t in probes:
+            for ta, tb in pairs:
                 for x in (x0, x0 + bumps):
-                    a, b = np.asarray(func(t, x)), np.asarray(func(t + period, x))
+                    a, b = np.asarray(func(ta, x)), np.asarray(func(tb, x))
                     if not np.allclose(a, b, rtol=1e-8, atol=1e-10 * (1 + np.abs(a).max())):
-                        raise ValueError(
-                            f"plant is not periodic with period={period:g}: {label} of mode "
-                            f"{plant.mode_names[i]!r} differs between t={t:.6g} and t+T "
-                            f"(max difference {np.abs(a - b).max():.3g})")
+                        return label, plant.mode_names[i], ta, tb, np.abs(a - b).max()
+    return None
+
+
+def _check_periodicity(plant, period, x0, u0, params):
+    """Raise when a vector field or guard is not T-periodic in t."""
+    probes = period * np.array([0.1234567, 0.5, 0.8765432])
+    bad = _time_mismatch(plant, x0, u0, params, [(t, t + period) for t in probes])
+    if bad is not None:
+        label, mode, t, _, diff = bad
+        raise ValueError(f"plant is not periodic with period={period:g}: {label} of mode "
+                         f"{mode!r} differs between t={t:.6g} and t+T (max difference "
+                         f"{diff:.3g})")
 
 
 def _prepare(plant, period, x0, mode0, u0, params, jacobian):
@@ -301,73 +357,27 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
     opts = _solver_options(kwargs, 'periodic_orbit')
     check_kwargs(kwargs, 'periodic_orbit')
     hp, period, x0, mode0, u0, params = _prepare(plant, period, x0, mode0, u0, params, jacobian)
-    if not isinstance(tol, numbers.Real) or not 0 < tol < 1:
-        raise ValueError(f"tol must be a number in (0, 1), got {tol!r}")
-    max_iter = check_positive_int(max_iter, 'max_iter')
-    max_periods = check_positive_int(max_periods, 'max_periods', minimum=0)
-    warmup = check_positive_int(warmup, 'warmup', minimum=0)
-    npoints = check_positive_int(npoints, 'npoints', minimum=2)
+    tol, max_iter, max_periods, warmup, npoints = _shooting_options(
+        tol, max_iter, max_periods, warmup, npoints)
     _check_periodicity(hp, period, x0, u0, params)
-
-    def flow(x, mode, variational, options=opts):
-        return _Flow(hp, 0.0, period, x, mode, lambda t: u0, params,
-                     variational=variational, **options)
-
-    def relres(x, xT):
-        return np.max(np.abs(xT - x)) / (1 + np.max(np.abs(x)))
-
-    # forward simulation only supplies starting guesses: moderate tolerances
-    loose = dict(opts, rtol=max(opts['rtol'], 1e-8), atol=max(opts['atol'], 1e-10))
-
-    def simulate(x, mode, nper):
-        res = np.inf
-        for _ in range(nper):
-            fl = flow(x, mode, False, loose)
-            res = relres(x, fl.x_final) if fl.mode_final == mode else np.inf
-            x, mode = fl.x_final, fl.mode_final
-        return x, mode, res
-
+    shooter = _PeriodShooter(hp, period, u0, params, opts)
     tried = []
     x, mode, periods = x0.copy(), mode0, warmup
     if warmup:
-        x, mode, res = simulate(x, mode, warmup)
+        x, mode, res = shooter.simulate(x, mode, warmup)
         tried.append(f"warm-up simulation to t={warmup}T: residual {res:.3g}")
     sim_x, sim_mode = x, mode
     while True:
-        # Newton on P(x) − x = 0: (∂P/∂x − I) δ = −(P(x) − x)
-        last, stalled = np.inf, 0
-        for it in range(max_iter + 1):
-            fl = flow(x, mode, True)
-            if fl.mode_final != mode:
-                tried.append(f"Newton from t={periods}T: the period ends in mode "
-                             f"{hp.mode_names[fl.mode_final]!r}, not {hp.mode_names[mode]!r}")
-                break
-            res = relres(x, fl.x_final)
-            if res <= tol:
-                return _finish(hp, period, fl, x, mode, npoints, params, u0, res, it, periods)
-            stalled = stalled + 1 if res > 0.9 * last else 0
-            if res > 1e3 * last or stalled >= 3 or it == max_iter:
-                tried.append(f"Newton from t={periods}T: residual {res:.3g} after {it} "
-                             "iterations" + (" (no progress)" if stalled >= 3 else ""))
-                break
-            last = res
-            # least squares handles neutral directions (multipliers equal to 1)
-            step, _, rank, _ = np.linalg.lstsq(fl.phi - np.eye(hp.nstates), x - fl.x_final,
-                                               rcond=None)
-            if rank == 0:
-                tried.append(f"Newton from t={periods}T: the period map is the identity "
-                             "to first order (all multipliers 1)")
-                break
-            if np.max(np.abs(step)) > 10 * (1 + np.max(np.abs(x))):
-                tried.append(f"Newton from t={periods}T: step of size "
-                             f"{np.max(np.abs(step)):.3g} rejected (divergence)")
-                break
-            x = x + step
+        found = shooter.newton(x, mode, tol, max_iter, f"Newton from t={periods}T", tried)
+        if found is not None:
+            fl, x, res, iterations = found
+            return _finish(hp, period, fl, x, mode, npoints, params, u0, res, iterations,
+                           periods)
         if periods >= warmup + max_periods:
             break
         # fall back to forward simulation towards an attracting orbit
         nper = min(10, warmup + max_periods - periods)
-        sim_x, sim_mode, res = simulate(sim_x, sim_mode, nper)
+        sim_x, sim_mode, res = shooter.simulate(sim_x, sim_mode, nper)
         x, mode, periods = sim_x, sim_mode, periods + nper
         tried.append(f"forward simulation to t={periods}T: residual {res:.3g}")
     raise RuntimeError("periodic_orbit did not converge to a T-periodic orbit "
@@ -375,6 +385,77 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
                        ". The response may be unbounded, quasi-periodic, chaotic or periodic "
                        "with a multiple of the period; try another x0, a warm-up or a larger "
                        "max_periods.")
+
+
+def _shooting_options(tol, max_iter, max_periods, warmup, npoints):
+    """Validated Newton tolerance and iteration, period and grid counts."""
+    if isinstance(tol, bool) or not isinstance(tol, numbers.Real) or not 0 < tol < 1:
+        raise ValueError(f"tol must be a number in (0, 1), got {tol!r}")
+    return (tol, check_positive_int(max_iter, 'max_iter'),
+            check_positive_int(max_periods, 'max_periods', minimum=0),
+            check_positive_int(warmup, 'warmup', minimum=0),
+            check_positive_int(npoints, 'npoints', minimum=2))
+
+
+def _relres(x, xT):
+    """Relative residual ``‖x(T) − x‖∞ / (1 + ‖x‖∞)``."""
+    return np.max(np.abs(xT - x)) / (1 + np.max(np.abs(x)))
+
+
+class _PeriodShooter:
+    """Period map of a forced plant, its Newton iteration and forward simulation."""
+
+    def __init__(self, hp, period, u0, params, opts):
+        self.hp, self.period, self.u0, self.params, self.opts = hp, period, u0, params, opts
+        # forward simulation only supplies starting guesses: moderate tolerances
+        self.loose = dict(opts, rtol=max(opts['rtol'], 1e-8), atol=max(opts['atol'], 1e-10))
+
+    def flow(self, x, mode, variational, options=None):
+        u0 = self.u0
+        return _Flow(self.hp, 0.0, self.period, x, mode, lambda t: u0, self.params,
+                     variational=variational, **(options or self.opts))
+
+    def simulate(self, x, mode, nper):
+        """State, mode and last-period residual after `nper` simulated periods."""
+        res = np.inf
+        for _ in range(nper):
+            fl = self.flow(x, mode, False, self.loose)
+            res = _relres(x, fl.x_final) if fl.mode_final == mode else np.inf
+            x, mode = fl.x_final, fl.mode_final
+        return x, mode, res
+
+    def newton(self, x, mode, tol, max_iter, where, tried):
+        """Newton on ``P(x) − x = 0``: (flow, x, residual, iterations) or None."""
+        names, n = self.hp.mode_names, self.hp.nstates
+        last, stalled = np.inf, 0
+        for it in range(max_iter + 1):
+            fl = self.flow(x, mode, True)
+            if fl.mode_final != mode:
+                tried.append(f"{where}: the period ends in mode {names[fl.mode_final]!r}, "
+                             f"not {names[mode]!r}")
+                return None
+            res = _relres(x, fl.x_final)
+            if res <= tol:
+                return fl, x, res, it
+            stalled = stalled + 1 if res > 0.9 * last else 0
+            if res > 1e3 * last or stalled >= 3 or it == max_iter:
+                tried.append(f"{where}: residual {res:.3g} after {it} iterations"
+                             + (" (no progress)" if stalled >= 3 else ""))
+                return None
+            last = res
+            # (∂P/∂x − I) δ = −(P(x) − x); least squares handles neutral
+            # directions (multipliers equal to 1)
+            step, _, rank, _ = np.linalg.lstsq(fl.phi - np.eye(n), x - fl.x_final, rcond=None)
+            if rank == 0:
+                tried.append(f"{where}: the period map is the identity to first order "
+                             "(all multipliers 1)")
+                return None
+            if np.max(np.abs(step)) > 10 * (1 + np.max(np.abs(x))):
+                tried.append(f"{where}: step of size {np.max(np.abs(step)):.3g} rejected "
+                             "(divergence)")
+                return None
+            x = x + step
+        return None  # pragma: no cover - the loop always returns
 
 
 def _finish(hp, period, fl, x, mode, npoints, params, u0, res, iterations, periods):

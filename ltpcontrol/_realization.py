@@ -40,7 +40,8 @@ The realization is read from the transformed model: ``A_F = Re Ā``,
 ``B_l``, ``C_l``, ``D_l`` the diagonal averages, ``B[k] = Σ_l B_l w^{lk}``.
 
 Method 'direct' finds T without search.  The eigenvalues of Â are the
-ladders ``μ_i w^{-n}`` (thesis eq. 4.91); in the modal coordinates
+ladders ``μ_i w^{-n}`` (thesis eq. 4.91), found by optimal matching of
+the eigenvalues to the ideal ladders of candidate centres (`_ladders`); in the modal coordinates
 ``q = Ŵ^{-1} x̂`` the identified output matrix is ``Ĉ_{r,(n,i)} = d_{n,i}
 γ_{r-n,i}`` (``γ_{l,i} = C_l W_i``) with unknown eigenvector scales, so
 consecutive ratios follow from ``Ĉ_{r+1,(n+1,i)} = (d_{n+1,i}/d_{n,i})
@@ -104,8 +105,10 @@ class FloquetRealization:
     nfev : int
         Number of distance evaluations (0 for 'direct').
     ladder_mismatch : float or None
-        'direct' only: largest ``|λ w^{-1} - λ'|`` between neighbouring
-        ladder members, relative to the ladder step ``2|λ| sin(π/N)``.
+        'direct' only: largest distance of a ladder member from its ideal
+        place ``μ w^{-n}``, in ladder steps ``2|μ| sin(π/N)``, weighted by
+        the member's contribution to the response relative to the largest
+        of its ladder (weakly excited outer members count little).
 
     Examples
     --------
@@ -175,8 +178,9 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
         Success threshold on the relative mismatch between the lifted model
         of the realization and `sys` (default 0.05).
     ladder_tol : float
-        'direct' only: largest accepted ladder mismatch relative to the
-        ladder step (default 0.1; a spectrum without ladders gives O(1)).
+        'direct' only: largest weighted ladder mismatch (`FloquetRealization`)
+        for `success` (default 0.1; a spectrum without ladders gives O(1)).
+        A larger mismatch still gives a realization, flagged unsuccessful.
     seed : int, optional
         Seed of the swarm ('pso'); the global NumPy random state used by
         pyswarms is restored afterwards.
@@ -198,7 +202,10 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
     -------
     FloquetRealization
         Its ``success`` flag must be checked: a search may end in a local
-        minimum, and 'direct' reports missing ladders as a failure.
+        minimum, and 'direct' flags imperfect ladders.  ``sys`` is None
+        only when no realization can be formed: repeated eigenvalues, or
+        eigenvalues that cannot be grouped into ``nstates`` conjugate-closed
+        ladders ('direct'), or a singular similarity ('pso').
 
     Raises
     ------
@@ -258,7 +265,7 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
     if method == 'direct':
         if pso_options is not None or minimize_options is not None:
             raise ValueError("pso_options and minimize_options only apply to method='pso'")
-        T, mismatch, message = _direct_transform(problem, ladder_tol)
+        T, mismatch, message = _direct_transform(problem)
     else:
         pso = _options(pso_options, 'pso_options', _pso_defaults(problem))
         nm = _options(minimize_options, 'minimize_options', _nm_defaults(problem))
@@ -276,6 +283,9 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
     success = d_corr <= tol and fit <= fit_tol
     summary = (f"corrected distance {d_corr:.3g} (tol {tol:g}), "
                f"fit error {fit:.3g} (fit_tol {fit_tol:g})")
+    if method == 'direct':
+        success = success and mismatch <= ladder_tol
+        summary += f", ladder mismatch {mismatch:.3g} (ladder_tol {ladder_tol:g})"
     if success:
         message = "Floquet structure reached: " + summary
     else:
@@ -469,7 +479,7 @@ def _frequency_response(A, B, C, D, z):
 # Method 'direct': eigenvalue ladders
 #
 
-def _direct_transform(problem, ladder_tol):
+def _direct_transform(problem):
     """Similarity T from the eigenvalue ladders, or (None, mismatch, reason)."""
     H, K, nx, N = problem.H, problem.K, problem.nx, problem.N
     lam, W = np.linalg.eig(problem.A)
@@ -478,16 +488,6 @@ def _direct_transform(problem, ladder_tol):
     if gaps.min() <= 1e-10 * scale:
         return None, None, ("the lifted A has repeated eigenvalues; the direct method "
                             "needs distinct Floquet exponents (try method='pso')")
-    chains, mismatch = _ladders(lam, nx, H, N)
-    if chains is None or mismatch > ladder_tol:
-        return None, mismatch, (
-            "the eigenvalues of the lifted A do not form ladders μ w^{-n}, n = -K..K "
-            f"(relative mismatch {mismatch:.3g} > ladder_tol {ladder_tol:g}); the model is "
-            "not a lifted Floquet-form LTP of this N and K")
-    partner = _conjugate_ladders(lam, chains)
-    if partner is None:
-        return None, mismatch, ("the ladders of the lifted A do not come in complex-conjugate "
-                                "pairs, so no real Floquet realization exists")
     if np.linalg.cond(W) > 1e8:
         warnings.warn("the eigenvectors of the lifted A are ill-conditioned "
                       f"(cond {np.linalg.cond(W):.2g}); the realization may be inaccurate",
@@ -495,9 +495,14 @@ def _direct_transform(problem, ladder_tol):
     Cc = problem.Vy @ problem.C                            # complex output harmonics
     Bc = problem.B @ problem.Vu.conj().T                   # complex input harmonics
     Winv = np.linalg.inv(W)
-    # balance eigenvector scales: ‖Ĉ_mod column‖ = ‖B̂_mod row‖
+    # contribution of each mode to the response: ‖Ĉ w_a‖ ‖(W^{-1} B̂)_a‖ (scale free)
     cn = np.linalg.norm(Cc @ W, axis=0)
     bn = np.linalg.norm(Winv @ Bc, axis=1)
+    chains, partner, mismatch = _ladders(lam, cn * bn, nx, H, N)
+    if chains is None:
+        return None, None, mismatch + ("; the model is not a lifted Floquet-form LTP of "
+                                       "this N and K")
+    # balance eigenvector scales: ‖Ĉ_mod column‖ = ‖B̂_mod row‖
     s = np.sqrt(np.where((cn > 0) & (bn > 0), bn / np.where(cn > 0, cn, 1), 1.0))
     W, Winv = W * s, Winv / s[:, None]
     Wnew = np.zeros((H * nx, H * nx), complex)        # columns (n, i), harmonic-major
@@ -533,74 +538,102 @@ def _direct_transform(problem, ladder_tol):
     return T.real, mismatch, ''
 
 
-def _ladders(lam, nx, H, N):
-    """Chains of ``H`` eigenvalues with ratio ``w^{-1}``, ordered n = -K..K.
+def _ladders(lam, weight, nx, H, N):
+    """Ladders of ``H`` eigenvalues ``μ w^{-n}``, n = -K..K, by optimal matching.
 
-    With all N harmonics (H = N) every ladder closes into a cycle and any
-    member may serve as the centre ``μ`` (``μ w^q`` gives an equivalent
-    realization); the member closest to the real axis is taken, which keeps
-    conjugate ladders conjugate.
+    Returns ``(chains (nx, H), partner (nx,), mismatch)`` or ``(None, None,
+    reason)``.  Ladders are formed one centre (or conjugate pair of
+    centres) at a time: every unassigned eigenvalue is tried as centre μ,
+    the ideal members ``μ w^{-n}`` are matched to the unassigned
+    eigenvalues by `linear_sum_assignment` on their distance relative to
+    the ladder step ``2|μ| sin(π/N)``, and the centre whose ladder matches
+    best (distances capped at one step, ties to the member closest to the
+    real axis, then to the largest `weight`) is kept.  A real centre takes
+    conjugate members ``n, -n``; a complex one brings the conjugate ladder
+    along, so the ladders always form a real realization.  The mismatch
+    of a member is weighted by its `weight` (contribution to the response)
+    relative to the largest of its ladder: weakly excited outer members,
+    which absorb the truncation error, count little.
     """
-    n = len(lam)
+    n, K = len(lam), (H - 1) // 2
     if H == 1:                                  # K = 0: every eigenvalue is a ladder
-        return np.arange(n)[:, np.newaxis], 0.0
+        chains = np.arange(n)[:, np.newaxis]
+        return chains, _conjugates(lam)[chains[:, 0]], 0.0
+    conj = _conjugates(lam)
     w = np.exp(2j * np.pi / N)
-    step = np.maximum(np.abs(lam), np.finfo(float).tiny) * 2 * np.sin(np.pi / N)
-    # link a -> b when λ_b ≈ λ_a w^{-1}; unless ladders are cycles (H = N),
-    # rows may instead take one of nx free ends
-    rel = np.abs(lam[:, None] / w - lam[None, :]) / step[:, None]
-    ends = 0 if H == N else nx
-    cost = np.concatenate([1.0 + rel, np.zeros((n, ends))], axis=1)
-    np.fill_diagonal(cost[:, :n], np.inf)
-    rows, cols = linear_sum_assignment(cost)
-    succ = np.full(n, -1)
-    links = cols < n
-    succ[rows[links]] = cols[links]
-    mismatch = float(rel[rows[links], cols[links]].max()) if links.any() else 0.0
-    if H == N:
-        heads, seen = [], np.zeros(n, bool)
-        for a in range(n):                      # one entry point per cycle
-            if not seen[a]:
-                heads.append(a)
-                b = a
-                while not seen[b]:
-                    seen[b] = True
-                    b = succ[b]
-    else:
-        heads = np.setdiff1d(np.arange(n), succ[succ >= 0])
-    chains = []
-    for h in heads:
-        chain = [h]
-        while succ[chain[-1]] >= 0 and succ[chain[-1]] != h and len(chain) <= H:
-            chain.append(succ[chain[-1]])
-        chains.append(chain)
-    if len(chains) != nx or any(len(c) != H for c in chains):
-        return None, max(mismatch, 1.0)
-    chains = np.array(chains)
-    if H == N:
-        # rotate each cycle so that its centre (position K) is the member closest
-        # to the real axis, ties to the larger real part: conjugate cycles then
-        # get conjugate centres and a real μ stays real
-        K = (H - 1) // 2
-        L = lam[chains]
-        off_axis = np.round(np.abs(L.imag) / np.abs(L), 8)
-        score = np.where(off_axis == off_axis.min(axis=1, keepdims=True), -L.real, np.inf)
-        shift = np.argmin(score, axis=1) - K
-        chains = np.array([np.roll(c, -r) for c, r in zip(chains, shift)])
-    return chains, mismatch
+    shifts = w ** -np.arange(-K, K + 1)
+    step = 2 * np.sin(np.pi / N)                    # ladder step relative to |μ|
+    tiny = np.finfo(float).tiny
+    free = np.ones(n, bool)
+    chains, partner, mismatch = [], [], 0.0
+    while free.any():
+        cand = np.flatnonzero(free)
+        best = None
+        for a in cand:
+            real = conj[a] == a
+            if not real and not free[conj[a]]:
+                continue
+            slots, rel = _match(lam, free, lam[a] * shifts, a, conj, real, step * abs(lam[a]))
+            if slots is None:
+                continue
+            score = np.minimum(rel, 1.0).sum()
+            key = (round(score, 3), round(abs(lam[a].imag) / max(abs(lam[a]), tiny), 8),
+                   -weight[a])
+            if best is None or key < best[0]:
+                best = (key, a, slots, rel)
+        if best is None:
+            return None, None, "the eigenvalues of the lifted A cannot be grouped into ladders"
+        _, a, slots, rel = best
+        chain = slots
+        free[chain] = False
+        w_rel = weight[chain] / max(weight[chain].max(), tiny)
+        mismatch = max(mismatch, float(np.max(rel * w_rel)))
+        if conj[a] == a:
+            chains.append(chain)
+            partner.append(len(chains) - 1)
+        else:
+            mate = conj[chain[::-1]]
+            free[mate] = False
+            chains += [chain, mate]
+            partner += [len(chains) - 1, len(chains) - 2]
+    if len(chains) != nx:
+        return None, None, (f"the eigenvalues form {len(chains)} ladders, not nstates = {nx}")
+    return np.array(chains), np.array(partner), mismatch
 
 
-def _conjugate_ladders(lam, chains):
-    """Index of the conjugate ladder of each ladder, or None."""
-    L = lam[chains]                                         # (nx, H)
-    # ladder j is the conjugate of ladder i when λ_{n,j} = conj(λ_{-n,i})
-    cost = np.abs(L[None, :, :] - L[:, None, ::-1].conj()).max(axis=2)
-    rows, cols = linear_sum_assignment(cost)
-    scale = np.abs(L).max()
-    partner = cols[np.argsort(rows)]
-    if np.any(cost[rows, cols] > 1e-6 * scale) or np.any(partner[partner] != np.arange(len(L))):
-        return None
-    return partner
+def _match(lam, free, targets, centre, conj, real, step):
+    """Unassigned eigenvalues nearest to the ideal ladder `targets` (centre fixed).
+
+    Members are drawn from conjugate classes ``{λ, conj λ}`` of unassigned
+    complex eigenvalues, one member per class, so that the ladder and its
+    conjugate (for a real centre: members n and -n) never share an
+    eigenvalue.  Returns ``(indices (H,), distances in ladder steps (H,))``
+    or ``(None, None)``.
+    """
+    H = len(targets)
+    K = (H - 1) // 2
+    pool = np.flatnonzero(free & (lam.imag > 0) & free[conj])
+    pool = pool[(pool != centre) & (pool != conj[centre])]
+    rows = np.arange(K + 1, H) if real else np.r_[0:K, K + 1:H]
+    if len(pool) < len(rows):
+        return None, None
+    # slot cost: the nearer orientation λ or conj λ of each class
+    up = np.abs(targets[rows][:, None] - lam[pool][None, :])
+    down = np.abs(targets[rows][:, None] - lam[pool][None, :].conj())
+    r, c = linear_sum_assignment(np.minimum(up, down))
+    idx = np.empty(H, int)
+    idx[K] = centre
+    idx[rows[r]] = np.where(up[r, c] <= down[r, c], pool[c], conj[pool[c]])
+    if real:
+        idx[:K] = conj[idx[K + 1:]][::-1]
+    return idx, np.abs(lam[idx] - targets) / step
+
+
+def _conjugates(lam):
+    """Index of the complex conjugate of every eigenvalue (itself when real)."""
+    cost = np.abs(lam[:, None] - lam[None, :].conj())
+    _, cols = linear_sum_assignment(cost)
+    return cols
 
 
 def _chain_scales(problem, V, Y):

@@ -113,6 +113,8 @@ KWARG_CALLS = {
     'fdsubspace': lambda **kw: ltp.fdsubspace(1 / (1j * OMEGA + 1), OMEGA, 1, **kw),
     'hybrid_ls': lambda **kw: ltp.hybrid_ls(T_LS, np.sin(6 * np.pi * T_LS),
                                             np.cos(6 * np.pi * T_LS), T, [0.0], 0, **kw),
+    'refine_ltp': lambda **kw: ltp.refine_ltp(
+        ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=T), H_DATA, **kw),
     # public methods with **kwargs
     'LTPStateSpace.to_ss': lambda **kw: ltp.ltpss(ct.rss(1, 1, 1), T).to_ss(**kw),
     'LTPStateSpace.linearize': lambda **kw: SYS.linearize(0.1, **kw),
@@ -124,7 +126,21 @@ KWARG_CALLS = {
     'LTPStateSpace.htf': lambda **kw: SYS.htf(1, **kw),
     'LTPStateSpace.sample': lambda **kw: SYS.sample(0.1, **kw),
     'HTF.plot': lambda **kw: H.plot(omega_num=5, **kw),
+    'compare_ltp': lambda **kw: ltp.compare_ltp(SYS, SYS, [1.0], **kw),
+    'select_structure': lambda **kw: ltp.select_structure(ltp.lifted_frequency_response(
+        _SINE_RESPONSE, 0.5, 1, transient=6.0), 0.5, [1], [0], **kw),
 }
+
+# autonomous plants: limit cycles, return maps, continuation
+_OSC = ct.nlsys(lambda t, x, u, p: [p['a'] * x[0] * (1 - x[0] ** 2 - x[1] ** 2) - x[1],
+                                    p['a'] * x[1] * (1 - x[0] ** 2 - x[1] ** 2) + x[0]],
+                None, states=2, inputs=0, params={'a': 0.5}, name='oscillator')
+KWARG_CALLS.update({
+    'limit_cycle': lambda **kw: ltp.limit_cycle(_OSC, 6.3, [1.0, 0.0], npoints=4, **kw),
+    'poincare_map': lambda **kw: ltp.poincare_map(_OSC, [1.0, 0.0], **kw),
+    'orbit_continuation': lambda **kw: ltp.orbit_continuation(
+        ltp.limit_cycle(_OSC, 6.3, [1.0, 0.0], npoints=4), 'a', [0.5], **kw),
+})
 
 # plotting functions hand **kwargs to matplotlib, whose error is AttributeError
 _MATPLOTLIB_KWARGS = {'bode_htf', 'HTF.plot'}
@@ -185,7 +201,11 @@ def test_unknown_keyword_is_rejected(name):
 
 # result containers document their fields under Attributes, not Parameters
 _RESULT_CLASSES = {'Excitation', 'HTFFit', 'DelayEstimate', 'FDSubspaceInfo',
-                   'PeriodicOrbit', 'FloquetRealization', 'MatrixErrors', 'LTPSubspaceInfo'}
+                   'PeriodicOrbit', 'FloquetRealization', 'MatrixErrors', 'LTPSubspaceInfo',
+                   'LTPComparison', 'StructureSelection'}
+_RESULT_CLASSES |= {'OrbitBranch', 'Bifurcation'}
+_RESULT_CLASSES |= {'LMIDesign'}
+_RESULT_CLASSES |= {'RefineInfo', 'MonteCarloResult'}
 
 DOC_DEFECTS = {}
 
@@ -331,7 +351,7 @@ def _representative_slice():
     ltp.simulate_hybrid(BALL, np.linspace(0, 0.6, 61), [1.0, 0.0])
     orbit = ltp.periodic_orbit(FORCED, T, [0.0], npoints=16)
     ltp.linearize_orbit(FORCED, orbit)
-    exc = ltp.chirp_replicas(T, 3, 8.0, 0.1, 20.0, dt=0.01)
+    exc = ltp.chirp_replicas(T, 6, 8.0, 0.1, 20.0, dt=0.01)
     y = (1 + np.cos(2 * np.pi * exc.time)) * exc.inputs
     est = ltp.estimate_htf((exc.time, exc.inputs, y), T, 1, segments=exc.segments)
     ltp.fit_htf(_model, est, [1.0], harmonics=[0])

@@ -15,6 +15,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 WORKLOADS = ['P1a', 'P1b', 'P2a', 'P2b', 'P3', 'P4a', 'P4b', 'P5a', 'P5b', 'P5c',
              'P6a', 'P6b', 'P6c',
              'P8a', 'P8b']
+WORKLOADS += ['P7-4']
 
 
 @pytest.fixture(scope='module')

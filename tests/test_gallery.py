@@ -61,3 +61,14 @@ def test_mathieu_gallery_prediction_agrees():
     rel = [float(line.rsplit(' ', 1)[1]) for line in buf.getvalue().splitlines()
            if 'relative difference' in line]
     assert len(rel) == 3 and max(rel) < 1e-8
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("script, figure", [
+    ('plot_van_der_pol_orbit.py', 'van_der_pol_orbit.png'),
+    ('plot_clockfree_hopper.py', 'clockfree_hopper_branch.png'),
+    ('plot_slip_running.py', 'slip_running.png'),
+    ('plot_orbit_bifurcations.py', 'orbit_period_doubling.png'),
+])
+def test_orbit_gallery_script_runs(script, figure, tmp_path, monkeypatch, capsys):
+    test_gallery_script_runs(script, figure, tmp_path, monkeypatch, capsys)

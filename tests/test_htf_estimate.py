@@ -8,6 +8,8 @@ the truncated harmonic-balance formula ``C_T [sI - (A_T - N)]⁻¹ B_T`` with
 K = 20 (central block row, ``G_k = H_{0,-k}``).
 """
 
+import warnings
+
 import numpy as np
 import pytest
 from control.exception import ControlArgument, ControlDimension
@@ -422,3 +424,75 @@ def test_metrics():
         nrmse(y, y[:-1])
     with pytest.raises(ValueError, match="y "):
         nrmse(np.zeros(5), np.ones(5))
+
+
+# ---------------------------------------------------------------- calibration
+@pytest.fixture(scope="module")
+def ten_replicas():
+    """Ten phase-shifted chirp replicas (0-4 Hz, 10 s, 8 s gaps) of the default plant."""
+    system = ScalarLTP()
+    exc = chirp_replicas(1.0, 10, 10.0, 0.0, 4.0, dt=0.01, gap=8.0)
+    return system, exc, system.simulate(exc.signal, exc.time)[0]
+
+
+def test_unmodelled_harmonics_are_detected(ten_replicas):
+    # a(t) is periodic: G_k decays with |k| but never vanishes.  With K = 1 the
+    # residual holds G_{±2}: the noise variance is inflated many times.
+    system, exc, y = ten_replicas
+    noisy = y + 0.01 * np.random.default_rng(3).standard_normal(y.size)
+    with pytest.warns(UserWarning, match=r"unmodelled harmonics: the inputs shifted by "
+                                         r"±2ω_p .*\|k\| > 1"):
+        H = estimate_htf((exc.time, exc.inputs, noisy), 1.0, 1, segments=exc.segments)
+    test = H.diagnostics["harmonic_test"]
+    assert test["pvalue"] < 1e-6 and test["variance_ratio"] > 3
+    # the std it reports are indeed too large: errors are far below them
+    z = np.abs(H.components()[1] - system.htf(H.omega, 1)) / H.std
+    assert np.mean(z < 1) > 0.9
+
+
+def test_two_sigma_coverage_when_k_is_large_enough(ten_replicas):
+    system, exc, y = ten_replicas
+    z = []
+    for seed in range(6):
+        noisy = y + 0.03 * np.random.default_rng(seed).standard_normal(y.size)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")       # K = 3 passes the harmonic test
+            H = estimate_htf((exc.time, exc.inputs, noisy), 1.0, 3, segments=exc.segments)
+        assert H.diagnostics["harmonic_test"]["pvalue"] > 1e-3
+        z.append(np.abs(H.components()[1] - system.htf(H.omega, 3)) / H.std)
+    z = np.concatenate([zi.ravel() for zi in z])
+    # complex Gaussian errors: P(|e| < 2σ) = 1 - e^{-4} = 0.982
+    assert 0.9 < np.mean(z < 2) < 0.99
+    assert np.mean(z ** 2) == pytest.approx(1, abs=0.1)
+
+
+@pytest.mark.parametrize("nreplicas, nharmonics", [(3, 1), (6, 2)])
+def test_minimum_replicas_warn_about_aliasing(nreplicas, nharmonics):
+    # G_{K+1} aliases into G_{K+1-R} with R phase-shifted replicas; harmonics beyond K
+    # are large here (a1 = 2), and too few windows are left to detect them
+    system = ScalarLTP(a1=2.0)
+    exc = chirp_replicas(1.0, nreplicas, 10.0, 0.0, 4.0, dt=0.01, gap=8.0)
+    y = system.simulate(exc.signal, exc.time)[0]
+    K = nharmonics
+    with pytest.warns(UserWarning, match=rf"G_{K + 1} into G_{K + 1 - nreplicas}"):
+        H = estimate_htf((exc.time, exc.inputs, y), 1.0, K, segments=exc.segments)
+    err = np.abs(H.components()[1] - system.htf(H.omega, K))
+    rel = np.max(err, axis=-1) / np.max(np.abs(system.htf(H.omega, K)), axis=-1)
+    assert rel.max() > 0.05                  # the warning is not a false alarm
+
+
+def test_enough_replicas_keep_errors_small_or_warn():
+    # default-style design with 2(2K+1) + 1 replicas on a plant with harmonics beyond K
+    system = ScalarLTP(a1=2.0)
+    for K in (1, 2):
+        exc = chirp_replicas(1.0, 2 * (2 * K + 1) + 1, 10.0, 0.0, 4.0, dt=0.01, gap=8.0)
+        y = system.simulate(exc.signal, exc.time)[0]
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            H = estimate_htf((exc.time, exc.inputs, y), 1.0, K, segments=exc.segments)
+        true = system.htf(H.omega, K)
+        rel = np.max(np.abs(H.components()[1] - true), axis=-1) / np.max(np.abs(true),
+                                                                        axis=-1)
+        warned = any(f"±{K + 1}ω_p" in str(w.message) for w in caught)
+        assert rel.max() <= 0.05 or warned
+        assert warned                            # harmonics beyond K are reported

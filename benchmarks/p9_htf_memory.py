@@ -1,4 +1,4 @@
-"""P7: memory and time of HTF evaluation for larger plants.
+"""P9: memory and time of HTF evaluation for larger plants.
 
 Workload: seeded random plants with a time-varying ``A(t) = A_0 + A_1 cos ω_p t``
 (no Floquet structure to exploit), one input, one output, evaluated on a
@@ -6,23 +6,23 @@ grid of frequencies.  ``ltp.htf`` chooses its internal truncation (``K_i =
 K + 10`` plus a convergence check at ``K_i + 8``), so the harmonic state
 space has ``(2K_i + 1) n`` states: 820 for n = 20, K = 10.
 
-* P7a: ``ltp.htf(sys, 10)`` and ``H(jω)`` (method 'auto') on 1000
+* P9a: ``ltp.htf(sys, 10)`` and ``H(jω)`` (method 'auto') on 1000
   frequencies, n = 20, against the same request with ``method='modal'``;
   target: within 2x of the modal time with peak memory <= 1.5 GB.
-* P7b: ``ltp.bode_htf`` of all 21 components on the same grid, against the
+* P9b: ``ltp.bode_htf`` of all 21 components on the same grid, against the
   modal evaluation of the full HTF; same targets.
-* P7c: the dense path (``method='solve'``) on the same request: it must be
+* P9c: the dense path (``method='solve'``) on the same request: it must be
   chunked, not refused, with peak memory <= 1.5 GB (default budget
   ``ltp.config.defaults['htf.max_memory'] = 1 GB``).  It is timed on every
   10th frequency and extrapolated.
-* P7d: ``htf`` + evaluation on 200 frequencies for n = 4, 20, 50 and
+* P9d: ``htf`` + evaluation on 200 frequencies for n = 4, 20, 50 and
   K = 5, 10, 20 ('auto'); a request whose harmonic state space cannot fit
   the budget is refused with its estimated size (reported as such).
 
-P7a-c run each in a fresh subprocess, which reports its CPU time, the
+P9a-c run each in a fresh subprocess, which reports its CPU time, the
 peak of `tracemalloc` (NumPy buffers; LAPACK workspace is not traced) and
 the growth of the peak resident-set size (``ru_maxrss``) during the work.
-The grid P7d (and ``--quick``) runs in this process and reports the
+The grid P9d (and ``--quick``) runs in this process and reports the
 `tracemalloc` peak only.
 Accuracy: the largest relative deviation from the other evaluation path
 (dense resolvent solves for the modal results, the modal form for the
@@ -47,15 +47,15 @@ def run(quick=False, log=print):
     cfg = QUICK if quick else FULL
     n, K, npts = cfg['n'], cfg['K'], cfg['npoints']
     work = f"HTF n={n} K={K}, {npts} freqs"
-    log(f"P7: {work}: auto, modal, bode_htf, solve")
+    log(f"P9: {work}: auto, modal, bode_htf, solve")
     fresh = not quick
     auto = _measure('htf', n, K, npts, 'auto', fresh=fresh)
     modal = _measure('htf', n, K, npts, 'modal', fresh=fresh)
     bode = _measure('bode', n, K, npts, 'auto', fresh=fresh)
     solve = _measure('htf', n, K, npts, 'solve', stride=cfg['stride'], fresh=fresh)
     rows = []
-    for rid, res, ours in (('P7a', auto, "ltp.htf 'auto' + H(jω)"),
-                           ('P7b', bode, 'ltp.bode_htf, all 2K+1 components')):
+    for rid, res, ours in (('P9a', auto, "ltp.htf 'auto' + H(jω)"),
+                           ('P9b', bode, 'ltp.bode_htf, all 2K+1 components')):
         ratio = res['time'] / modal['time']
         rows.append(row(
             rid, work, ours=ours, peer="ltp.htf method='modal' + H(jω)",
@@ -66,7 +66,7 @@ def run(quick=False, log=print):
                     'peak memory <= 1.5 GB': _peak(res) <= LIMIT},
             notes=_mem_note(res), extra=dict(ours=res, peer=modal)))
     rows.append(row(
-        'P7c', work, ours="ltp.htf method='solve' (dense, chunked)", t_ours=solve['time'],
+        'P9c', work, ours="ltp.htf method='solve' (dense, chunked)", t_ours=solve['time'],
         metric='peak GB', value=_peak(solve) / 1e9, target='chunked, <= 1.5 GB',
         target_met=_peak(solve) <= LIMIT and solve['chunks'] > 1, err_ours=solve['err'],
         tol=TOL, checks={'not refused': solve['status'] == 'ok',
@@ -75,18 +75,18 @@ def run(quick=False, log=print):
         f"{cfg['stride']}th frequency, extrapolated", extra=solve))
     for nn in cfg['grid_n']:
         for KK in cfg['grid_K']:
-            log(f"P7d: n={nn} K={KK}")
+            log(f"P9d: n={nn} K={KK}")
             res = _measure('htf', nn, KK, cfg['grid_points'], 'auto', fresh=False)
             wl = f"HTF n={nn} K={KK}, {cfg['grid_points']} freqs"
             if res['status'] != 'ok':
-                rows.append(row(f"P7d n{nn} K{KK}", wl, ours="ltp.htf 'auto'",
+                rows.append(row(f"P9d n{nn} K{KK}", wl, ours="ltp.htf 'auto'",
                                 metric='refused', value=res['estimate'] / 1e9,
                                 target='fits or refused', target_met=True,
                                 checks={'refusal names the size': 'GB' in res['status']},
                                 notes=res['status'], extra=res))
                 continue
             rows.append(row(
-                f"P7d n{nn} K{KK}", wl, ours="ltp.htf 'auto'", t_ours=res['time'],
+                f"P9d n{nn} K{KK}", wl, ours="ltp.htf 'auto'", t_ours=res['time'],
                 metric='traced GB', value=res['traced'] / 1e9, target='<= 1.5 GB',
                 target_met=res['traced'] <= LIMIT, err_ours=res['err'], tol=TOL,
                 checks={'ours <= tol': res['err'] <= TOL}, notes=_mem_note(res), extra=res))
@@ -111,7 +111,7 @@ def _measure(kind, n, K, npoints, method, stride=1, fresh=True):
             method, str(stride)]
     proc = subprocess.run(args, capture_output=True, text=True, timeout=1800)
     if proc.returncode != 0:
-        raise RuntimeError(f"P7 case {args[2:]} failed:\n{proc.stderr[-3000:]}")
+        raise RuntimeError(f"P9 case {args[2:]} failed:\n{proc.stderr[-3000:]}")
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 

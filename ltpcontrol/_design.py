@@ -1,0 +1,325 @@
+"""Periodic LQR, Kalman filters and LQG controllers.
+
+The gains come from the stabilizing periodic Riccati solutions of
+`ltpcontrol._riccati`.  LQR: ``K = R⁻¹(BᵀX + Nᵀ)`` (continuous),
+``K_k = (R_k + B_kᵀX_{k+1}B_k)⁻¹(B_kᵀX_{k+1}A_k + N_kᵀ)`` (discrete).
+
+Kalman filters by duality.  Continuous time: the filter Riccati equation
+``Ṗ = AP + PAᵀ - (PCᵀ + GN) R⁻¹ (CPᵀ + NᵀGᵀ) + GQGᵀ`` runs forward; with
+``τ = -t`` it is the control equation of the time-reversed, transposed
+plant ``Ã(τ) = A(-τ)ᵀ, B̃(τ) = C(-τ)ᵀ``, so ``P(t) = X̃(-t)`` and
+``L(t) = G̃(-t)ᵀ``.  Discrete time (predictor form, as `control.dlqe`):
+``P_{k+1} = A_kP_kA_kᵀ - (A_kP_kC_kᵀ + G_kN)(C_kP_kC_kᵀ + R_k)⁻¹(.)ᵀ +
+G_kQG_kᵀ`` is the control equation of the step-reversed dual ``Ã_j =
+A_{N-1-j}ᵀ``, ``B̃_j = C_{N-1-j}ᵀ`` with ``P_k = X̃_{N-k}``.  The time
+reversal keeps the Floquet multipliers (``Φ̃(T, 0) = Φ(T, 0)ᵀ``).
+"""
+
+import numpy as np
+from control.exception import ControlArgument, ControlDimension
+
+from ._ltpsys import LTPStateSpace
+from ._periodic_matrix import PeriodicMatrix, as_periodic
+from ._riccati import _check_weights, care, dare
+from ._validation import real_array
+
+__all__ = ['lqr', 'dlqr', 'lqe', 'dlqe', 'lqg']
+
+
+def lqr(sys, Q, R, N=None, nsteps=None):
+    """Periodic linear quadratic regulator, as `control.lqr`.
+
+    Minimizes ``∫ (xᵀQx + uᵀRu + 2xᵀNu) dt`` for ``ẋ = A(t)x + B(t)u``
+    with the periodic state feedback ``u = -K(t) x``.  A discrete-time
+    system is passed on to `dlqr`, as python-control does.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        Plant (its A and B are used).
+    Q, R : array_like, PeriodicMatrix or callable
+        State and input weights, (n, n) and (m, m); R(t) positive definite.
+    N : array_like, PeriodicMatrix or callable, optional
+        Cross weight (n, m).
+    nsteps : int, optional
+        Continuous time: steps per period of the Riccati solver (see
+        `ltpcontrol.care`).
+
+    Returns
+    -------
+    K : PeriodicMatrix
+        Gain ``K(t) = R⁻¹(BᵀX + Nᵀ)``, shape (m, n).
+    X : PeriodicMatrix
+        Stabilizing periodic Riccati solution; the optimal cost from
+        ``x(t0)`` is ``x(t0)ᵀ X(t0) x(t0)``.
+    E : ndarray of complex
+        Closed-loop Floquet exponents of ``A - BK`` (full precision).
+
+    Raises
+    ------
+    ValueError
+        No stabilizing solution, R not positive definite, Q or R not symmetric.
+    ControlDimension
+        Wrong weight shapes.
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss(lambda t: np.array([[0.0, 1.0], [-1 - 0.5 * np.cos(t), 0.1]]),
+    ...                 [[0.0], [1.0]], np.eye(2), 0, period=2 * np.pi)
+    >>> K, X, E = ltp.lqr(sys, np.eye(2), [[1.0]])
+    >>> K.shape, bool(np.all(E.real < 0))
+    ((1, 2), True)
+    """
+    if _discrete(sys, nsteps):
+        return dlqr(sys, Q, R, N)
+    X, E, K = care(sys.A, sys.B, Q, R, N, period=sys.period, nsteps=nsteps)
+    return K, X, E
+
+
+def dlqr(sys, Q, R, N=None):
+    """Periodic discrete-time linear quadratic regulator, as `control.dlqr`.
+
+    Minimizes ``Σ_k (x_kᵀQ_kx_k + u_kᵀR_ku_k + 2x_kᵀN_ku_k)`` for
+    ``x_{k+1} = A_kx_k + B_ku_k`` with ``u_k = -K_k x_k``.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        Discrete-time plant with N = period/dt steps per period.
+    Q, R, N : array_like, PeriodicMatrix or callable
+        Weights: a 2D array (the same at every step), an array of shape
+        (N, rows, cols) (one matrix per step), or a periodic matrix sampled
+        at ``t = k dt``.  N (cross weight) is zero by default.
+
+    Returns
+    -------
+    K : PeriodicMatrix
+        Gains ``K_k`` stored as held samples (``K(k dt) = K_k``), shape (m, n).
+    X : PeriodicMatrix
+        Stabilizing periodic Riccati solution ``X_k``, held likewise.
+    E : ndarray of complex
+        Closed-loop per-step exponents ``μ^{1/N}`` (see
+        `ltpcontrol.floquet_exponents`).
+
+    Examples
+    --------
+    >>> A = np.array([[[1.1, 0.2], [0.0, 0.9]], [[0.7, 0.0], [0.3, 1.2]]])
+    >>> sysd = ltp.ltpss(A, [[0.0], [1.0]], np.eye(2), 0, period=2.0, dt=1.0)
+    >>> K, X, E = ltp.dlqr(sysd, np.eye(2), [[1.0]])
+    >>> K(0.0).shape, K(1.0).shape, bool(np.all(np.abs(E) < 1))
+    ((1, 2), (1, 2), True)
+    """
+    _check_ltp(sys, 'sys')
+    if not sys.isdtime(strict=True):
+        raise ControlArgument("dlqr: sys must be a discrete-time system (use lqr)")
+    steps = sys.nsteps
+    A, B = sys.A.sample(steps), sys.B.sample(steps)
+    X, E, K = dare(A, B, _steps(Q, sys, 'Q'), _steps(R, sys, 'R'),
+                   None if N is None else _steps(N, sys, 'N'))
+    return _held(K, sys), _held(X, sys), E
+
+
+def lqe(sys, QN, RN, NN=None, nsteps=None):
+    """Periodic Kalman(-Bucy) filter gain, as `control.lqe`.
+
+    For ``ẋ = A(t)x + B(t)u + G(t)w``, ``y = C(t)x + v`` with white noises
+    of intensities ``E[wwᵀ] = QN``, ``E[vvᵀ] = RN``, ``E[wvᵀ] = NN``, the
+    estimator ``x̂' = Ax̂ + Bu + L(y - Cx̂)``.  As in python-control, G is
+    the B matrix of `sys`.  A discrete-time system is passed on to `dlqe`.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        Plant; its B serves as the noise input matrix G.
+    QN, RN : array_like, PeriodicMatrix or callable
+        Process and sensor noise intensities (shapes (m, m), (p, p)); RN
+        positive definite.
+    NN : array_like, PeriodicMatrix or callable, optional
+        Cross intensity (m, p).
+    nsteps : int, optional
+        Steps per period of the Riccati solver.
+
+    Returns
+    -------
+    L : PeriodicMatrix
+        Estimator gain ``L(t) = (PCᵀ + GN) RN⁻¹``, shape (n, p).
+    P : PeriodicMatrix
+        Stabilizing periodic error covariance.
+    E : ndarray of complex
+        Floquet exponents of the error dynamics ``A - LC``.
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss(lambda t: np.array([[0.0, 1.0], [-1 - 0.5 * np.cos(t), -0.1]]),
+    ...                 [[0.0], [1.0]], [[1.0, 0.0]], 0, period=2 * np.pi)
+    >>> L, P, E = ltp.lqe(sys, [[1.0]], [[0.1]])
+    >>> L.shape, bool(np.all(E.real < 0))
+    ((2, 1), True)
+    """
+    if _discrete(sys, nsteps):
+        return dlqe(sys, QN, RN, NN)
+    T = sys.period
+    G = sys.B
+    QN = as_periodic(QN, T, 'QN', shape=(G.shape[1],) * 2)
+    RN = as_periodic(RN, T, 'RN', shape=(sys.noutputs,) * 2)
+    NN = as_periodic(np.zeros((G.shape[1], sys.noutputs)) if NN is None else NN, T, 'NN',
+                     shape=(G.shape[1], sys.noutputs))
+    probe = np.arange(16) * T / 16
+    _check_weights(QN(probe), RN(probe), 'QN', 'RN')
+    X, E, Gd = care(_reverse(sys.A, True), _reverse(sys.C, True),
+                    _reverse(G @ QN @ G.T, False), _reverse(RN, False),
+                    _reverse(G @ NN, False), period=T, nsteps=nsteps)
+    return _reverse(Gd, True), _reverse(X, False), E
+
+
+def dlqe(sys, QN, RN, NN=None):
+    """Periodic discrete-time Kalman filter gain (predictor form), as `control.dlqe`.
+
+    For ``x_{k+1} = A_kx_k + B_ku_k + G_kw_k``, ``y_k = C_kx_k + v_k``, the
+    one-step predictor ``x̂_{k+1} = A_kx̂_k + B_ku_k + L_k(y_k - C_kx̂_k)``
+    with ``L_k = (A_kP_kC_kᵀ + G_kN_k)(C_kP_kC_kᵀ + RN_k)⁻¹`` and the a
+    priori error covariance ``P_k``.  G is the B matrix of `sys`.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        Discrete-time plant.
+    QN, RN, NN : array_like, PeriodicMatrix or callable
+        Noise covariances per step (2D: the same at every step; (N, ., .):
+        one per step); NN (cross covariance) is zero by default.
+
+    Returns
+    -------
+    L : PeriodicMatrix
+        Predictor gains ``L_k`` (held samples), shape (n, p).
+    P : PeriodicMatrix
+        A priori error covariance ``P_k`` (held samples).
+    E : ndarray of complex
+        Per-step exponents of the error dynamics ``A_k - L_kC_k``.
+
+    Examples
+    --------
+    >>> A = np.array([[[1.1, 0.2], [0.0, 0.9]], [[0.7, 0.0], [0.3, 1.2]]])
+    >>> sysd = ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=2.0, dt=1.0)
+    >>> L, P, E = ltp.dlqe(sysd, [[1.0]], [[0.5]])
+    >>> L(0.0).shape, bool(np.all(np.abs(E) < 1))
+    ((2, 1), True)
+    """
+    _check_ltp(sys, 'sys')
+    if not sys.isdtime(strict=True):
+        raise ControlArgument("dlqe: sys must be a discrete-time system (use lqe)")
+    steps = sys.nsteps
+    A, G, C = (M.sample(steps) for M in (sys.A, sys.B, sys.C))
+    QN, RN = _steps(QN, sys, 'QN'), _steps(RN, sys, 'RN')
+    NN = np.zeros((1, G.shape[2], C.shape[1])) if NN is None else _steps(NN, sys, 'NN')
+    _shape_check(QN, (G.shape[2],) * 2, 'QN')
+    _shape_check(RN, (C.shape[1],) * 2, 'RN')
+    _shape_check(NN, (G.shape[2], C.shape[1]), 'NN')
+    _check_weights(QN, RN, 'QN', 'RN')
+    Gt = np.swapaxes(G, 1, 2)
+    # dual problem on the reversed step order j = N-1-k
+    flip = (lambda M: np.ascontiguousarray(M[::-1]))
+    X, E, Gd = dare(flip(np.swapaxes(A, 1, 2)), flip(np.swapaxes(C, 1, 2)),
+                    flip(G @ QN @ Gt), flip(np.broadcast_to(RN, (steps,) + RN.shape[1:])),
+                    flip(G @ NN))
+    P = np.roll(X[::-1], 1, axis=0)              # P_k = X̃_{N-k}
+    L = np.swapaxes(Gd[::-1], 1, 2)              # L_k = G̃_{N-1-k}ᵀ
+    return _held(L, sys), _held(P, sys), E
+
+
+def lqg(sys, Q, R, QN, RN, name=None):
+    """Periodic LQG output-feedback controller as an `LTPStateSpace`.
+
+    Combines the LQR gain ``K`` of ``(Q, R)`` (`lqr`/`dlqr`) with the
+    Kalman gain ``L`` of ``(QN, RN)`` (`lqe`/`dlqe`, noise through B):
+
+        x̂' = (A - BK - LC + LDK) x̂ + L y,   u = -K x̂
+
+    (discrete time: the same recursion for ``x̂_{k+1}``, the predictor form).
+    The controller maps the plant outputs y to the plant inputs u, so the
+    closed loop is ``feedback(sys, ctrl, sign=1)``; its Floquet exponents
+    are those of ``A - BK`` and ``A - LC`` together (separation principle).
+
+    Parameters
+    ----------
+    sys : LTPStateSpace
+        Plant.
+    Q, R : array_like, PeriodicMatrix or callable
+        LQR weights.
+    QN, RN : array_like, PeriodicMatrix or callable
+        Process (on the inputs of `sys`) and sensor noise intensities.
+    name : str, optional
+        Name of the controller.
+
+    Returns
+    -------
+    LTPStateSpace
+        Controller with inputs y and outputs u.
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss(lambda t: np.array([[0.0, 1.0], [1 + 0.5 * np.cos(t), -0.1]]),
+    ...                 [[0.0], [1.0]], [[1.0, 0.0]], 0, period=2 * np.pi)
+    >>> ctrl = ltp.lqg(sys, np.eye(2), [[1.0]], [[1.0]], [[0.1]])
+    >>> loop = ltp.feedback(sys, ctrl, sign=1)
+    >>> loop.nstates, ltp.is_stable(loop)
+    (4, True)
+    """
+    _check_ltp(sys, 'sys')
+    K, _, _ = lqr(sys, Q, R)
+    L, _, _ = lqe(sys, QN, RN)
+    A = sys.A - sys.B @ K - L @ sys.C + L @ sys.D @ K
+    return LTPStateSpace(A, L, -K, np.zeros((sys.ninputs, sys.noutputs)), sys.period,
+                         dt=sys.dt, name=name, inputs=sys.output_labels,
+                         outputs=sys.input_labels)
+
+
+#
+# Helpers
+#
+
+def _discrete(sys, nsteps):
+    """True for a discrete-time plant (which takes no nsteps)."""
+    _check_ltp(sys, 'sys')
+    if sys.isdtime(strict=True):
+        if nsteps is not None:
+            raise ControlArgument("nsteps applies to continuous-time systems only")
+        return True
+    return False
+
+
+def _check_ltp(sys, name):
+    if not isinstance(sys, LTPStateSpace):
+        raise ControlArgument(f"{name} must be an LTPStateSpace, got {type(sys).__name__}")
+
+
+def _steps(M, sys, name):
+    """Per-step values of a weight, shape (N or 1, rows, cols)."""
+    if isinstance(M, PeriodicMatrix) or callable(M):
+        return as_periodic(M, sys.period, name).sample(sys.nsteps)
+    arr = real_array(M, name, ndim=(0, 1, 2, 3))
+    if arr.ndim == 3 and arr.shape[0] != sys.nsteps:
+        raise ControlDimension(f"{name} has {arr.shape[0]} matrices but the period has "
+                               f"{sys.nsteps} steps")
+    arr = np.atleast_2d(arr)
+    return arr if arr.ndim == 3 else arr[np.newaxis]
+
+
+def _shape_check(M, shape, name):
+    if M.shape[1:] != shape:
+        raise ControlDimension(f"{name} must have shape {shape}, got {M.shape[1:]}")
+
+
+def _held(values, sys):
+    return PeriodicMatrix.from_samples(values, sys.period, kind='hold')
+
+
+def _reverse(M, transpose):
+    """``M(-t)`` (transposed if asked) as a periodic matrix."""
+    T = M.period
+
+    def value(t):
+        out = M._eval(np.mod(-np.asarray(t, float), T))
+        return np.swapaxes(out, 1, 2) if transpose else out
+    shape = M.shape[::-1] if transpose else M.shape
+    return PeriodicMatrix._new(T, shape, func=value, breakpoints=np.mod(-M.breakpoints, T))

@@ -1,0 +1,188 @@
+"""Structured least-squares fit of a Floquet-form LTP model to harmonic data.
+
+A continuous LTP in Floquet form (constant A, periodic ``B(t)``, ``C(t)``,
+``D(t)`` with Fourier coefficients ``B_m``, ``C_l``, ``D_n``) has, with
+``R_m(Ω) = (j(Ω + mω_p) I - A)^{-1}``, the harmonic response to the input
+harmonic 0
+
+    G_n(jΩ) = Σ_{m=-K..K} C_{n-m} R_m(Ω) B_m + D_n,        n = -K..K,
+
+truncated to the input harmonics ``|m| <= K`` of a K-harmonic model.  It is
+linear in D, linear in B for fixed (A, C) and in C for fixed (A, B), and
+``dR_m = R_m dA R_m``.  The parameters are real: ``Re P_0, Re P_h, Im P_h``
+(h > 0) of every coefficient series, so that ``P_{-h} = conj P_h`` and the
+model is real.  The similarity ``x -> S x`` leaves G unchanged; a
+Gauss-Newton step of minimum norm does not move along these ``n_p^2`` flat
+directions.
+"""
+
+import numpy as np
+
+from ._ltpsys import LTPStateSpace
+from ._periodic_matrix import PeriodicMatrix
+
+__all__ = []
+
+
+def _resolvents(A, omega, wp, K):
+    """``R_m(Ω) = (j(Ω + mω_p) I - A)^{-1}``, shape (M, 2K+1, n, n)."""
+    n = A.shape[0]
+    s = 1j * (omega[:, None] + wp * np.arange(-K, K + 1)[None, :])
+    return np.linalg.inv(s[..., None, None] * np.eye(n) - A)
+
+
+def _model_response(R, Bc, Cc, Dc, K):
+    """``G_n = Σ_m C_{n-m} R_m B_m + D_n`` for n = -K..K, shape (2K+1, ny, M)."""
+    X = np.einsum('wmij,mj->wmi', R, Bc[:, :, 0])                 # R_m B_m
+    idx = np.arange(-K, K + 1)
+    Cnm = Cc[(idx[:, None] - idx[None, :]) + 2 * K]               # (n, m, ny, nx)
+    return np.einsum('nmoi,wmi->now', Cnm, X) + Dc[:, :, 0, None]
+
+
+def _harmonic_response(sys, omega, K):
+    """Continuous harmonic response G_n(jΩ), n = -K..K, of a Floquet-form model."""
+    wp = 2 * np.pi / sys.period
+    R = _resolvents(sys.A(0.0), omega, wp, K)
+    Bc, Cc, Dc = _coefficients(sys, K)
+    return _model_response(R, Bc, Cc, Dc, K)
+
+
+def _coefficients(sys, K):
+    """Fourier coefficients B_m (|m| <= K), C_l (|l| <= 2K), D_n (|n| <= K)."""
+    def central(P, H):
+        c = P.fourier(max(H, P.nharmonics or 0, 1))
+        J = c.shape[0] // 2
+        return c[J - H:J + H + 1]
+    return central(sys.B, K), central(sys.C, 2 * K), central(sys.D, K)
+
+
+def _conj_map(H, size):
+    """Real parameters → complex coefficients ``P_h``, h = -H..H, P_{-h} = conj(P_h)."""
+    # real vector [Re P_0, Re P_1, Im P_1, ..., Re P_H, Im P_H] (each `size` long)
+    T = np.zeros(((2 * H + 1) * size, (2 * H + 1) * size), complex)
+    eye = np.eye(size)
+    T[H * size:(H + 1) * size, :size] = eye
+    for h in range(1, H + 1):
+        re, im = slice((2 * h - 1) * size, 2 * h * size), slice(2 * h * size, (2 * h + 1) * size)
+        for sign in (1, -1):
+            rows = slice((H + sign * h) * size, (H + sign * h + 1) * size)
+            T[rows, re] = eye
+            T[rows, im] = sign * 1j * eye
+    return T
+
+
+class _FloquetFit:
+    """Real parameter vector θ = (B, C, D coefficients[, A]) of a K-harmonic model."""
+
+    def __init__(self, nx, ny, K, period, estimate_d, fit_a):
+        self.nx, self.ny, self.K, self.wp = nx, ny, K, 2 * np.pi / period
+        self.fit_a = fit_a
+        Tb, Tc, Td = _conj_map(K, nx), _conj_map(2 * K, ny * nx), _conj_map(K, ny)
+        self.nb, self.nc, self.nd = Tb.shape[0], Tc.shape[0], Td.shape[0]
+        T = np.zeros((self.nb + self.nc + self.nd,) * 2, complex)
+        nb, nc = self.nb, self.nc
+        T[:nb, :nb], T[nb:nb + nc, nb:nb + nc], T[nb + nc:, nb + nc:] = Tb, Tc, Td
+        self.T = T if estimate_d else T[:, :nb + nc]
+        self.ncoef = self.T.shape[1]
+
+    def pack(self, sys):
+        Bc, Cc, Dc = _coefficients(sys, self.K)
+        c = np.concatenate([Bc.ravel(), Cc.ravel(), Dc.ravel()])
+        theta = np.linalg.lstsq(self.T, c, rcond=None)[0].real
+        return np.concatenate([theta, sys.A(0.0).ravel()]) if self.fit_a else theta
+
+    def unpack(self, theta, A=None):
+        K, nx, ny, nb, nc = self.K, self.nx, self.ny, self.nb, self.nc
+        c = self.T @ theta[:self.ncoef]
+        if self.fit_a:
+            A = theta[self.ncoef:].reshape(nx, nx)
+        return (A, c[:nb].reshape(2 * K + 1, nx, 1), c[nb:nb + nc].reshape(4 * K + 1, ny, nx),
+                c[nb + nc:].reshape(2 * K + 1, ny, 1))
+
+    def response_and_jacobian(self, theta, omega, A=None, jac=True):
+        """Harmonic response (2K+1, ny, M) and its Jacobian ((2K+1) ny M, len θ)."""
+        K, nx, ny, nb, nc = self.K, self.nx, self.ny, self.nb, self.nc
+        A, Bc, Cc, Dc = self.unpack(theta, A)
+        R = _resolvents(A, omega, self.wp, K)
+        G = _model_response(R, Bc, Cc, Dc, K)
+        if not jac:
+            return G, None
+        M, idx = omega.size, np.arange(-K, K + 1)
+        Cnm = Cc[(idx[:, None] - idx[None, :]) + 2 * K]            # (n, m, o, i)
+        CR = np.einsum('nmoi,wmij->nowmj', Cnm, R)                 # C_{n-m} R_m
+        X = np.einsum('wmij,mj->wmi', R, Bc[:, :, 0])              # R_m B_m, (w, m, i)
+        # dG_n = Σ_l dC_l X_{n-l}, |n-l| <= K
+        Xsel = np.zeros((2 * K + 1, 4 * K + 1, M, nx), complex)
+        for a, n in enumerate(idx):
+            Xsel[a, n - idx + 2 * K] = X.transpose(1, 0, 2)
+        eye = np.eye(ny)
+        JC = np.einsum('oq,nlwi->nowlqi', eye, Xsel).reshape(-1, nc)
+        JD = np.einsum('na,oq,w->nowaq', np.eye(2 * K + 1), eye,
+                       np.ones(M)).reshape(-1, self.nd)
+        J = np.hstack([CR.reshape(-1, nb), JC, JD]) @ self.T
+        if self.fit_a:
+            # dR_m = R_m dA R_m:  dG_n = Σ_m C_{n-m} R_m dA R_m B_m
+            J = np.hstack([J, np.einsum('nowmi,wmj->nowij', CR, X).reshape(-1, nx * nx)])
+        return G, J
+
+
+def fit_floquet(sys, Gc, omega, K, *, estimate_d=True, fit_a=True, maxiter=50, rtol=1e-8,
+                **labels):
+    """Least-squares Floquet-form model of K harmonics fitted to ``G_n(jΩ)``.
+
+    Starts from the Floquet-form LTPStateSpace `sys` and minimises
+    ``Σ |G_n(jΩ) - Ĝ_n|²`` over the lines Ω (rad/s) and n = -K..K (module
+    notes) by Levenberg-Marquardt steps: Gauss-Newton (minimum-norm, on
+    column-scaled Jacobians) while the cost falls, damped otherwise.
+    Returns ``(model, relative residual, converged)``.
+    """
+    nx, ny = sys.nstates, Gc.shape[1]
+    fit = _FloquetFit(nx, ny, K, sys.period, estimate_d, fit_a)
+    A0 = sys.A(0.0)
+    scale = max(np.linalg.norm(Gc), np.finfo(float).tiny)
+
+    def cost(theta, jac=False):
+        G, J = fit.response_and_jacobian(theta, omega, A0, jac)
+        r = (G - Gc).ravel() / scale
+        r = np.concatenate([r.real, r.imag])
+        return (r, np.vstack([J.real, J.imag]) / scale) if jac else r
+
+    theta = fit.pack(sys)
+    r, J = cost(theta, True)
+    f = r @ r
+    mu, converged = 0.0, False
+    for _ in range(maxiter):
+        # column scaling, floored so that (nearly) uninfluential parameters stay put
+        colnorm = np.linalg.norm(J, axis=0)
+        colnorm = np.maximum(colnorm, 1e-8 * max(colnorm.max(), np.finfo(float).tiny))
+        # one SVD per iteration: the damped step -V diag(s/(s²+μ)) U^T r for any μ
+        U, sv, Vt = np.linalg.svd(J / colnorm, full_matrices=False)
+        Utr = U.T @ r
+        sv = np.where(sv > max(J.shape) * np.finfo(float).eps * sv[0], sv, 0.0)
+        while True:
+            with np.errstate(divide='ignore', invalid='ignore'):
+                gain = np.where(sv > 0, sv / (sv ** 2 + mu), 0.0)
+            step = -(Vt.T @ (gain * Utr)) / colnorm
+            with np.errstate(all='ignore'):
+                r_new = cost(theta + step)
+            f_new = r_new @ r_new
+            if np.isfinite(f_new) and f_new < f:
+                break
+            mu = max(10 * mu, 1e-8)
+            if mu > 1e8:
+                break
+        if not (np.isfinite(f_new) and f_new < f):
+            converged = True                      # no descent left: a (local) minimum
+            break
+        theta, decrease, f = theta + step, f - f_new, f_new
+        mu = mu / 10 if mu > 1e-7 else 0.0
+        if decrease <= rtol * max(f, np.finfo(float).tiny) or f < 1e-30:
+            converged = True
+            break
+        r, J = cost(theta, True)
+    A, Bc, Cc, Dc = fit.unpack(theta, A0)
+    period = sys.period
+    model = LTPStateSpace(A, PeriodicMatrix(Bc, period), PeriodicMatrix(Cc, period),
+                          PeriodicMatrix(Dc, period), period, states=sys.state_labels,
+                          **labels)
+    return model, float(np.sqrt(f)), converged

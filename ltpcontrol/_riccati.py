@@ -1,0 +1,463 @@
+"""Stabilizing periodic solutions of periodic Riccati equations.
+
+Continuous time, ``-Ẋ = AᵀX + XA - (XB + S) R⁻¹ (BᵀX + Sᵀ) + Q`` with
+T-periodic data.  With ``Ā = A - BR⁻¹Sᵀ`` and ``Q̄ = Q - SR⁻¹Sᵀ`` the
+state/costate ``z = [x; λ]`` of the optimal control problem obeys
+``ż = H(t) z``, ``H = [[Ā, -BR⁻¹Bᵀ], [-Q̄, -Āᵀ]]``, and the stabilizing
+solution is ``X(t) = V(t) U(t)⁻¹`` where ``[U; V]`` spans the stable
+invariant subspace of the Hamiltonian flow.  The period is split into short
+steps ``t_0 = 0 < ... < t_M = T`` (switching instants are step boundaries);
+the step factors ``Ψ_k = Φ_H(t_{k+1}, t_k)`` come from the library's Magnus
+integrator.
+
+Discrete time, ``X_k = A_kᵀX_{k+1}A_k - (A_kᵀX_{k+1}B_k + S_k)(R_k +
+B_kᵀX_{k+1}B_k)⁻¹(B_kᵀX_{k+1}A_k + S_kᵀ) + Q_k``: step k is the symplectic
+pencil ``L_k [x_{k+1}; λ_{k+1}] = M_k [x_k; λ_k]`` with
+``L_k = [[I, B_kR_k⁻¹B_kᵀ], [0, Ā_kᵀ]]``, ``M_k = [[Ā_k, 0], [-Q̄_k, I]]``
+(continuous time: ``L_k = I``, ``M_k = Ψ_k``).
+
+Both cases then share one algorithm:
+
+1. collapse the cyclic product ``L_{M-1}⁻¹M_{M-1} ... L_0⁻¹M_0`` into one
+   2n x 2n pencil ``(L, M)`` with orthogonal transformations only: for two
+   neighbouring factors, a QR factorisation of ``[L_k; -M_{k+1}]`` gives
+   ``[Z1 Z2]`` with ``Z1 L_k = Z2 M_{k+1}``, so ``M_{k+1} L_k⁻¹ = Z2⁻¹ Z1``
+   and the pair becomes ``(Z2 L_{k+1}, Z1 M_k)``; pairs are merged in a
+   balanced tree.  No product, inverse or exponential of a stiff flow is
+   formed;
+2. the stable deflating subspace ``[U; V]`` of ``(M, L)`` by ordered QZ
+   gives ``X_0 = V U⁻¹`` (exactly n multipliers inside the unit circle
+   are required: otherwise no stabilizing solution exists);
+3. the other samples by the backward recursion (the Riccati map, which is
+   contractive towards the stabilizing solution), ``X_M = X_0``; the
+   mismatch between the recursion's ``X_0`` and the pencil's is the
+   periodicity residual, removed by Newton steps on the periodicity
+   condition (one Stein equation each) and checked;
+4. the closed-loop step factors (``U`` of ``Ψ_k [I; X_k]``, or
+   ``A_k - B_k G_k``) give the closed-loop multipliers through the
+   periodic Schur form (`ltpcontrol._floquet`).
+
+Values inside a step ``[t_k, t_{k+1}]`` are ``X(t) = V U⁻¹`` with
+``[U; V] = Φ_H(t_{k+1}, t)⁻¹ [I; X_{k+1}]`` (the backward flow, which
+contracts onto the stabilizing solution), computed at Chebyshev points of
+every step when X is first evaluated between the step boundaries and
+interpolated (checked against the exact value inside every step).
+"""
+
+import warnings
+
+import numpy as np
+import scipy.linalg as la
+from control.exception import ControlArgument, ControlDimension
+
+from ._floquet import _log_multipliers, chebyshev_nodes, piecewise_chebyshev
+from ._periodic_matrix import PeriodicMatrix, as_periodic
+from ._steps import step_grid
+from ._transition import step_transitions
+from ._validation import real_array
+
+__all__ = ['care', 'dare']
+
+# relative periodicity residual above which a warning is issued
+_RESIDUAL_WARN = 1e-8
+# degree of the Chebyshev interpolant of X(t) on every step
+_CHEB_DEG = 16
+# multipliers within this distance of the unit circle count as on it
+_CIRCLE_TOL = 1e-10
+
+
+def care(A, B, Q, R, S=None, period=None, nsteps=None):
+    """Stabilizing periodic solution of the periodic Riccati differential equation.
+
+    ``-Ẋ = AᵀX + XA - (XB + S) R⁻¹ (BᵀX + Sᵀ) + Q`` with T-periodic data,
+    the periodic counterpart of `control.care`.
+
+    Parameters
+    ----------
+    A, B : PeriodicMatrix, callable or array_like
+        Plant matrices, shapes (n, n) and (n, m).
+    Q, R : PeriodicMatrix, callable or array_like
+        Symmetric weights, (n, n) and (m, m); R(t) positive definite.
+    S : PeriodicMatrix, callable or array_like, optional
+        Cross weight (n, m); zero by default.
+    period : float, optional
+        Period T; taken from the first `PeriodicMatrix` argument when omitted.
+    nsteps : int, optional
+        Uniform steps per period (switching instants are added).  By default
+        ``ceil(T max_t ‖H(t)‖₂)`` clipped to [16, 4096].
+
+    Returns
+    -------
+    X : PeriodicMatrix
+        The stabilizing solution, ``X(t + T) = X(t)``.
+    L : ndarray of complex
+        Closed-loop Floquet exponents of ``A - BG`` (see
+        `ltpcontrol.floquet_exponents`).
+    G : PeriodicMatrix
+        Gain ``G(t) = R⁻¹(BᵀX + Sᵀ)``.
+
+    Raises
+    ------
+    ValueError
+        If R is not positive definite, Q or R is not symmetric, or no
+        stabilizing solution exists ((A, B) not stabilizable, or a mode of
+        (A, Q) unobservable on the stability boundary).
+    ControlDimension
+        If the shapes do not match.
+
+    Examples
+    --------
+    An LTI plant written as periodic gives `control.care`'s solution:
+
+    >>> A, B = np.array([[0.0, 1.0], [2.0, -1.0]]), np.array([[0.0], [1.0]])
+    >>> X, L, G = ltp.care(A, B, np.eye(2), [[1.0]], period=1.0)
+    >>> np.allclose(X(0.3), ct.care(A, B, np.eye(2), [[1.0]])[0])
+    True
+    """
+    period = _period_of((A, B, Q, R, S), period)
+    A = as_periodic(A, period, 'A')
+    n = A.shape[0]
+    if A.shape != (n, n):
+        raise ControlDimension(f"A must be square, got shape {A.shape}")
+    B = as_periodic(B, period, 'B')
+    if B.shape[0] != n:
+        raise ControlDimension(f"B must have {n} rows, got shape {B.shape}")
+    m = B.shape[1]
+    Q = as_periodic(Q, period, 'Q', shape=(n, n))
+    R = as_periodic(R, period, 'R', shape=(m, m))
+    S = as_periodic(np.zeros((n, m)) if S is None else S, period, 'S', shape=(n, m))
+    ops = (A, B, Q, R, S)
+    breaks = np.unique(np.concatenate([M.breakpoints for M in ops]))
+    probe = np.union1d(np.arange(16) * period / 16, breaks)
+    _check_weights(Q(probe), R(probe), 'Q', 'R')
+
+    def hamiltonian(a, b, q, r, s):
+        # R⁻¹ [Bᵀ, Sᵀ]
+        rinv = np.linalg.solve(r, np.swapaxes(np.concatenate([b, s], axis=1), 1, 2))
+        out = np.empty((len(a), 2 * n, 2 * n))
+        out[:, :n, :n] = a - b @ rinv[:, :, n:]        # Ā = A - B R⁻¹ Sᵀ
+        out[:, :n, n:] = -(b @ rinv[:, :, :n])         # -B R⁻¹ Bᵀ
+        out[:, n:, :n] = s @ rinv[:, :, n:] - q        # -Q̄ = S R⁻¹ Sᵀ - Q
+        out[:, n:, n:] = -np.swapaxes(out[:, :n, :n], 1, 2)
+        return out
+
+    H = PeriodicMatrix._new(period, (2 * n, 2 * n), combine=(hamiltonian, list(ops)),
+                            breakpoints=breaks)
+    grid = _grid(H, period, breaks, nsteps)
+    Psi = _flow(H, grid[:-1], np.diff(grid))
+    ident = np.broadcast_to(np.eye(2 * n), Psi.shape)
+    X0 = _stable_solution(ident, Psi, n)
+    Psi_inv = np.linalg.inv(Psi)
+
+    def sweep(X0):
+        # backward flow from X(T) = X(0): [U; V] = Ψ_k⁻¹ [I; X_{k+1}]
+        Xg = np.empty((len(grid), n, n))
+        Xg[-1] = X0
+        for k in range(len(grid) - 2, -1, -1):
+            UV = Psi_inv[k, :, :n] + Psi_inv[k, :, n:] @ Xg[k + 1]
+            Xg[k] = _graph(UV, n)
+        # closed-loop step factors: x(t_{k+1}) = [Ψ_k [I; X_k]]_top x(t_k)
+        return Xg, (Psi @ _stack(Xg[:-1]))[:, :n]
+    Xg, factors = _refine(X0, sweep)
+    L = _exponents(factors, period=period)
+    cache = []
+
+    def solution(t):
+        tau = np.mod(np.atleast_1d(np.asarray(t, float)), period)
+        k = np.searchsorted(grid, tau)
+        on = np.abs(grid[np.minimum(k, len(grid) - 1)] - tau) <= 1e-14 * period
+        if np.all(on):                      # step boundaries: no interpolant needed
+            return Xg[k]
+        if not cache:
+            cache.append(_interpolant(H, grid, Xg))
+        return cache[0](t)
+
+    X = PeriodicMatrix._new(period, (n, n), func=solution, breakpoints=grid[:-1])
+
+    def gain(b, r, s, x):
+        return np.linalg.solve(r, np.swapaxes(b, 1, 2) @ x + np.swapaxes(s, 1, 2))
+
+    G = PeriodicMatrix._new(period, (m, n), combine=(gain, [B, R, S, X]),
+                            breakpoints=np.union1d(breaks, grid[:-1]))
+    return X, L, G
+
+
+def dare(A, B, Q, R, S=None):
+    """Stabilizing periodic solution of the periodic Riccati difference equation.
+
+    ``X_k = A_kᵀX_{k+1}A_k - (A_kᵀX_{k+1}B_k + S_k)(R_k + B_kᵀX_{k+1}B_k)⁻¹
+    (B_kᵀX_{k+1}A_k + S_kᵀ) + Q_k`` with ``X_{k+N} = X_k``, the periodic
+    counterpart of `control.dare`.
+
+    Parameters
+    ----------
+    A, B, Q, R, S : array_like
+        The N matrices of one period, shapes (N, n, n), (N, n, m), (N, n, n),
+        (N, m, m) and (N, n, m); a 2D array is the same matrix at every step.
+        S is zero by default.  R_k + B_kᵀX_{k+1}B_k must be positive
+        definite; R_k is required to be.
+
+    Returns
+    -------
+    X : ndarray, shape (N, n, n)
+        The stabilizing solution.
+    L : ndarray of complex
+        Closed-loop per-step exponents ``ρ = μ^{1/N}`` of the multipliers μ
+        of ``Π_k (A_k - B_k G_k)`` (see `ltpcontrol.floquet_exponents`).
+    G : ndarray, shape (N, m, n)
+        Gains ``G_k = (R_k + B_kᵀX_{k+1}B_k)⁻¹(B_kᵀX_{k+1}A_k + S_kᵀ)``.
+
+    Raises
+    ------
+    ValueError
+        If R is not positive definite, Q or R is not symmetric, or no
+        stabilizing solution exists.
+    ControlDimension
+        If the shapes or the numbers of steps do not match.
+
+    Examples
+    --------
+    >>> A = np.array([[[1.2, 0.3], [0.0, 0.5]], [[0.8, 0.0], [0.4, 1.1]]])
+    >>> B = np.array([[[0.0], [1.0]], [[1.0], [0.0]]])
+    >>> X, L, G = ltp.dare(A, B, np.eye(2), [[1.0]])
+    >>> X.shape, G.shape, bool(np.all(np.abs(L) < 1))
+    ((2, 2, 2), (2, 1, 2), True)
+    """
+    A, B, Q, R, S = _step_arrays(A, B, Q, R, S)
+    N, n, m = B.shape
+    _check_weights(Q, R, 'Q', 'R')
+    Abar = A - B @ np.linalg.solve(R, np.swapaxes(S, 1, 2))
+    Qbar = Q - S @ np.linalg.solve(R, np.swapaxes(S, 1, 2))
+    Lk = np.zeros((N, 2 * n, 2 * n))
+    Mk = np.zeros((N, 2 * n, 2 * n))
+    Lk[:, :n, :n] = np.eye(n)
+    Lk[:, :n, n:] = B @ np.linalg.solve(R, np.swapaxes(B, 1, 2))
+    Lk[:, n:, n:] = np.swapaxes(Abar, 1, 2)
+    Mk[:, :n, :n] = Abar
+    Mk[:, n:, :n] = -Qbar
+    Mk[:, n:, n:] = np.eye(n)
+    X0 = _stable_solution(Lk, Mk, n)
+    Bt = np.swapaxes(B, 1, 2)
+
+    def sweep(X0):
+        X = np.empty((N + 1, n, n))
+        X[N] = X0
+        for k in range(N - 1, -1, -1):
+            X[k] = _riccati_step(A[k], B[k], Q[k], R[k], S[k], X[k + 1])
+        Xn = X[1:]
+        G = np.linalg.solve(R + Bt @ Xn @ B, Bt @ Xn @ A + np.swapaxes(S, 1, 2))
+        return X, A - B @ G
+    X, factors = _refine(X0, sweep)
+    X = X[:N]
+    Xn = np.roll(X, -1, axis=0)
+    G = np.linalg.solve(R + Bt @ Xn @ B, Bt @ Xn @ A + np.swapaxes(S, 1, 2))
+    L = _exponents(factors, nper=N)
+    return X, L, G
+
+
+#
+# Shared steps
+#
+
+def _interpolant(H, grid, Xg):
+    """X(t) inside the steps: the backward flow at Chebyshev points, interpolated."""
+    n = Xg.shape[1]
+    cheb = chebyshev_nodes(_CHEB_DEG)
+    nodes = grid[:-1, None] + np.diff(grid)[:, None] * cheb
+    sub = _flow(H, nodes[:, :-1].ravel(), np.diff(nodes, axis=1).ravel())
+    sub = sub.reshape(len(grid) - 1, _CHEB_DEG, 2 * n, 2 * n)
+    # W[k, j] = Φ_H(t_{k+1}, s_j),  [U; V] = W⁻¹ [I; X_{k+1}]
+    W = np.empty((len(grid) - 1, _CHEB_DEG + 1, 2 * n, 2 * n))
+    W[:, -1] = np.eye(2 * n)
+    for j in range(_CHEB_DEG - 1, -1, -1):
+        W[:, j] = W[:, j + 1] @ sub[:, j]
+    values = _graph(np.linalg.solve(W, _stack(Xg[1:])[:, None]), n)
+    values[:, 0] = Xg[:-1]
+    interp = piecewise_chebyshev(grid, values)
+    probe = grid[:-1] + 0.3717 * np.diff(grid)
+    exact = _graph(np.linalg.solve(_flow(H, probe, grid[1:] - probe), _stack(Xg[1:])), n)
+    err = np.abs(interp(probe) - exact).max() / max(1.0, np.abs(exact).max())
+    if err > 1e-10:
+        warnings.warn(f"the interpolated Riccati solution has relative errors up to "
+                      f"{err:.1e} inside the steps; increase nsteps", UserWarning,
+                      stacklevel=4)
+    return interp
+
+
+def _stable_solution(Lk, Mk, n):
+    """``X_0 = V U⁻¹`` from the stable deflating subspace of the collapsed pencil."""
+    Lc, Mc = _collapse(np.asarray(Lk, float), np.asarray(Mk, float))
+    # QZ of the pencil M - μ L, stable eigenvalues first
+    _, _, alpha, beta, _, Zq = la.ordqz(Mc, Lc, sort='iuc', output='real')
+    with np.errstate(divide='ignore', invalid='ignore'):
+        mod = np.where(beta != 0, np.abs(alpha) / np.abs(beta), np.inf)
+    nstable = int(np.count_nonzero(mod < 1 - _CIRCLE_TOL))
+    if nstable != n or np.any(np.abs(mod - 1) <= _CIRCLE_TOL):
+        raise ValueError(
+            "no stabilizing periodic solution exists: the Hamiltonian has "
+            f"{int(np.count_nonzero(np.abs(mod - 1) <= _CIRCLE_TOL))} multipliers on "
+            "the unit circle (check that (A, B) is stabilizable and that Q penalizes "
+            "every mode on the stability boundary)")
+    U, V = Zq[:n, :n], Zq[n:, :n]
+    if np.linalg.cond(U) > 1e12:
+        raise ValueError("no stabilizing periodic solution exists: the stable subspace "
+                         "is not a graph over the state space (check that (A, B) is "
+                         "stabilizable)")
+    X0 = np.linalg.solve(U.T, V.T).T
+    return 0.5 * (X0 + X0.T)
+
+
+def _collapse(L, M):
+    """One pencil ``(L, M)`` with ``L⁻¹M = L_{K-1}⁻¹M_{K-1} ... L_0⁻¹M_0``.
+
+    Neighbours are merged pairwise (a balanced tree, batched): for factors
+    k, k+1 the QR factorisation of ``[L_k; -M_{k+1}]`` gives ``[Z1 Z2]``
+    with ``Z1 L_k = Z2 M_{k+1}``, and the pair becomes ``(Z2 L_{k+1}, Z1 M_k)``.
+    """
+    d = L.shape[1]
+    while len(L) > 1:
+        even = len(L) - len(L) % 2
+        q, _ = np.linalg.qr(np.concatenate([L[0:even:2], -M[1:even:2]], axis=1),
+                            mode='complete')
+        Z = np.swapaxes(q, 1, 2)[:, d:]
+        Lnew, Mnew = Z[:, :, d:] @ L[1:even:2], Z[:, :, :d] @ M[0:even:2]
+        if even < len(L):
+            Lnew, Mnew = np.concatenate([Lnew, L[-1:]]), np.concatenate([Mnew, M[-1:]])
+        L, M = Lnew, Mnew
+    return L[0], M[0]
+
+
+def _riccati_step(a, b, q, r, s, xn):
+    """One backward step of the discrete Riccati map."""
+    axb = a.T @ xn @ b + s
+    X = a.T @ xn @ a - axb @ np.linalg.solve(r + b.T @ xn @ b, axb.T) + q
+    return 0.5 * (X + X.T)
+
+
+def _graph(UV, n):
+    """``X = V U⁻¹`` for stacked ``[U; V]`` (shape (..., 2n, n)), symmetrized."""
+    U, V = UV[..., :n, :], UV[..., n:, :]
+    if UV.ndim == 2:
+        X = np.linalg.solve(U.T, V.T).T
+        return 0.5 * (X + X.T)
+    X = np.swapaxes(np.linalg.solve(np.swapaxes(U, -1, -2), np.swapaxes(V, -1, -2)), -1, -2)
+    return 0.5 * (X + np.swapaxes(X, -1, -2))
+
+
+def _stack(X):
+    """``[I; X]`` for one or many X."""
+    n = X.shape[-1]
+    ident = np.broadcast_to(np.eye(n), X.shape)
+    return np.concatenate([ident, X], axis=-2)
+
+
+def _flow(H, t0, h):
+    zero = PeriodicMatrix.constant(np.zeros((H.shape[0], 0)), H.period)
+    Psi, _, _ = step_transitions(H, zero, np.asarray(t0, float), np.asarray(h, float))
+    return Psi
+
+
+def _exponents(factors, period=None, nper=None):
+    """Floquet exponents (continuous) or per-step exponents (discrete) of factors."""
+    logmod, arg = _log_multipliers(None, None, grid=None, factors=factors)
+    if nper is not None:
+        with np.errstate(under='ignore', over='ignore'):
+            return np.exp((logmod + 1j * arg) / nper)
+    return (logmod + 1j * arg) / period
+
+
+def _refine(X0, sweep, passes=2):
+    """Newton refinement of the pencil's ``X_0`` on the periodicity condition.
+
+    ``sweep(X_0)`` runs the backward recursion over one period and returns
+    the samples (first: the period map ``F(X_0)``) and the closed-loop step
+    factors.  ``F(X_0 + Δ) ≈ F(X_0) + ΦᵀΔΦ`` with the closed-loop monodromy
+    Φ, so the Newton step solves the Stein equation ``Δ = ΦᵀΔΦ + F(X_0) -
+    X_0``.  The pencil's ``X_0`` is backward stable but its error is
+    amplified by the conditioning of the stable subspace; one or two steps
+    restore full accuracy.  Returns the samples with ``X[0] = X[-1]``.
+    """
+    scale = max(1.0, np.abs(X0).max())
+    for attempt in range(passes + 1):
+        Xs, factors = sweep(X0)
+        res = Xs[0] - X0
+        if attempt == passes or np.abs(res).max() <= 1e-13 * scale:
+            break
+        mono = np.eye(X0.shape[0])
+        for f in factors:
+            mono = f @ mono
+        if not np.all(np.isfinite(mono)) or np.max(np.abs(la.eigvals(mono))) >= 1:
+            break
+        delta = la.solve_discrete_lyapunov(mono.T, res)
+        X0 = X0 + 0.5 * (delta + delta.T)
+    err = np.abs(res).max() / scale
+    if not np.isfinite(err) or err > _RESIDUAL_WARN:
+        warnings.warn(f"the periodic Riccati solution has a periodicity residual of "
+                      f"{err:.1e}: the problem is ill-conditioned (closed-loop "
+                      "multipliers close to the unit circle or a badly scaled plant)",
+                      UserWarning, stacklevel=3)
+    Xs[0] = X0
+    return Xs, factors
+
+
+def _check_weights(Q, R, qname, rname):
+    """Symmetric Q, symmetric positive definite R (stacks of samples)."""
+    for M, name in ((Q, qname), (R, rname)):
+        scale = max(1.0, np.abs(M).max())
+        if np.abs(M - np.swapaxes(M, 1, 2)).max() > 1e-10 * scale:
+            raise ValueError(f"{name} must be symmetric")
+    if R.shape[-1] and np.min(np.linalg.eigvalsh(R)) <= 1e-14 * max(1.0, np.abs(R).max()):
+        raise ValueError(f"{rname} must be positive definite")
+
+
+def _grid(H, period, breaks, nsteps):
+    """Step grid of `_steps.step_grid`, by default ``ceil(T max‖H‖)`` steps
+    (clipped to [16, 4096]) with the norm estimated from 16 samples."""
+    if nsteps is None:
+        probe = np.concatenate([np.arange(16) * period / 16, breaks])
+        norm = np.max(np.linalg.norm(H(probe), ord=2, axis=(1, 2)), initial=0.0)
+        nsteps = int(np.clip(np.ceil(period * norm), 16, 4096))
+    return step_grid(H, nsteps=nsteps)
+
+
+def _period_of(args, period):
+    if period is None:
+        for M in args:
+            if isinstance(M, PeriodicMatrix):
+                return M.period
+        raise ControlArgument("period must be given when no argument is a PeriodicMatrix")
+    from ._validation import check_period
+    return check_period(period)
+
+
+def _step_arrays(A, B, Q, R, S):
+    """Validate the step matrices of a discrete periodic problem; common N."""
+    names = ('A', 'B', 'Q', 'R', 'S')
+    arrs = []
+    for M, name in zip((A, B, Q, R, S), names):
+        if M is None:
+            arrs.append(None)
+            continue
+        arr = real_array(M, name, ndim=(0, 1, 2, 3))
+        if arr.ndim < 2:
+            arr = np.atleast_2d(arr)
+        arrs.append(arr if arr.ndim == 3 else arr[np.newaxis])
+    steps = {a.shape[0] for a in arrs if a is not None and a.shape[0] != 1}
+    if len(steps) > 1:
+        raise ControlDimension("A, B, Q, R and S must have the same number of steps N "
+                               f"(or one matrix), got {sorted(steps)}")
+    N = steps.pop() if steps else 1
+    A, B, Q, R, S = arrs
+    n = A.shape[1]
+    if A.shape[1:] != (n, n):
+        raise ControlDimension(f"A must hold square matrices, got shape {A.shape}")
+    if B.shape[1] != n:
+        raise ControlDimension(f"B must have {n} rows, got shape {B.shape}")
+    m = B.shape[2]
+    if S is None:
+        S = np.zeros((1, n, m))
+    for M, name, shape in ((Q, 'Q', (n, n)), (R, 'R', (m, m)), (S, 'S', (n, m))):
+        if M.shape[1:] != shape:
+            raise ControlDimension(f"{name} must have shape {shape} (per step), "
+                                   f"got {M.shape[1:]}")
+    return tuple(np.broadcast_to(M, (N,) + M.shape[1:]).copy() for M in (A, B, Q, R, S))

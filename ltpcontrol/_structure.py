@@ -1,0 +1,236 @@
+"""Choice of the harmonics K and the order n_p of an identified LTP model.
+
+Every candidate ``(n_p, K)`` is identified with `identify_ltp` from the
+lines of the training set (all lines but every `holdout`-th) and scored on
+
+* the held-out lines: ``e_val = ‖Ĝ - G‖ / ‖G‖`` over the harmonics
+  ``|n| <= K_max`` of the data (a K-harmonic model predicts them all),
+* an information criterion on the training lines, ``AIC = M_r log(SSE/M_r)
+  + 2 d`` with ``M_r`` real residuals and ``d = (2K+1) n_p + (4K+1) p n_p +
+  (2K+1) p`` free parameters (B, C, D harmonics; A is fixed by the
+  similarity up to its ``n_p`` exponents, which are added).
+
+The singular values of the subspace step at the largest candidate order
+show the lifted order ``(2K+1) n_p`` as a gap.  A plant whose A(t) is
+periodic has infinitely many harmonics in Floquet form; the validation
+error of a K-harmonic model then falls geometrically with K until it
+reaches the data's own error.
+"""
+
+import warnings
+from dataclasses import dataclass
+
+import matplotlib.pyplot as plt
+import numpy as np
+import control as ct
+from control.exception import ControlArgument
+
+from ._floquet_fit import _harmonic_response
+from ._lifting import _real_basis
+from ._ltp_subspace import identify_ltp
+from ._validation import check_kwargs, check_period, check_positive_int, steps_per_period
+
+__all__ = ['select_structure', 'StructureSelection']
+
+
+@dataclass(frozen=True)
+class StructureSelection:
+    """Result of `select_structure`.
+
+    Attributes
+    ----------
+    nstates : ndarray of int
+        Candidate orders n_p (rows of the tables).
+    nharmonics : ndarray of int
+        Candidate harmonics K (columns of the tables).
+    validation_error : ndarray, shape (len(nstates), len(nharmonics))
+        Relative error on the held-out lines (NaN where identification
+        failed).
+    aic : ndarray, same shape
+        Information criterion on the training lines.
+    singular_values : ndarray
+        Singular values of the subspace step for the largest candidate.
+    best : tuple of int
+        ``(n_p, K)`` chosen by the `criterion`.
+    criterion : str
+        'validation' or 'aic'.
+
+    Examples
+    --------
+    >>> sel = StructureSelection(np.array([1]), np.array([0, 1]),
+    ...                          np.array([[0.1, 0.01]]), np.array([[5.0, 2.0]]),
+    ...                          np.ones(3), (1, 1), 'validation')
+    >>> sel.best
+    (1, 1)
+    """
+
+    nstates: np.ndarray
+    nharmonics: np.ndarray
+    validation_error: np.ndarray
+    aic: np.ndarray
+    singular_values: np.ndarray
+    best: tuple
+    criterion: str
+
+    def plot(self, ax=None):
+        """Validation error versus K for every n_p, and the singular values.
+
+        Parameters
+        ----------
+        ax : array of two matplotlib Axes, optional
+
+        Returns
+        -------
+        control.ControlPlot
+
+        Examples
+        --------
+        >>> sel = StructureSelection(np.array([1]), np.array([0, 1]),
+        ...                          np.array([[0.1, 0.01]]), np.array([[5.0, 2.0]]),
+        ...                          np.ones(3), (1, 1), 'validation')
+        >>> sel.plot().axes.shape
+        (1, 2)
+        """
+        if ax is None:
+            fig, ax = plt.subplots(1, 2, figsize=(9, 3.5))
+        ax = np.asarray(ax, dtype=object).reshape(1, 2)
+        fig = ax[0, 0].figure
+        lines = np.empty((1, 2), dtype=object)
+        lines[0, 0] = [ax[0, 0].semilogy(self.nharmonics, err, 'o-', label=f"$n_p$ = {n}")[0]
+                       for n, err in zip(self.nstates, self.validation_error)]
+        ax[0, 0].set_xlabel("harmonics K")
+        ax[0, 0].set_ylabel("validation error")
+        ax[0, 0].set_xticks(self.nharmonics)
+        ax[0, 0].legend()
+        ax[0, 0].set_title(f"best ($n_p$, K) = {self.best} ({self.criterion})")
+        sv = self.singular_values
+        lines[0, 1] = ax[0, 1].semilogy(np.arange(1, sv.size + 1), sv, '.')
+        ax[0, 1].set_xlabel("index")
+        ax[0, 1].set_ylabel("singular value")
+        ax[0, 1].set_title("subspace step, largest candidate")
+        fig.tight_layout()
+        return ct.ControlPlot(lines, ax, fig)
+
+
+def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion='validation',
+                     q=None, progress=False, **kwargs):
+    """Choose the order n_p and the harmonics K of an LTP model from data.
+
+    Parameters
+    ----------
+    data : control.FrequencyResponseData
+        Real lifted response (`lifted_frequency_response`) with at least
+        ``max(nharmonics)`` harmonics.
+    period : float
+        Period T of the system.
+    nstates, nharmonics : array_like of int
+        Candidate orders n_p and harmonics K.
+    holdout : int, optional
+        Every `holdout`-th line (starting with the second) is held out for
+        validation (default 4).
+    criterion : {'validation', 'aic'}, optional
+        Score that picks `best` (default the held-out error; ties within
+        10 % go to the smaller model).
+    q : int, optional
+        Block rows of the subspace step (`identify_ltp`).
+    progress : bool, optional
+        Show a progress bar over the candidates.
+
+    Returns
+    -------
+    StructureSelection
+        Tables of both scores, the singular values and the choice; its
+        ``plot()`` method draws them.
+
+    Raises
+    ------
+    ControlArgument
+        If `data` is not discrete-time frequency-response data.
+    ValueError
+        If the data have fewer than ``max(nharmonics)`` harmonics, a
+        candidate list is empty, or `criterion` is unknown.
+    TypeError
+        For unknown keyword arguments.
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss([[-2.0]], lambda t: np.array([[1 + 0.5 * np.cos(4 * np.pi * t)]]),
+    ...                 [[1.0]], 0, period=0.5)
+    >>> w = np.pi / 2 * np.array([k for k in range(1, 48) if k % 4])
+    >>> exc = ltp.sine_experiments(w, 0.5, dt=0.0125, nperiods=8, settle=12)
+    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
+    >>> G = ltp.lifted_frequency_response(resp, 0.5, 2, transient=6.0, input_hold='foh')
+    >>> sel = ltp.select_structure(G, 0.5, [1, 2], [0, 1, 2])
+    >>> sel.best
+    (1, 1)
+    """
+    check_kwargs(kwargs, 'select_structure')
+    if not isinstance(data, ct.FrequencyResponseData) or not data.dt or data.dt is True:
+        raise ControlArgument("data must be discrete-time lifted frequency-response data "
+                              "(from lifted_frequency_response)")
+    period = check_period(period)
+    ns = np.unique([check_positive_int(n, 'nstates') for n in np.atleast_1d(nstates)])
+    Ks = np.unique([check_positive_int(k, 'nharmonics', minimum=0)
+                    for k in np.atleast_1d(nharmonics)])
+    if ns.size == 0 or Ks.size == 0:
+        raise ValueError("nstates and nharmonics must not be empty")
+    if criterion not in ('validation', 'aic'):
+        raise ValueError(f"criterion must be 'validation' or 'aic', got {criterion!r}")
+    holdout = check_positive_int(holdout, 'holdout', minimum=2)
+    N = steps_per_period(period, float(data.dt), 'the sampling time of data')
+    Kmax = int(Ks.max())
+    rows = data.noutputs
+    ny = rows // (2 * Kmax + 1) if rows % (2 * Kmax + 1) == 0 else 0
+    Kdata = next((k for k in range(N) if (2 * k + 1) * ny == rows), None) if ny else None
+    if Kdata is None:
+        # the data hold (2K_d+1) p rows for some K_d >= Kmax
+        Kdata = next((k for k in range(Kmax, N // 2 + 1)
+                      if rows % (2 * k + 1) == 0), None)
+        if Kdata is None:
+            raise ValueError(f"the data ({rows} lifted outputs) do not hold "
+                             f"max(nharmonics) = {Kmax} harmonics")
+        ny = rows // (2 * Kdata + 1)
+    M = data.omega.size
+    held = np.zeros(M, bool)
+    held[1::holdout] = True
+    V, _ = _real_basis(np.arange(-Kdata, Kdata + 1), N)
+    Gc = (np.kron(V, np.eye(ny)) @ data.frdata[:, 0, :]).reshape(2 * Kdata + 1, ny, M)
+    val = np.full((ns.size, Ks.size), np.nan)
+    aic = np.full((ns.size, Ks.size), np.nan)
+    from tqdm.auto import tqdm
+    bar = tqdm(total=val.size, desc="structures", disable=not progress, leave=False)
+    sv = None
+    for i, n in enumerate(ns):
+        for j, K in enumerate(Ks):
+            train = ct.frd(data.frdata[:(2 * K + 1) * ny, :, ~held], data.omega[~held],
+                           data.dt)
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter('ignore')
+                    model, info = identify_ltp(train, period, int(n), int(K), q=q,
+                                               return_info=True)
+            except ValueError:
+                bar.update(1)
+                continue
+            if n == ns[-1] and K == Ks[-1]:
+                sv = info.subspace.singular_values
+            pred = _harmonic_response(model, data.omega, Kdata)
+            err = pred - Gc
+            val[i, j] = np.linalg.norm(err[..., held]) / np.linalg.norm(Gc[..., held])
+            sse = np.sum(np.abs(err[..., ~held]) ** 2)
+            mr = 2 * err[..., ~held].size
+            d = (2 * K + 1) * n + (4 * K + 1) * ny * n + (2 * K + 1) * ny + n
+            aic[i, j] = mr * np.log(max(sse, np.finfo(float).tiny) / mr) + 2 * d
+            bar.update(1)
+    bar.close()
+    score = val if criterion == 'validation' else aic
+    if np.all(np.isnan(score)):
+        raise ValueError("no candidate structure could be identified from the data")
+    if criterion == 'validation':
+        # smallest model (n_p first, then K) within 10 % of the best error
+        ok = score <= 1.1 * np.nanmin(score)
+    else:
+        ok = score == np.nanmin(score)
+    i, j = np.argwhere(ok)[0]
+    return StructureSelection(ns, Ks, val, aic, np.asarray(sv if sv is not None else []),
+                              (int(ns[i]), int(Ks[j])), criterion)
