@@ -11,6 +11,7 @@ Examples assume::
 
 from ._periodic_matrix import PeriodicMatrix
 from ._ltpsys import LTPStateSpace, ltpss, series, parallel, feedback, append, negate
+from ._interconnect import interconnect
 from ._timeresp import forced_response, step_response, initial_response, impulse_response
 from ._floquet import (monodromy, floquet_multipliers, floquet_exponents, is_stable,
                        floquet_transform)
@@ -56,6 +57,7 @@ __all__ = [
     # systems and periodic matrices
     'PeriodicMatrix', 'LTPStateSpace', 'ltpss',
     'series', 'parallel', 'feedback', 'append', 'negate',
+    'interconnect',
     # time responses
     'forced_response', 'step_response', 'initial_response', 'impulse_response',
     # Floquet theory
@@ -87,3 +89,8 @@ __all__ = [
     # noisy data and Monte-Carlo studies
     'refine_ltp', 'RefineInfo', 'monte_carlo', 'MonteCarloResult',
 ]
+
+# python-control's entry points dispatch LTP systems to ltpcontrol (see _interop)
+from . import config  # noqa: E402
+from ._interop import install as _install_interop  # noqa: E402
+_install_interop()

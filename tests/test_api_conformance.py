@@ -79,6 +79,8 @@ KWARG_CALLS = {
     'feedback': lambda **kw: ltp.feedback(SYS, 1.0, **kw),
     'append': lambda **kw: ltp.append(SYS, SYS, **kw),
     'negate': lambda **kw: ltp.negate(SYS, **kw),
+    'interconnect': lambda **kw: ltp.interconnect([SYS, 2.0], inplist='sys[1].u[0]',
+                                                  outlist='y[0]', check_unused=False, **kw),
     'forced_response': lambda **kw: ltp.forced_response(SYS, [0, 0.5, 1], **kw),
     'step_response': lambda **kw: ltp.step_response(SYS, 1.0, **kw),
     'initial_response': lambda **kw: ltp.initial_response(SYS, 1.0, 1.0, **kw),
