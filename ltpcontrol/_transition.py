@@ -125,9 +125,11 @@ def _magnus(A, B, a, b, step_t0, step_h, nsub, n, m, d):
     starts = a[:, None] + delta[:, None] * np.arange(nsub)   # (S, nsub)
     nodes = np.stack([starts + _C1 * delta[:, None], starts + _C2 * delta[:, None]], -1)
     tflat = nodes.ravel()
-    Mt = np.zeros((tflat.size, d, d))
-    Mt[:, :n, :n] = A._eval(tflat)
-    if m:
+    if not m:
+        Mt = A._eval(tflat)
+    else:
+        Mt = np.zeros((tflat.size, d, d))
+        Mt[:, :n, :n] = A._eval(tflat)
         Bt = B._eval(tflat)
         sigma = ((nodes - step_t0[:, None, None]) / step_h[:, None, None]).ravel()
         Mt[:, :n, n:n + m] = Bt
@@ -180,6 +182,8 @@ def expm_batch(X):
     degree = np.full(len(X), 13)
     for m in (9, 7, 5, 3):
         degree[norms <= _THETA[m]] = m
+    if len(X) and np.all(degree == degree[0]):
+        return _pade(X, norms, int(degree[0]))
     for m in (3, 5, 7, 9, 13):
         sel = np.flatnonzero(degree == m)
         if sel.size:
