@@ -27,7 +27,49 @@ numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 numpydoc_validation_checks = set()
 default_role = 'py:obj'
-nitpicky = False
+# every page resolves names in the ltpcontrol namespace
+rst_prolog = '.. currentmodule:: ltpcontrol\n'
+
+# Internal link check: every reference must resolve, so a misspelt or removed
+# name fails the build.  Exempt are only single-backtick names that are
+# documented parameters, returns or attributes (numpydoc's way of naming an
+# argument), and, when the inventories of other projects are not loaded,
+# references into those projects.
+nitpicky = True
+
+
+def _documented_names():
+    import inspect
+    from numpydoc.docscrape import ClassDoc, FunctionDoc
+
+    sections = ('Parameters', 'Other Parameters', 'Returns', 'Yields', 'Attributes')
+    names = set()
+    for obj in (getattr(ltpcontrol, n) for n in ltpcontrol.__all__):
+        members = [obj]
+        if inspect.isclass(obj):
+            members += [m for k, m in vars(obj).items()
+                        if callable(m) and (not k.startswith('_') or k == '__call__')]
+        for member in members:
+            doc = ClassDoc(member, config={'show_class_members': False}) \
+                if inspect.isclass(member) else FunctionDoc(member)
+            for section in sections:
+                for item in doc[section]:
+                    for name in item.name.replace('*', '').split(','):
+                        names.add(name.strip())
+                        if section == 'Attributes':      # e.g. PeriodicOrbit.monodromy
+                            names.add(f"{member.__name__}.{name.strip()}")
+            try:
+                names.update(inspect.signature(member).parameters)
+            except (TypeError, ValueError):
+                pass
+    return {name for name in names if name and not hasattr(ltpcontrol, name)}
+
+
+nitpick_ignore = [('py:obj', name) for name in sorted(_documented_names())]
+nitpick_ignore_regex = [
+    # python-control's configuration keys named in docstrings
+    ('py:obj', r"config\.defaults\[.*"),
+]
 
 intersphinx_mapping = {
     'python': ('https://docs.python.org/3', None),
@@ -41,14 +83,21 @@ intersphinx_disabled_reftypes = ['*']
 intersphinx_timeout = 1
 if os.environ.get('LTP_DOCS_ONLINE') != '1':
     intersphinx_mapping = {}
+    _external = r'(control|numpy|scipy|matplotlib|ast|StateSpace|TransferFunction|' \
+        r'NonlinearIOSystem|BitGenerator|SeedSequence|solve_ivp|input_output_response)'
+    nitpick_ignore_regex += [(r'py:.*', _external + r'(\..*)?')]
 
-# Gallery: only `plot_*.py` scripts are gallery entries; the quick ones are
-# executed during the build, the longer reproductions are rendered as code.
+# Gallery: every `plot_*.py` script is executed and its figures rendered.
+# The long reproductions run their reduced version (LTP_EXAMPLES_QUICK=1)
+# unless LTP_DOCS_FULL=1 asks for the full runs.
+if os.environ.get('LTP_DOCS_FULL') != '1':
+    os.environ['LTP_EXAMPLES_QUICK'] = '1'
 sphinx_gallery_conf = {
     'examples_dirs': '../examples',
     'gallery_dirs': 'auto_examples',
     'ignore_pattern': r'(^|/)(?!plot_)[^/]+\.py$',
-    'filename_pattern': r'/plot_(mathieu_htf|hopper_htf|switching_mathieu|analysis)\.py$',
+    'filename_pattern': r'/plot_',
+    'only_warn_on_example_error': False,
     'within_subsection_order': 'FileNameSortKey',
     'download_all_examples': False,
     'show_memory': False,

@@ -31,8 +31,6 @@ the sampled output by a whole number of samples (50 ms = 9 samples).
 Set ``LTP_EXAMPLES_QUICK=1`` for a reduced run (shorter chirps).
 """
 
-import os
-import sys
 import time
 
 import matplotlib
@@ -41,8 +39,6 @@ matplotlib.use('Agg')
 
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import ltpcontrol as ltp  # noqa: E402
 from hopper import HOPPER_PARAMS, PERIOD, hopper_plant  # noqa: E402

@@ -41,7 +41,6 @@ spring constants).
 
 import math
 import os
-import sys
 import time
 import warnings
 
@@ -52,8 +51,6 @@ matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from joblib import Parallel, delayed  # noqa: E402
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import ltpcontrol as ltp  # noqa: E402
 from hopper import HOPPER_PARAMS, PERIOD, hopper_ltp, hopper_orbit, hopper_plant  # noqa: E402

@@ -34,7 +34,6 @@ signal-to-noise ratio.
 """
 
 import os
-import sys
 import time
 import warnings
 
@@ -42,10 +41,8 @@ import control as ct
 import matplotlib.pyplot as plt
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-
-import ltpcontrol as ltp  # noqa: E402
-from mathieu import mathieu_ltp  # noqa: E402
+import ltpcontrol as ltp
+from mathieu import mathieu_ltp
 
 QUICK = os.environ.get('LTP_EXAMPLES_QUICK', '0') == '1'
 T, TS, OVERSAMPLE, K = 0.5, 0.01, 4, 1

@@ -26,7 +26,6 @@ folds).
 """
 
 import os
-import sys
 import time
 
 import matplotlib
@@ -35,8 +34,6 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from joblib import Parallel, delayed  # noqa: E402
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from slip_data import CLEAN, MONOPOD, SPRINGS, generate_strides  # noqa: E402
 from slip_identification import (cross_validate, fit_leg, format_table,  # noqa: E402

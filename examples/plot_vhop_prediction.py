@@ -40,7 +40,6 @@ sines, fewer harmonic counts).
 """
 
 import os
-import sys
 import time
 import warnings
 
@@ -51,8 +50,6 @@ matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from joblib import Parallel, delayed  # noqa: E402
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import ltpcontrol as ltp  # noqa: E402
 from plot_hopper_htf_identification import chirp_function  # noqa: E402

@@ -24,12 +24,11 @@ import warnings
 import numpy as np
 import scipy.linalg as la
 import control as ct
-from control.exception import ControlArgument
 
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix
 from ._transition import expm_batch, step_transitions
-from ._validation import check_kwargs, check_period, steps_per_period
+from ._validation import as_ltp, check_positive, steps_per_period
 
 __all__ = ['sample_system', 'd2c']
 
@@ -40,7 +39,7 @@ _COND_MAX = 1e12
 
 
 def sample_system(sys, Ts, method='zoh', alpha=None, prewarp_frequency=None,
-                  name=None, copy_names=True, **kwargs):
+                  name=None, copy_names=True, *, inputs=None, outputs=None, states=None):
     """Discretize a continuous-time LTP system.
 
     ``ct.sample_system(sys, Ts, ...)`` and ``sys.sample(Ts, ...)`` call this
@@ -114,11 +113,9 @@ def sample_system(sys, Ts, method='zoh', alpha=None, prewarp_frequency=None,
     >>> round(float(sysd.A(0.0)[0, 0]), 12) == round((20 - 1) / (20 + 1), 12)
     True
     """
-    labels = _pop_labels(kwargs, 'sample_system')
-    _check_ltp(sys, 'sys')
-    if not sys.isctime(strict=True):
-        raise ValueError(f"sys must be a continuous-time system, got dt={sys.dt}")
-    Ts = check_period(Ts, 'Ts')
+    labels = _labels(inputs, outputs, states)
+    sys = as_ltp(sys, discrete=False, lti_hint='control.sample_system')
+    Ts = check_positive(Ts, 'Ts')
     N = steps_per_period(sys.period, Ts, 'Ts')
     if method not in _TUSTIN + ('zoh',):
         raise ValueError(f"method must be 'zoh', 'tustin' or 'bilinear', got {method!r}")
@@ -137,7 +134,7 @@ def sample_system(sys, Ts, method='zoh', alpha=None, prewarp_frequency=None,
 
 
 def d2c(sysd, method='tustin', prewarp_frequency=None, interpolation='fourier',
-        name=None, copy_names=True, **kwargs):
+        name=None, copy_names=True, *, inputs=None, outputs=None, states=None):
     """Continuous-time LTP system from a discrete-time one (inverse Tustin).
 
     Parameters
@@ -192,10 +189,8 @@ def d2c(sysd, method='tustin', prewarp_frequency=None, interpolation='fourier',
     >>> np.allclose(sysc.B(0.3), sys.B(0.3))
     True
     """
-    labels = _pop_labels(kwargs, 'd2c')
-    _check_ltp(sysd, 'sysd')
-    if not sysd.isdtime(strict=True):
-        raise ValueError("sysd must be a discrete-time system, got a continuous-time one")
+    labels = _labels(inputs, outputs, states)
+    sysd = as_ltp(sysd, 'sysd', discrete=True)
     if method not in _TUSTIN + ('log',):
         raise ValueError(f"method must be 'tustin', 'bilinear' or 'log', got {method!r}")
     if interpolation not in ('fourier', 'hold'):
@@ -221,17 +216,9 @@ def d2c(sysd, method='tustin', prewarp_frequency=None, interpolation='fourier',
 # Private helpers
 #
 
-def _check_ltp(sys, name):
-    if not isinstance(sys, LTPStateSpace):
-        raise ControlArgument(f"{name} must be an LTPStateSpace, got {type(sys).__name__}"
-                              + ("; use control.sample_system for LTI systems"
-                                 if isinstance(sys, ct.LTI) else ""))
-
-
-def _pop_labels(kwargs, where):
-    labels = {key: kwargs.pop(key) for key in _LABEL_KEYS if key in kwargs}
-    check_kwargs(kwargs, where)
-    return labels
+def _labels(*values):
+    """The signal names given, as keywords for `LTPStateSpace`."""
+    return {key: v for key, v in zip(_LABEL_KEYS, values) if v is not None}
 
 
 def _bilinear_constant(Ts, prewarp_frequency, tustin):
@@ -242,7 +229,7 @@ def _bilinear_constant(Ts, prewarp_frequency, tustin):
         warnings.warn("prewarp_frequency ignored: it only applies to the Tustin "
                       "(bilinear) method", UserWarning, stacklevel=3)
         return 2.0 / Ts
-    w = check_period(prewarp_frequency, 'prewarp_frequency')
+    w = check_positive(prewarp_frequency, 'prewarp_frequency')
     if w * Ts >= np.pi:
         raise ValueError(f"prewarp_frequency={w} must be below the Nyquist frequency "
                          f"π/Ts = {np.pi / Ts}")

@@ -22,14 +22,12 @@ import control as ct
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
-from ._validation import check_kwargs, check_positive_int, real_array
+from ._validation import check_positive, check_positive_int, real_array
 
 __all__ = ["fdsubspace", "FDSubspaceInfo"]
 
 # Largest order tried by the automatic order choice unless `max_order` is given.
 _DEFAULT_MAX_ORDER = 10
-# Keyword arguments forwarded to `control.ss` for naming the result.
-_SYSTEM_KEYWORDS = ("name", "inputs", "outputs", "states")
 
 
 @dataclass(frozen=True)
@@ -73,11 +71,11 @@ class FDSubspaceInfo:
 
 def fdsubspace(data, omega=None, order=None, *, q=None, dt=None, weights=None,
                estimate_d=True, max_order=None, timescale=None,
-               return_info=False, **kwargs):
+               return_info=False, name=None, inputs=None, outputs=None, states=None):
     r"""Identify an LTI state-space model from frequency-response data.
 
     Frequency-domain subspace identification of McKelvey, Akçay and Ljung
-    (1996), algorithm for arbitrarily spaced frequencies.  It is non-iterative
+    [McKelvey1996]_, algorithm for arbitrarily spaced frequencies.  It is non-iterative
     and exact on noise-free data of a system of the identified order.
 
     Parameters
@@ -242,8 +240,6 @@ def fdsubspace(data, omega=None, order=None, *, q=None, dt=None, weights=None,
     >>> bool(info.singular_values[2] < 1e-10 * info.singular_values[0])
     True
     """
-    sys_kwargs = {key: kwargs.pop(key) for key in _SYSTEM_KEYWORDS if key in kwargs}
-    check_kwargs(kwargs, "fdsubspace")
     G, omega, dt, labels = _parse_data(data, omega, dt)
     ny, nu, nw = G.shape
     w = _parse_weights(weights, G.shape)
@@ -279,9 +275,9 @@ def fdsubspace(data, omega=None, order=None, *, q=None, dt=None, weights=None,
         zfit = zd
     B, D = _fit_bd(A, C, zfit, G, w, estimate_d)
 
-    sys_kwargs.setdefault("inputs", labels[0])
-    sys_kwargs.setdefault("outputs", labels[1])
-    sys = ct.ss(A, B, C, D, dt, **sys_kwargs)
+    sys = ct.ss(A, B, C, D, dt, name=name, states=states,
+                inputs=labels[0] if inputs is None else inputs,
+                outputs=labels[1] if outputs is None else outputs)
     if not return_info:
         return sys
     # Weighted residual of the fitted model on the data.
@@ -349,12 +345,7 @@ def _parse_dt(dt):
     if dt is True or (isinstance(dt, numbers.Real) and not isinstance(dt, bool)
                       and dt == 0):
         return dt if dt is True else 0
-    if isinstance(dt, (bool, np.bool_)) or not isinstance(dt, numbers.Real):
-        raise ControlArgument(f"dt must be 0, True or a positive number, got {dt!r}")
-    dt = float(dt)
-    if not np.isfinite(dt) or dt <= 0:
-        raise ValueError(f"dt must be 0, True or a positive number, got {dt}")
-    return dt
+    return check_positive(dt, "dt")
 
 
 def _same_timebase(dt1, dt2):
@@ -381,12 +372,7 @@ def _parse_timescale(timescale, omega):
     """Bilinear time scale T: user value, or 2/(geometric mean of omega)."""
     if timescale is None:
         return 2.0 / float(np.exp(np.mean(np.log(omega))))
-    if isinstance(timescale, (bool, np.bool_)) or not isinstance(timescale, numbers.Real):
-        raise ControlArgument(f"timescale must be a positive number, got {timescale!r}")
-    T = float(timescale)
-    if not np.isfinite(T) or T <= 0:
-        raise ValueError(f"timescale must be positive and finite, got {T}")
-    return T
+    return check_positive(timescale, "timescale")
 
 
 def _choose_sizes(order, q, max_order, nw, ny, nu):

@@ -27,10 +27,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from control.exception import ControlArgument
 
+from ._ltpsys import ltpss
 from ._periodic_matrix import PeriodicMatrix
 from ._steps import step_grid
 from ._transition import expm_batch, step_transitions
-from ._validation import check_kwargs, check_positive_int, steps_per_period
+from ._validation import as_ltp, check_kwargs, check_positive_int, steps_per_period
 
 __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
            'is_stable', 'floquet_transform']
@@ -85,7 +86,8 @@ def floquet_multipliers(sys, nsteps=None):
 
     Computed by the periodic real Schur decomposition of the factors
     ``H_1 H_2 ... H_p`` with ``H_1 = Φ_{M-1}, ..., H_p = Φ_0`` (SLICOT
-    MB03VD/MB03WD) without forming the product.
+    MB03VD/MB03WD) without forming the product; see [BittantiColaneri2009]_
+    for the theory and [Varga2008]_ for periodic Schur methods.
 
     Parameters
     ----------
@@ -341,18 +343,9 @@ def floquet_transform(sys, real=True, nsteps=None, **kwargs):
 # Private helpers
 #
 
-def _check_sys(sys):
-    for attr in ('A', 'B', 'C', 'D'):
-        if not isinstance(getattr(sys, attr, None), PeriodicMatrix):
-            raise ControlArgument("sys must be an LTPStateSpace (with PeriodicMatrix "
-                                  f"attributes A, B, C, D), got {type(sys).__name__}")
-    if getattr(sys, 'dt', None) is None or getattr(sys, 'period', None) is None:
-        raise ControlArgument("sys must have a period and a time base dt")
-
-
 def _factors(sys, nsteps):
     """Grid ``t_0..t_M`` and step transition matrices ``Φ_k`` (M, n, n)."""
-    _check_sys(sys)
+    sys = as_ltp(sys)
     A, T = sys.A, sys.period
     n = A.shape[0]
     if nsteps is not None:
@@ -522,15 +515,10 @@ def _logm_form(grid, factors, logmod, dtime):
 
 def _assemble(sys, grid, G, E, R):
     """Build P(t) and the Floquet-form system from the grid values."""
-    from ._ltpsys import ltpss
     period = grid[-1]
     n = G.shape[1]
-    labels = {key: getattr(sys, f'{key[:-1]}_labels') for key in ('inputs', 'outputs',
-                                                                     'states')
-              if hasattr(sys, f'{key[:-1]}_labels')}
-    name = getattr(sys, 'name', None)
-    if name is not None:
-        labels['name'] = f'{name}$floquet'
+    labels = dict(inputs=sys.input_labels, outputs=sys.output_labels,
+                  states=sys.state_labels, name=f'{sys.name}$floquet')
     if sys.dt:
         # discrete time: P[k] = G_k R, B_F[k] = P[k+1]^{-1} B[k], C_F[k] = C[k] P[k]
         nw = len(G)

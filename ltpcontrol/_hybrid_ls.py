@@ -6,7 +6,7 @@ The model (thesis §4.1) is a linear time-periodic system
 
 whose `M` modes are switched on by known rectangular functions ``s^i(t) = 1`` on
 ``[t_i, t_{i+1}) + nT``.  Each mode is a smooth periodic matrix truncated to
-``K`` harmonics, ``A^i(t) = Σ_{|k|≤K} A^i_k e^{jkω_p t}``.  In the frequency domain
+```K``` harmonics, ``A^i(t) = Σ_{|k|≤K} A^i_k e^{jkω_p t}``.  In the frequency domain
 (eq. 4.11)
 
     jω X(ω) = Σ_i Σ_k A^i_k X^i_k(ω) + Σ_i Σ_k B^i_k U^i_k(ω),
@@ -18,13 +18,15 @@ real and imaginary parts and imposing ``A^i_{-k} = conj(A^i_k)`` (eqs. 4.13–4.
 gives a real linear regression solved by least squares (eq. 4.22).
 """
 
-import numbers
 import warnings
 
 import numpy as np
-from control.exception import ControlArgument, ControlDimension
+from control.exception import ControlDimension
 
-from ._validation import check_kwargs, check_period, check_positive_int, real_array
+from ._ltpsys import ltpss
+from ._periodic_matrix import PeriodicMatrix
+from ._validation import (check_period, check_positive, check_positive_int, real_array,
+                          time_record)
 
 __all__ = ["hybrid_ls", "HybridLSResult"]
 
@@ -47,7 +49,7 @@ class HybridLSResult:
     B : array_like, shape (M, 2K+1, n, m)
         Fourier coefficients of the mode input matrices.
     period : float
-        Period `T` of the system.
+        Period ``T`` of the system.
     switching_times : array_like, shape (M,)
         Mode start times ``t_1 = 0 < t_2 < ... < t_M < T``.
     nequations, rank : int, optional
@@ -63,11 +65,11 @@ class HybridLSResult:
     B : ndarray, shape (M, 2K+1, n, m), complex
         Fourier coefficients of the mode input matrices ``B^i(t)``.
     period : float
-        Period `T`.
+        Period ``T``.
     switching_times : ndarray, shape (M,)
         Mode start times.
     nharmonics : int
-        Number `K` of harmonics per mode.
+        Number ``K`` of harmonics per mode.
     nunknowns : int
         Number of real unknowns per state component, ``M (2K+1) (n+m)``.
     nequations, rank : int or None
@@ -137,8 +139,6 @@ class HybridLSResult:
         >>> At([0.25, 0.5, 1.25])[:, 0, 0]      # -1, then -2 + cos(2πt)
         array([-1., -3., -1.])
         """
-        from ._periodic_matrix import PeriodicMatrix
-
         times = list(self.switching_times)
         return tuple(
             PeriodicMatrix.switching([PeriodicMatrix(c, self.period) for c in coeffs],
@@ -164,14 +164,13 @@ class HybridLSResult:
         >>> sys.period
         1.0
         """
-        from ._ltpsys import ltpss
-
         n, m = self.A.shape[2], self.B.shape[3]
         At, Bt = self.matrices()
         return ltpss(At, Bt, np.eye(n), np.zeros((n, m)), self.period)
 
 
-def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, **kwargs):
+def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, *, nconv=None,
+              nshifts=None, excitation_tol=1e-3):
     """Identify a switching LTP system from full-state data by least squares.
 
     Estimates the Fourier coefficients of every mode ``A^i(t)``, ``B^i(t)`` of
@@ -192,13 +191,31 @@ def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, **kwargs):
     u : array_like or list of array_like
         Inputs, shape (m, L) (or (L,) when m = 1), one array per record.
     period : float
-        Period `T` of the system.
+        Period ``T`` of the system.
     switching_times : array_like
         Mode start times ``t_1 = 0 < t_2 < ... < t_M < T`` (thesis eq. 4.3);
         ``[0]`` identifies a single smooth LTP system.
     nharmonics : int, optional
-        Number of harmonics `K` estimated for each ``A^i(t)``, ``B^i(t)``
-        (thesis `K`); ``K = 0`` gives a piecewise LTI model.  Default 1.
+        Number of harmonics ``K`` estimated for each ``A^i(t)``, ``B^i(t)``
+        (thesis ``K``); ``K = 0`` gives a piecewise LTI model.  Default 1.
+
+    nconv : int, optional
+        Truncation ``N`` of the convolution ``X^i_k(ω) = Σ_{|n|≤N} S^i_{n-k}
+        X(ω - nω_p)`` with the switching-function coefficients (thesis ``N``,
+        Remark 3).  Default: the largest ``N`` with ``N ω_p`` below the Nyquist
+        frequency of the slowest-sampled record.
+    nshifts : int, optional
+        Equations are formed at ``ω + hω_p`` for ``|h| ≤ nshifts`` around every
+        excited input frequency ``ω`` (thesis ``h``, eq. 4.19).  The input
+        spectrum sits on the excited lines only, so these equations see the
+        harmonics ``|h| <= nshifts`` of ``B(t)`` (and, when the states carry no
+        harmonics beyond the input lines, of ``A(t)``): a unique estimate
+        needs ``2 nshifts + 1 >= M (2K+1)``.  Default: the smallest such
+        value, and at least 2.
+    excitation_tol : float, optional
+        A DFT line of a record is taken as excited when its input amplitude
+        exceeds ``excitation_tol`` times the largest input line of that
+        record.  Default 1e-3.
 
     Returns
     -------
@@ -206,25 +223,6 @@ def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, **kwargs):
         Estimated coefficients ``result.A`` (M, 2K+1, n, n) and ``result.B``
         (M, 2K+1, n, m); ``result.matrices()`` and ``result.model()`` give the
         identified matrices and system.
-
-    Other Parameters
-    ----------------
-    nconv : int, optional
-        Truncation `N` of the convolution ``X^i_k(ω) = Σ_{|n|≤N} S^i_{n-k}
-        X(ω - nω_p)`` with the switching-function coefficients (thesis `N`,
-        Remark 3).  Default: the largest `N` with ``N ω_p`` below the Nyquist
-        frequency of the slowest-sampled record.
-    nshifts : int, optional
-        Equations are formed at ``ω + hω_p`` for ``|h| ≤ nshifts`` around every
-        excited input frequency ``ω`` (thesis `h`, eq. 4.19).  Default 2.
-        When the states carry no harmonics beyond the input lines (an LTI
-        plant, or input lines far apart from their ``ω_p``-shifts) these
-        equations only see the harmonics ``|h| <= nshifts`` of ``A(t)``, and
-        ``2 nshifts + 1 >= M (2K+1)`` is needed for a unique estimate.
-    excitation_tol : float, optional
-        A DFT line of a record is taken as excited when its input amplitude
-        exceeds ``excitation_tol`` times the largest input line of that
-        record.  Default 1e-3.
 
     Raises
     ------
@@ -256,10 +254,10 @@ def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, **kwargs):
     excited line.  Records must therefore start from the periodic steady
     state; a lightly damped LTP (Floquet multipliers near the unit circle)
     needs the exact periodic initial state ``x0 = (I - Φ)^{-1} x_forced``
-    (see the research note ``thesis-errata.md``).
+    (see :ref:`thesis-notes`).  The method is that of [Uyanik2016b]_.
 
     The error floor is set by aliasing of the non-smooth state and by the
-    truncation `N`; it falls as the sampling rate and `nconv` grow.  On the
+    truncation ``N``; it falls as the sampling rate and `nconv` grow.  On the
     switching Mathieu example of thesis §4.1.3 the largest coefficient error
     is about 2e-2 at 100 Hz and 2e-4 at 1 kHz.  Work and memory grow as
     (excited lines) x (2h+1) x (2N+1) x (n+m); lower `nconv` for broadband
@@ -285,16 +283,13 @@ def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, **kwargs):
     >>> res.A[:, 0, 0, 0].real.round(3), res.B[:, 0, 0, 0].real.round(3)
     (array([-1., -3.]), array([1., 1.]))
     """
-    nconv = kwargs.pop("nconv", None)
-    nshifts = kwargs.pop("nshifts", 2)
-    excitation_tol = kwargs.pop("excitation_tol", 1e-3)
-    check_kwargs(kwargs, "hybrid_ls")
-
     period = check_period(period)
     K = check_positive_int(nharmonics, "nharmonics", minimum=0)
-    h = check_positive_int(nshifts, "nshifts", minimum=0)
-    tol = _check_tol(excitation_tol)
+    tol = check_positive(excitation_tol, "excitation_tol", below=1)
     tsw = _check_switching_times(switching_times, period)
+    # the B^i_k columns span 2h+1 shifts: 2h+1 >= M(2K+1) (see nshifts)
+    h = max(2, len(tsw) * (2 * K + 1) // 2) if nshifts is None else \
+        check_positive_int(nshifts, "nshifts", minimum=0)
     records = _records(t, x, u, period)
     n, m = records[0][2].shape[0], records[0][3].shape[0]
 
@@ -354,14 +349,6 @@ def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, **kwargs):
 # Input processing
 #
 
-def _check_tol(tol):
-    if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, numbers.Real):
-        raise ControlArgument(f"excitation_tol must be a real number, got {tol!r}")
-    if not 0 < tol < 1:
-        raise ValueError(f"excitation_tol must lie in (0, 1), got {tol}")
-    return float(tol)
-
-
 def _check_switching_times(switching_times, period):
     tsw = real_array(switching_times, "switching_times", ndim=(0, 1))
     tsw = np.atleast_1d(tsw)
@@ -390,22 +377,12 @@ def _records(t, x, u, period):
     records = []
     for j, (tj, xj, uj) in enumerate(triples):
         where = f"[{j}]" if multi else ""
-        tj = real_array(tj, f"t{where}", ndim=1)
-        xj = np.atleast_2d(real_array(xj, f"x{where}", ndim=(1, 2)))
-        uj = np.atleast_2d(real_array(uj, f"u{where}", ndim=(1, 2)))
+        tj, dt, (xj, uj) = time_record(tj, {f"x{where}": xj, f"u{where}": uj},
+                                       tname=f"t{where}", min_samples=3)
         L = tj.size
-        for name, arr in (("x", xj), ("u", uj)):
-            if arr.shape[1] != L:
-                raise ControlDimension(
-                    f"{name}{where} has {arr.shape[1]} samples but t{where} has {L}")
-        if L < 3:
-            raise ValueError(f"t{where} must hold at least 3 samples, got {L}")
         if not np.any(uj):
             raise ValueError(f"u{where} is identically zero: the record has no "
                              "excitation, so it carries no information on A(t) and B(t)")
-        dt = (tj[-1] - tj[0]) / (L - 1)
-        if dt <= 0 or np.max(np.abs(np.diff(tj) - dt)) > 1e-6 * dt:
-            raise ValueError(f"t{where} must be increasing and uniformly spaced")
         # a record closed by a repeated periodic sample drops its last sample
         nper = L * dt / period
         if abs(nper - round(nper)) > 1e-6 * nper:

@@ -1,6 +1,7 @@
 """Lifting of discrete-time LTP systems to LTI systems.
 
-Frequency lifting (thesis Section 4.2.4 with errata items 1-2).  With the
+Frequency lifting (thesis Section 4.2.4, corrected as in items 1-2 of the
+"Notes on the thesis" page).  With the
 DT Fourier coefficients ``M_l = (1/N) Σ_k M[k] w^{-lk}``, ``w = e^{j2π/N}``,
 and harmonics n (ascending), the harmonic balance of ``x[k+1] = A[k]x[k] +
 B[k]u[k]`` for ``u[k] = z^k Σ_m U_m w^{mk}`` gives
@@ -12,7 +13,7 @@ so ``z 𝒳 = Λ^{-1} 𝒜 𝒳 + Λ^{-1} ℬ 𝒰``, ``𝒴 = 𝒞 𝒳 + 𝒟 
 Toeplitz matrices and ``Λ = blkdiag(w^n I)`` (eqs. 4.69-4.73), whose
 transfer function is the DT HTF ``H(z) = 𝒞 (zΛ - 𝒜)^{-1} ℬ + 𝒟``.
 
-Real form (thesis Section 4.2.5, errata items 3-4): the unitary ``V`` with
+Real form (thesis Section 4.2.5, notes items 3-4): the unitary ``V`` with
 block columns ``c_0 = e_0``, ``c_n = (e_n + e_{-n})/√2``, ``s_n = j(e_n -
 e_{-n})/√2`` (and ``c_{N/2} = e_{N/2}`` for the self-conjugate Nyquist
 harmonic of even N) pairs ``X_{-n}`` with ``X_n`` as the exchange corners of
@@ -28,8 +29,7 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
-from ._ltpsys import LTPStateSpace
-from ._validation import check_kwargs, check_positive_int
+from ._validation import as_ltp, check_kwargs, check_positive_int
 
 __all__ = ['lift']
 
@@ -95,7 +95,9 @@ def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, start=
     For odd N every harmonic but 0 has a conjugate partner and the real
     form has the same size as the complex one; for even N the Nyquist
     harmonic N/2 (= -N/2) is self-conjugate and forms one real coordinate
-    of its own (errata item 4), so no extra ``U_{N/2}`` row is added.
+    of its own (:ref:`thesis-notes`, item 4), so no extra ``U_{N/2}`` row is
+    added.  The lifting is the one of [Uyanik2019]_ (thesis Section 4.2.4),
+    with the corrections of items 1-3 of that page.
 
     Examples
     --------
@@ -111,11 +113,7 @@ def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, start=
     np.float64(0.0625)
     """
     check_kwargs(kwargs, 'lift')
-    if not isinstance(sysd, LTPStateSpace):
-        raise ControlArgument(f"sysd must be an LTPStateSpace, got {type(sysd).__name__}")
-    if not sysd.isdtime(strict=True):
-        raise ValueError("sysd must be a discrete-time system (lift the result of "
-                         "sample_system); got a continuous-time one")
+    sysd = as_ltp(sysd, 'sysd', discrete=True)
     if method not in ('frequency', 'time'):
         raise ValueError(f"method must be 'frequency' or 'time', got {method!r}")
     if not isinstance(real, (bool, np.bool_)):

@@ -226,21 +226,24 @@ def cyclic_lyap(Phi, W, adjoint=False, check=True):
     K = np.einsum('kia,kjb->kijab', Phi, Phi).reshape(M, nn, nn)   # Φ ⊗ Φ
     if adjoint:
         K = np.swapaxes(K, 1, 2)                   # Φᵀ ⊗ Φᵀ
+    # column j = (c, b) of the block matrix holds 1 at row (c, b) (equation
+    # with unknown c as output) and column b of −K_k at row block r: the
+    # equation k with c as input, k = c, r = c + 1 (forward), or k = r = c − 1
     blocks = np.arange(M)
-    nxt = (blocks + 1) % M
-    # equation k: row block r_k, identity on x_{out}, −K_k on x_{in}
-    out_blk, in_blk = (blocks, nxt) if adjoint else (nxt, blocks)
-    row_blk = out_blk
+    k = blocks if not adjoint else (blocks - 1) % M
+    r = (blocks + 1) % M if not adjoint else k
     i = np.arange(nn)
-    shape = (M, nn, nn)
-    rows = np.concatenate([(row_blk[:, None] * nn + i).ravel(), np.broadcast_to(
-        row_blk[:, None, None] * nn + i[None, :, None], shape).ravel()])
-    cols = np.concatenate([(out_blk[:, None] * nn + i).ravel(), np.broadcast_to(
-        in_blk[:, None, None] * nn + i[None, None, :], shape).ravel()])
-    vals = np.concatenate([np.ones(M * nn), -K.ravel()])
-    L = sp.csc_matrix((vals, (rows, cols)), shape=(M * nn, M * nn))
-    rhs = np.empty(M * nn)
-    rhs[(row_blk[:, None] * nn + i).ravel()] = W.reshape(M, nn).ravel()
+    rows = np.empty((M, nn, nn + 1), int)
+    rows[:, :, 0] = blocks[:, None] * nn + i
+    rows[:, :, 1:] = (r[:, None] * nn + i)[:, None, :]
+    vals = np.empty((M, nn, nn + 1))
+    vals[:, :, 0] = 1.0
+    vals[:, :, 1:] = -np.swapaxes(K[k], 1, 2)
+    L = sp.csc_matrix((vals.ravel(), rows.ravel(), np.arange(M * nn + 1) * (nn + 1)),
+                      shape=(M * nn, M * nn))
+    L.sum_duplicates()                           # M = 1: the two blocks overlap
+    # equation k sits in the rows of its output block (k + 1, or k adjoint)
+    rhs = np.roll(W.reshape(M, nn), 0 if adjoint else 1, axis=0).ravel()
     X = spla.splu(L).solve(rhs).reshape(M, n, n)
     return 0.5 * (X + np.swapaxes(X, 1, 2))
 

@@ -31,7 +31,7 @@ from control.exception import ControlArgument
 
 from ._lyapunov import cyclic_lyap, periodic_solution
 from ._periodic_matrix import PeriodicMatrix
-from ._steps import step_grid, step_integrals
+from ._steps import gram_weight, step_grid, step_integrals
 from ._transition import step_transitions
 
 __all__ = ['norm']
@@ -143,7 +143,7 @@ def _h2(sys, nsteps, print_warning):
         return 0.0
     grid = step_grid(sys.A, [sys.B, sys.C], nsteps)
     Phi, W, V, S = step_integrals(sys.A, grid[:-1], np.diff(grid),
-                                  Qf=sys.B @ sys.B.T, Qa=sys.C.T @ sys.C)
+                                  Qf=gram_weight(sys.B), Qa=gram_weight(sys.C, True))
     _require_stable(Phi, 2)
     Xo = cyclic_lyap(Phi, V, adjoint=True, check=False)
     total = np.einsum('kij,kji->', np.roll(Xo, -1, axis=0), W) + S.sum()
@@ -182,7 +182,7 @@ def _hankel(sys, nsteps):
         Q = cyclic_lyap(A, np.swapaxes(C, 1, 2) @ C, adjoint=True, check=False)
         return float(np.sqrt(max(_lam_max(P, Q).max(), 0.0)))
     A, T = sys.A, sys.period
-    Qf, Qa = sys.B @ sys.B.T, sys.C.T @ sys.C
+    Qf, Qa = gram_weight(sys.B), gram_weight(sys.C, True)
     grid = step_grid(A, [sys.B, sys.C], nsteps)
     Phi, W, V, _ = step_integrals(A, grid[:-1], np.diff(grid), Qf=Qf, Qa=Qa)
     _require_stable(Phi, 'hankel')
@@ -335,9 +335,8 @@ def _unit_circle_angles(sys, gamma, grid, values):
     """Angles of the unit-circle multipliers of H_γ, or None if there are none."""
     from ._floquet import _log_multipliers
     H = _hamiltonian(sys, gamma, values)
-    zero = PeriodicMatrix.constant(np.zeros((H.shape[0], 0)), sys.period)
     # the test needs the multipliers' moduli to well below _UNIT only
-    Phi, _, _ = step_transitions(H, zero, grid[:-1], np.diff(grid), rtol=1e-9)
+    Phi, _, _ = step_transitions(H, None, grid[:-1], np.diff(grid), rtol=1e-9)
     logmod, arg = _log_multipliers(None, None, grid=grid, factors=Phi)
     on = np.abs(logmod) < _UNIT
     return arg[on] if np.any(on) else None

@@ -15,10 +15,11 @@ See the Conventions page of the documentation for the Fourier scaling.
 """
 
 import numbers
+import warnings
 
 import numpy as np
 
-from ._validation import check_period, check_positive_int, real_array
+from ._validation import check_period, check_positive_int, commensurate, real_array
 
 __all__ = ['PeriodicMatrix']
 
@@ -304,6 +305,17 @@ class PeriodicMatrix:
                 self._coeffs.shape[0]) != self._coeffs.shape[0] // 2]))
 
     @property
+    def _piecewise_constant(self):
+        """True when the matrix is constant between its breakpoints (by its form)."""
+        if self._coeffs is not None:
+            return self.is_constant
+        if self._pieces is not None:
+            return all(p._piecewise_constant for p in self._pieces)
+        # pointwise combinations of piecewise-constant operands
+        return self._combine is not None and all(o._piecewise_constant
+                                                  for o in self._combine[1])
+
+    @property
     def nharmonics(self):
         """Number K of harmonics of an exact Fourier form, else None."""
         return None if self._coeffs is None else self._coeffs.shape[0] // 2
@@ -444,7 +456,6 @@ class PeriodicMatrix:
                 return coeffs
             previous = coeffs
             nsamp *= 2
-        import warnings
         warnings.warn("Fourier coefficients of the callable did not converge; "
                       "for a matrix with jumps use PeriodicMatrix.switching",
                       UserWarning, stacklevel=3)
@@ -505,7 +516,7 @@ class PeriodicMatrix:
             other_period = self.period
         else:
             other_period = other.period
-        period = _common_period(self.period, other_period)
+        period = commensurate(self.period, other_period)
         a, b = self.with_period(period), other.with_period(period)
         if a._coeffs is not None and b._coeffs is not None:
             return PeriodicMatrix(fourier_op(a._coeffs, b._coeffs), period)
@@ -604,7 +615,7 @@ class PeriodicMatrix:
                                                      for r in rows]), 1.0)
         period = periods[0]
         for p in periods[1:]:
-            period = _common_period(period, p)
+            period = commensurate(period, p)
         mats = [[m.with_period(period) if isinstance(m, PeriodicMatrix)
                  else PeriodicMatrix.constant(m, period) for m in row] for row in rows]
         operands = [m for row in mats for m in row]
@@ -661,11 +672,6 @@ def _as_matrix(value, name):
 
 def _is_operand(x):
     return isinstance(x, (PeriodicMatrix, numbers.Real, np.ndarray, list))
-
-
-def _common_period(a, b):
-    from ._validation import commensurate
-    return commensurate(a, b)
 
 
 def _call_vectorised(func, t, shape):

@@ -18,8 +18,10 @@ blocks of the transition matrix Ψ of the block upper-triangular generator
     M(t) = [[-Aᵀ, Qa, 0], [0, A, Qf], [0, 0, -Aᵀ]]:
     Φ = Ψ22,  W = Ψ23 Φᵀ,  V = Φᵀ Ψ12,  S = tr(Φᵀ Ψ13),
 
-computed by the library's Magnus integrator (`_transition.step_transitions`)
-for every step at once.  Only the blocks that are asked for are built.
+computed by the library's integrator (`_transition.step_transitions`: one
+exponential per segment when A and the weights are piecewise constant,
+Magnus otherwise) for every step at once, with M evaluated block by block
+at the integrator's nodes.  Only the blocks that are asked for are built.
 The steps are short (``h ‖A‖ <= 1`` by default), so the growing blocks
 ``e^{-Aᵀh}`` stay moderate even for stiff A.
 """
@@ -51,7 +53,9 @@ def step_grid(A, others=(), nsteps=None):
     breaks = np.unique(np.mod(np.concatenate(
         [A.breakpoints] + [M.breakpoints for M in others]), T))
     if nsteps is None:
-        probe = np.concatenate([np.arange(256) * T / 256, breaks])
+        # a piecewise-constant A takes all its values at 0 and the breakpoints
+        probe = np.concatenate([[0.0] if A._piecewise_constant else np.arange(256) * T / 256,
+                                breaks])
         norm = np.max(np.linalg.norm(A(probe), ord=2, axis=(1, 2)), initial=0.0)
         nsteps = int(np.clip(np.ceil(T * norm), 16, 4096))
     else:
@@ -64,6 +68,24 @@ def step_grid(A, others=(), nsteps=None):
     grid = grid[np.concatenate([np.diff(grid) > 0, [True]])]
     grid[-1] = T
     return grid
+
+
+def gram_weight(F, adjoint=False):
+    """``F Fᵀ`` (``Fᵀ F`` when `adjoint`) of a periodic matrix, pointwise.
+
+    Examples
+    --------
+    >>> from ltpcontrol._steps import gram_weight
+    >>> C = ltp.PeriodicMatrix.constant([[1.0, 2.0]], 1.0)
+    >>> gram_weight(C, adjoint=True)(0.0)
+    array([[1., 2.],
+           [2., 4.]])
+    """
+    if adjoint:
+        n, op = F.shape[1], lambda f: np.swapaxes(f, 1, 2) @ f
+    else:
+        n, op = F.shape[0], lambda f: f @ np.swapaxes(f, 1, 2)
+    return PeriodicMatrix._new(F.period, (n, n), combine=(op, [F]), breakpoints=F.breakpoints)
 
 
 def step_integrals(A, t0, h, Qf=None, Qa=None):
@@ -95,18 +117,27 @@ def step_integrals(A, t0, h, Qf=None, Qa=None):
     (True, None, None)
     """
     n = A.shape[0]
-    Z = np.zeros((n, n))
-    At = -A.T
-    # rows/cols of the 3n generator that are needed: [adjoint, state, forward]
-    use = [Qa is not None, True, Qf is not None]
-    full = [[At, Qa if Qa is not None else Z, Z],
-            [Z, A, Qf if Qf is not None else Z],
-            [Z, Z, At]]
-    keep = [i for i in range(3) if use[i]]
-    M = PeriodicMatrix.block([[full[i][j] for j in keep] for i in keep])
-    zero = PeriodicMatrix.constant(np.zeros((M.shape[0], 0)), M.period)
-    Psi, _, _ = step_transitions(M, zero, np.asarray(t0, float), np.asarray(h, float))
+    # blocks of the 3n generator that are needed: [adjoint, state, forward]
+    keep = [i for i, Q in enumerate((Qa, A, Qf)) if Q is not None]
     blk = {k: slice(j * n, (j + 1) * n) for j, k in enumerate(keep)}
+    weights = [Q.with_period(A.period) for Q in (Qa, Qf) if Q is not None]
+
+    def generator(a, *q):
+        # M(t) at the integrator's nodes
+        out = np.zeros((len(a), len(keep) * n, len(keep) * n))
+        out[:, blk[1], blk[1]] = a
+        q = iter(q)
+        if Qa is not None:
+            out[:, blk[0], blk[0]] = -np.swapaxes(a, 1, 2)
+            out[:, blk[0], blk[1]] = next(q)
+        if Qf is not None:
+            out[:, blk[2], blk[2]] = -np.swapaxes(a, 1, 2)
+            out[:, blk[1], blk[2]] = next(q)
+        return out
+    M = PeriodicMatrix._new(A.period, (len(keep) * n,) * 2, combine=(generator, [A] + weights),
+                            breakpoints=np.concatenate([A.breakpoints] +
+                                                       [Q.breakpoints for Q in weights]))
+    Psi, _, _ = step_transitions(M, None, np.asarray(t0, float), np.asarray(h, float))
     Phi = Psi[:, blk[1], blk[1]]
     W = V = S = None
     if Qf is not None:

@@ -16,13 +16,12 @@ import warnings
 
 import numpy as np
 import control as ct
-from control.exception import ControlArgument, ControlDimension
+from control.exception import ControlDimension
 from scipy.integrate import solve_ivp
 
-from ._ltpsys import LTPStateSpace
 from ._march import periodic_march
 from ._transition import step_transitions
-from ._validation import check_kwargs, real_array
+from ._validation import as_ltp, check_kwargs, check_positive, real_array
 
 __all__ = ['forced_response', 'step_response', 'initial_response', 'impulse_response']
 
@@ -75,7 +74,7 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
     True
     """
     check_kwargs(kwargs, 'forced_response')
-    sys = _check_system(sys)
+    sys = as_ltp(sys, lti_hint='control.forced_response')
     t = _time_vector(sys, timepts)
     u, ntraces = _input_array(sys, inputs, len(t))
     x0 = _initial_state(sys, initial_state, ntraces)
@@ -92,8 +91,9 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
 
 
 def step_response(sys, timepts=None, initial_state=0.0, input_indices=None,
-                  output_indices=None, *, return_states=False, squeeze=None,
-                  transpose=False, **kwargs):
+                  output_indices=None, *, method='transition', input_hold='foh',
+                  rtol=1e-12, return_states=False, squeeze=None, transpose=False,
+                  **kwargs):
     """Step response of an LTP system, one trace per input.
 
     The step is applied at the first time point; for an LTP system the
@@ -110,10 +110,10 @@ def step_response(sys, timepts=None, initial_state=0.0, input_indices=None,
         Initial state.
     input_indices, output_indices : int or list of int, optional
         Inputs to step and outputs to keep (default all).
+    method, input_hold, rtol : optional
+        As in `forced_response`.
     return_states, squeeze, transpose : bool, optional
         As in `control.step_response`.
-    **kwargs
-        `method`, `input_hold` and `rtol` as in `forced_response`.
 
     Returns
     -------
@@ -127,7 +127,8 @@ def step_response(sys, timepts=None, initial_state=0.0, input_indices=None,
     >>> round(float(resp.outputs[-1]), 3)
     1.0
     """
-    sys = _check_system(sys)
+    check_kwargs(kwargs, 'step_response')
+    sys = as_ltp(sys, lti_hint='control.step_response')
     t = _time_vector(sys, timepts)
     ins = _indices(input_indices, sys.ninputs, 'input_indices')
     outs = _indices(output_indices, sys.noutputs, 'output_indices')
@@ -135,11 +136,13 @@ def step_response(sys, timepts=None, initial_state=0.0, input_indices=None,
     for trace, i in enumerate(ins):
         u[i, trace] = 1.0
     x0 = _initial_state(sys, initial_state, len(ins))
-    return _trace_response(sys, t, u, x0, ins, outs, 'step', 'Step response',
-                           return_states, squeeze, transpose, kwargs)
+    x, y = _simulate(sys, t, u, x0, method, input_hold, rtol)
+    return _trace_response(sys, t, u, x, y, ins, outs, 'step', 'Step response',
+                           return_states, squeeze, transpose)
 
 
 def initial_response(sys, timepts=None, initial_state=0.0, output_indices=None, *,
+                     method='transition', input_hold='foh', rtol=1e-12,
                      return_states=False, squeeze=None, transpose=False, **kwargs):
     """Free response of an LTP system from an initial state.
 
@@ -153,10 +156,10 @@ def initial_response(sys, timepts=None, initial_state=0.0, output_indices=None, 
         Initial state at the first time point.
     output_indices : int or list of int, optional
         Outputs to keep (default all).
+    method, input_hold, rtol : optional
+        As in `forced_response`.
     return_states, squeeze, transpose : bool, optional
         As in `control.initial_response`.
-    **kwargs
-        `method`, `input_hold` and `rtol` as in `forced_response`.
 
     Returns
     -------
@@ -169,12 +172,14 @@ def initial_response(sys, timepts=None, initial_state=0.0, output_indices=None, 
     >>> bool(np.isclose(resp.outputs[-1], 2 * np.exp(-1)))
     True
     """
-    sys = _check_system(sys)
+    check_kwargs(kwargs, 'initial_response')
+    sys = as_ltp(sys, lti_hint='control.initial_response')
     t = _time_vector(sys, timepts)
     outs = _indices(output_indices, sys.noutputs, 'output_indices')
     resp = forced_response(sys, t, np.zeros((sys.ninputs, len(t))), initial_state,
                            return_states=return_states, squeeze=squeeze,
-                           transpose=transpose, **kwargs)
+                           transpose=transpose, method=method, input_hold=input_hold,
+                           rtol=rtol)
     if len(outs) == sys.noutputs:
         return resp
     return ct.TimeResponseData(
@@ -185,6 +190,7 @@ def initial_response(sys, timepts=None, initial_state=0.0, output_indices=None, 
 
 
 def impulse_response(sys, timepts=None, input_indices=None, output_indices=None, *,
+                     method='transition', input_hold='foh', rtol=1e-12,
                      return_states=False, squeeze=None, transpose=False, **kwargs):
     """Impulse response of an LTP system, one trace per input.
 
@@ -201,10 +207,10 @@ def impulse_response(sys, timepts=None, input_indices=None, output_indices=None,
         Time points (default as in `step_response`).
     input_indices, output_indices : int or list of int, optional
         Inputs to excite and outputs to keep (default all).
+    method, input_hold, rtol : optional
+        As in `forced_response`.
     return_states, squeeze, transpose : bool, optional
         As in `control.impulse_response`.
-    **kwargs
-        `method`, `input_hold` and `rtol` as in `forced_response`.
 
     Returns
     -------
@@ -217,7 +223,8 @@ def impulse_response(sys, timepts=None, input_indices=None, output_indices=None,
     >>> bool(np.isclose(resp.outputs[-1], np.exp(-1)))
     True
     """
-    sys = _check_system(sys)
+    check_kwargs(kwargs, 'impulse_response')
+    sys = as_ltp(sys, lti_hint='control.impulse_response')
     t = _time_vector(sys, timepts)
     ins = _indices(input_indices, sys.ninputs, 'input_indices')
     outs = _indices(output_indices, sys.noutputs, 'output_indices')
@@ -231,8 +238,9 @@ def impulse_response(sys, timepts=None, input_indices=None, output_indices=None,
             warnings.warn("the system has direct feedthrough D(t0) != 0: the impulse in "
                           "the output at t0 is not shown", UserWarning, stacklevel=2)
         x0 = sys.B(t[0])[:, ins]
-    return _trace_response(sys, t, u, x0, ins, outs, 'impulse', 'Impulse response',
-                           return_states, squeeze, transpose, kwargs)
+    x, y = _simulate(sys, t, u, x0, method, input_hold, rtol)
+    return _trace_response(sys, t, u, x, y, ins, outs, 'impulse', 'Impulse response',
+                           return_states, squeeze, transpose)
 
 
 #
@@ -245,7 +253,7 @@ def _simulate(sys, t, u, x0, method, hold, rtol):
         raise ValueError(f"method must be 'transition' or 'solve_ivp', got {method!r}")
     if hold not in ('foh', 'zoh'):
         raise ValueError(f"input_hold must be 'foh' or 'zoh', got {hold!r}")
-    rtol = _check_rtol(rtol)
+    rtol = check_positive(rtol, 'rtol', below=1)
     if sys.isdtime():
         return _march_discrete(sys, t, u, x0)
     if method == 'solve_ivp':
@@ -337,15 +345,6 @@ def _outputs(sys, t, x, u):
 # Argument processing
 #
 
-def _check_system(sys):
-    if isinstance(sys, (ct.StateSpace, ct.TransferFunction)):
-        raise ControlArgument("sys is an LTI system: use control.forced_response, or "
-                              "convert it with ltpss(sys, period)")
-    if not isinstance(sys, LTPStateSpace):
-        raise ControlArgument(f"sys must be an LTPStateSpace, got {type(sys).__name__}")
-    return sys
-
-
 def _time_vector(sys, timepts):
     if timepts is None:
         timepts = _default_final_time(sys)
@@ -410,14 +409,6 @@ def _initial_state(sys, x0, ntraces):
     return x0.copy()
 
 
-def _check_rtol(rtol):
-    if isinstance(rtol, bool) or not isinstance(rtol, (int, float, np.floating)):
-        raise ControlArgument(f"rtol must be a positive number, got {rtol!r}")
-    if not 0 < rtol < 1:
-        raise ValueError(f"rtol must lie in (0, 1), got {rtol}")
-    return float(rtol)
-
-
 def _indices(spec, count, name):
     if spec is None:
         return list(range(count))
@@ -428,13 +419,8 @@ def _indices(spec, count, name):
     return [int(i) for i in spec]
 
 
-def _trace_response(sys, t, u, x0, ins, outs, trace_type, title, return_states,
-                    squeeze, transpose, kwargs):
-    method = kwargs.pop('method', 'transition')
-    hold = kwargs.pop('input_hold', 'foh')
-    rtol = kwargs.pop('rtol', 1e-12)
-    check_kwargs(kwargs, title.split()[0].lower() + '_response')
-    x, y = _simulate(sys, t, u, x0, method, hold, rtol)
+def _trace_response(sys, t, u, x, y, ins, outs, trace_type, title, return_states,
+                    squeeze, transpose):
     y = y[outs]
     return ct.TimeResponseData(
         t, y, x, u, issiso=len(outs) == 1 and len(ins) == 1,

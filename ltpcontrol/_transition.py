@@ -15,7 +15,9 @@ It is computed with the fourth-order Magnus integrator
 
 on m sub-steps of each smooth piece (switching instants split a step), with m
 doubled until two resolutions agree (the Richardson-extrapolated value is
-returned).  Everything is vectorised over steps.
+returned).  Without input, when A is constant between its switching
+instants (its form says so), each segment is exactly ``e^{A h}``: one
+matrix exponential, no sub-steps.  Everything is vectorised over steps.
 """
 
 import warnings
@@ -32,8 +34,10 @@ def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=4096):
 
     Parameters
     ----------
-    A, B : PeriodicMatrix
-        System matrices (B may have zero columns).
+    A : PeriodicMatrix
+        State matrix.
+    B : PeriodicMatrix or None
+        Input matrix (None or zero columns: no input).
     t0, h : ndarray
         Step starts and lengths (1D, same length).
     rtol : float
@@ -55,50 +59,59 @@ def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=4096):
     """
     t0 = np.asarray(t0, float)
     h = np.broadcast_to(np.asarray(h, float), t0.shape)
-    n, m = A.shape[0], B.shape[1]
+    n, m = A.shape[0], 0 if B is None else B.shape[1]
     # split every step at the switching instants that fall inside it
-    seg_step, seg_a, seg_b = _segments(t0, h, _breakpoints(A, B), A.period)
-    E = _segment_transitions(A, B, seg_a, seg_b, t0[seg_step], h[seg_step],
-                             rtol, max_substeps)
-    # compose segments of each step in time order: E_step = E_last ... E_first
-    d = n + 2 * m
-    out = np.broadcast_to(np.eye(d), (len(t0), d, d)).copy()
-    order = np.lexsort((seg_a, seg_step))
-    pos = np.zeros(len(seg_step), int)
-    counts = np.bincount(seg_step, minlength=len(t0))
-    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    pos[order] = np.arange(len(order)) - np.repeat(starts, counts)
-    for j in range(int(pos.max()) + 1 if len(pos) else 0):
-        sel = order[pos[order] == j]
-        out[seg_step[sel]] = E[sel] @ out[seg_step[sel]]
-    return out[:, :n, :n], out[:, :n, n:n + m], out[:, :n, n + m:]
-
-
-def _breakpoints(A, B):
-    # switching instants of A and B within one period of A
-    return np.unique(np.mod(np.concatenate([A.breakpoints, B.breakpoints]), A.period))
+    bps = A.breakpoints if B is None else np.concatenate([A.breakpoints, B.breakpoints])
+    seg_step, seg_a, seg_b = _segments(t0, h, np.unique(np.mod(bps, A.period)), A.period)
+    if m == 0 and A._piecewise_constant:
+        # A is constant on every segment: the transition is e^{A h}
+        E = expm_batch((seg_b - seg_a)[:, None, None] * A._eval(0.5 * (seg_a + seg_b)))
+    else:
+        E = _segment_transitions(A, B, seg_a, seg_b, t0[seg_step], h[seg_step],
+                                 rtol, max_substeps)
+    if len(seg_step) > len(t0):
+        # compose the segments of each step in time order: E_last ... E_first
+        d = n + 2 * m
+        out = np.broadcast_to(np.eye(d), (len(t0), d, d)).copy()
+        counts = np.bincount(seg_step, minlength=len(t0))
+        pos = np.arange(len(seg_step)) - np.repeat(np.cumsum(counts) - counts, counts)
+        for j in range(int(pos.max()) + 1):
+            sel = pos == j
+            out[seg_step[sel]] = E[sel] @ out[seg_step[sel]]
+        E = out
+    return E[:, :n, :n], E[:, :n, n:n + m], E[:, :n, n + m:]
 
 
 def _segments(t0, h, bps, period):
-    """Split each step at the switching instants ``bps + j T`` inside it."""
+    """Split each step at the switching instants ``bps + j T`` inside it.
+
+    Returns the step index, start and end of every segment, steps in order
+    and the segments of a step in time order.
+    """
+    nstep = len(t0)
     if bps.size == 0:
-        idx = np.arange(len(t0))
+        idx = np.arange(nstep)
         return idx, t0.copy(), t0 + h
-    steps, starts, ends = [], [], []
-    for k, (a, hk) in enumerate(zip(t0, h)):
-        b = a + hk
-        shifts = np.arange(np.floor(a / period), np.floor(b / period) + 1) * period
-        cand = (bps[None, :] + shifts[:, None]).ravel()
-        tol = 1e-12 * max(1.0, abs(b))
-        pts = np.concatenate([[a], np.sort(cand[(cand > a + tol) & (cand < b - tol)]), [b]])
-        steps.extend([k] * (len(pts) - 1))
-        starts.extend(pts[:-1])
-        ends.extend(pts[1:])
-    return np.array(steps), np.array(starts), np.array(ends)
+    b = t0 + h
+    # candidates bps[i] + j T for the periods j0..j1 each step touches
+    j0, j1 = np.floor(t0 / period), np.floor(b / period)
+    count = ((j1 - j0 + 1) * bps.size).astype(int)
+    step = np.repeat(np.arange(nstep), count)
+    g = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+    cand = bps[g % bps.size] + (j0[step] + g // bps.size) * period
+    tol = 1e-12 * np.maximum(1.0, np.abs(b))
+    inside = (cand > t0[step] + tol[step]) & (cand < b[step] - tol[step])
+    # every step's points [t0, inner instants..., t0 + h], grouped by step
+    key = np.concatenate([np.arange(nstep), step[inside], np.arange(nstep)])
+    pts = np.concatenate([t0, cand[inside], b])
+    order = np.argsort(key, kind='stable')
+    key, pts = key[order], pts[order]
+    same = key[:-1] == key[1:]
+    return key[:-1][same], pts[:-1][same], pts[1:][same]
 
 
 def _segment_transitions(A, B, a, b, step_t0, step_h, rtol, max_substeps):
-    n, m = A.shape[0], B.shape[1]
+    n, m = A.shape[0], 0 if B is None else B.shape[1]
     d = n + 2 * m
     nsub = 2
     prev = None
@@ -125,15 +138,15 @@ def _magnus(A, B, a, b, step_t0, step_h, nsub, n, m, d):
     starts = a[:, None] + delta[:, None] * np.arange(nsub)   # (S, nsub)
     nodes = np.stack([starts + _C1 * delta[:, None], starts + _C2 * delta[:, None]], -1)
     tflat = nodes.ravel()
-    if not m:
-        Mt = A._eval(tflat)
-    else:
+    if m:
         Mt = np.zeros((tflat.size, d, d))
         Mt[:, :n, :n] = A._eval(tflat)
         Bt = B._eval(tflat)
         sigma = ((nodes - step_t0[:, None, None]) / step_h[:, None, None]).ravel()
         Mt[:, :n, n:n + m] = Bt
         Mt[:, :n, n + m:] = sigma[:, None, None] * Bt
+    else:
+        Mt = A._eval(tflat)
     Mt = Mt.reshape(nseg, nsub, 2, d, d)
     M1, M2 = Mt[:, :, 0], Mt[:, :, 1]
     dl = delta[:, None, None, None]

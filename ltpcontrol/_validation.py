@@ -2,15 +2,77 @@
 
 Each helper raises python-control's exceptions (`ControlDimension` is a
 `ValueError`, `ControlArgument` a `TypeError`) or a builtin with a message
-that names the offending argument.
+that names the offending argument.  There is one helper per concept:
+
+- `as_ltp`: a system argument (an `LTPStateSpace`, or an LTI system given a period),
+- `check_period`: a period; `check_positive`: any other positive quantity
+  (``dt``, ``Ts``, durations, frequencies, tolerances),
+- `check_positive_int`: counts and orders,
+- `real_array`: numeric arrays,
+- `time_record`: a uniformly sampled time record and its signals (one tolerance,
+  `TIME_RTOL`).
 """
 
 import numbers
 
+import control as ct
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
 __all__ = []
+
+#: Relative deviation of the sample steps from their mean below which a time
+#: vector counts as uniformly sampled.
+TIME_RTOL = 1e-6
+
+
+def as_ltp(sys, name="sys", *, period=None, discrete=None, lti_hint=None):
+    """Return `sys` as an `LTPStateSpace`, or raise naming the argument.
+
+    Parameters
+    ----------
+    sys : LTPStateSpace or control.StateSpace or control.TransferFunction
+        The system argument.
+    name : str
+        Argument name used in error messages.
+    period : float, optional
+        If given, an LTI `sys` is converted with ``ltpss(sys, period)``;
+        passing it with an `LTPStateSpace` is an error.
+    discrete : bool, optional
+        Require a discrete-time (True) or continuous-time (False) system.
+    lti_hint : str, optional
+        The python-control function to suggest when `sys` is LTI and no
+        `period` is given.
+
+    Examples
+    --------
+    >>> from ltpcontrol._validation import as_ltp
+    >>> as_ltp(ct.ss(-1, 1, 1, 0), period=2.0).period
+    2.0
+    >>> as_ltp(ct.ss(-1, 1, 1, 0), lti_hint='control.forced_response')
+    Traceback (most recent call last):
+    ...
+    control.exception.ControlArgument: sys is an LTI system: use control.forced_response, or convert it with ltpss(sys, period)
+    """
+    # _ltpsys imports this module: the system class is looked up at call time
+    from ._ltpsys import LTPStateSpace, ltpss
+    if isinstance(sys, LTPStateSpace):
+        if period is not None:
+            raise TypeError(f"the period is taken from the LTPStateSpace {name}; "
+                            "do not pass period")
+    elif isinstance(sys, (ct.StateSpace, ct.TransferFunction)):
+        if period is None:
+            use = f"use {lti_hint}, or " if lti_hint else ""
+            raise ControlArgument(f"{name} is an LTI system: {use}convert it with "
+                                  "ltpss(sys, period)")
+        sys = ltpss(sys, check_period(period))
+    else:
+        raise ControlArgument(f"{name} must be an LTPStateSpace, got {type(sys).__name__}")
+    if discrete is not None and sys.isdtime(strict=True) != discrete:
+        kind = "discrete" if discrete else "continuous"
+        raise ValueError(f"{name} must be a {kind}-time system, got a "
+                         f"{'continuous' if discrete else 'discrete'}-time one")
+    return sys
 
 
 def check_kwargs(kwargs, where):
@@ -28,8 +90,35 @@ def check_kwargs(kwargs, where):
         raise TypeError(f"{where}: unrecognized keyword(s): {sorted(kwargs)}")
 
 
+def check_positive(value, name, below=None):
+    """Return `value` as a positive finite float (less than `below` if given).
+
+    For sample times, durations, frequencies and tolerances; periods go
+    through `check_period`.
+
+    Examples
+    --------
+    >>> from ltpcontrol._validation import check_positive
+    >>> check_positive(0.01, 'dt')
+    0.01
+    >>> check_positive(0, 'Ts')
+    Traceback (most recent call last):
+    ...
+    ValueError: Ts must be positive and finite, got 0.0
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(
+            value, (numbers.Real, np.floating, np.integer)):
+        raise ControlArgument(f"{name} must be a real number, got {value!r}")
+    value = float(value)
+    if not np.isfinite(value) or value <= 0:
+        raise ValueError(f"{name} must be positive and finite, got {value}")
+    if below is not None and value >= below:
+        raise ValueError(f"{name} must lie in (0, {below}), got {value}")
+    return value
+
+
 def check_period(period, name="period"):
-    """Return `period` as a positive finite float.
+    """Return the period `period` as a positive finite float.
 
     Examples
     --------
@@ -37,13 +126,7 @@ def check_period(period, name="period"):
     >>> check_period(2)
     2.0
     """
-    if isinstance(period, (bool, np.bool_)) or not isinstance(
-            period, (numbers.Real, np.floating, np.integer)):
-        raise ControlArgument(f"{name} must be a real number, got {period!r}")
-    period = float(period)
-    if not np.isfinite(period) or period <= 0:
-        raise ValueError(f"{name} must be positive and finite, got {period}")
-    return period
+    return check_positive(period, name)
 
 
 def check_positive_int(value, name, minimum=1):
@@ -145,3 +228,52 @@ def steps_per_period(period, dt, name="dt"):
         raise ValueError(f"{name}={dt} does not divide the period {period} into an "
                          f"integer number of steps (period/{name} = {ratio})")
     return nsteps
+
+
+def time_record(t, signals, *, tname="t", min_samples=2):
+    """Parse one uniformly sampled time record.
+
+    Parameters
+    ----------
+    t : array_like, shape (L,)
+        Sample times, increasing and uniformly spaced to within `TIME_RTOL`
+        of the mean step.
+    signals : dict
+        ``{name: array_like}``; each array has shape (k, L), or (L,) for one
+        channel.
+    tname : str
+        Name of the time argument in error messages.
+    min_samples : int
+        Fewest samples accepted.
+
+    Returns
+    -------
+    t : ndarray, shape (L,)
+    dt : float
+        Mean sample step ``(t[-1] - t[0]) / (L - 1)``.
+    arrays : list of ndarray, each (k, L)
+        The signals, in the order of `signals`.
+
+    Examples
+    --------
+    >>> from ltpcontrol._validation import time_record
+    >>> t, dt, (u,) = time_record([0.0, 0.5, 1.0], {'u': [1, 2, 3]})
+    >>> dt, u.shape
+    (0.5, (1, 3))
+    >>> time_record([0.0, 0.5, 1.5], {'u': [1, 2, 3]})
+    Traceback (most recent call last):
+    ...
+    ValueError: t must be increasing and uniformly spaced
+    """
+    t = real_array(t, tname, ndim=1)
+    arrays = [np.atleast_2d(real_array(x, name, ndim=(1, 2))) for name, x in signals.items()]
+    L = t.size
+    for name, arr in zip(signals, arrays):
+        if arr.shape[1] != L:
+            raise ControlDimension(f"{name} has {arr.shape[1]} samples but {tname} has {L}")
+    if L < min_samples:
+        raise ValueError(f"{tname} must hold at least {min_samples} samples, got {L}")
+    dt = (t[-1] - t[0]) / (L - 1) if L > 1 else 0.0
+    if L > 1 and (dt <= 0 or np.max(np.abs(np.diff(t) - dt)) > TIME_RTOL * dt):
+        raise ValueError(f"{tname} must be increasing and uniformly spaced")
+    return t, float(dt), arrays

@@ -320,9 +320,9 @@ def test_too_little_data():
 
 
 def test_rank_deficient_warns():
-    # 2 identical records: 20 equations, rank 10 < 12 unknowns
+    # 2 identical records, 5 shifts each: 20 equations, rank 10 < 12 unknowns
     with pytest.warns(UserWarning, match="rank deficient"):
-        res = hybrid_ls(*one_sine(2), 1.0, [0, 0.5], 1)
+        res = hybrid_ls(*one_sine(2), 1.0, [0, 0.5], 1, nshifts=2)
     assert res.rank < res.nunknowns
 
 
@@ -408,3 +408,32 @@ def test_result_validation():
         HybridLSResult(A[0], B, 1.0, [0, 0.5])
     with pytest.raises(ValueError, match="period"):
         HybridLSResult(A, B, 0.0, [0, 0.5])
+
+
+def test_default_nshifts_identifies_switching_input_matrix():
+    # x' = a_i x + b_i u with both a and b switching at mid-period, modelled with
+    # K = 1: the B^i_k columns span only 2h+1 shifts, so 2h+1 >= M(2K+1) = 6
+    # and the default must be h = 3, not 2
+    period, a, b = 1.0, (-1.0, -3.0), (1.0, 2.0)
+    Afuns = [lambda s, i=i: np.array([[a[i]]]) for i in range(2)]
+    Bfuns = [lambda s, i=i: np.array([[b[i]]]) for i in range(2)]
+    freqs = np.array([0.3, 0.7, 1.3])
+
+    def ufun(s):
+        return np.sin(2 * np.pi * freqs * s)[:, None]
+
+    t = np.arange(10000) / 1000.0
+    x = steady_state(Afuns, Bfuns, [0, 0.5], period, ufun, t, 10.0)
+    u = [np.sin(2 * np.pi * f * t) for f in freqs]
+    B_true, A_true = np.zeros((2, 3)), np.zeros((2, 3))
+    B_true[:, 1], A_true[:, 1] = b, a
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = hybrid_ls([t] * 3, list(x), u, period, [0, 0.5], 1)
+    assert res.rank == res.nunknowns == 12
+    np.testing.assert_allclose(res.B[:, :, 0, 0], B_true, atol=1e-4)
+    np.testing.assert_allclose(res.A[:, :, 0, 0], A_true, atol=1e-4)
+    # the former default h = 2 is rank deficient and misses B by far more
+    with pytest.warns(UserWarning, match="rank deficient"):
+        bad = hybrid_ls([t] * 3, list(x), u, period, [0, 0.5], 1, nshifts=2)
+    assert np.abs(bad.B[:, :, 0, 0] - B_true).max() > 1e-2

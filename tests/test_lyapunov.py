@@ -171,3 +171,13 @@ def test_lyap_bad_input():
         ltp.gram(unstable, 'c')
     with pytest.raises(ValueError, match="type must be"):
         ltp.gram(ltp.ltpss([[-0.5]], [[1.0]], [[1.0]], 0, period=1.0), 'x')
+
+
+@pytest.mark.parametrize('adjoint', [False, True])
+def test_dlyap_single_step_equals_python_control(adjoint):
+    # N = 1: the identity and the Kronecker block share the diagonal block
+    A = 0.3 * RNG.standard_normal((3, 3))
+    Q = np.eye(3) + 0.1 * np.ones((3, 3))
+    ref = ct.dlyap(A.T, Q) if adjoint else ct.dlyap(A, Q)
+    X = ltp.dlyap(A[None], Q[None], adjoint=adjoint)
+    assert np.abs(X[0] - ref).max() <= 1e-12 * np.abs(ref).max()
