@@ -375,8 +375,7 @@ def _stack(X):
 
 
 def _flow(H, t0, h):
-    zero = PeriodicMatrix.constant(np.zeros((H.shape[0], 0)), H.period)
-    Psi, _, _ = step_transitions(H, zero, np.asarray(t0, float), np.asarray(h, float))
+    Psi, _, _ = step_transitions(H, None, np.asarray(t0, float), np.asarray(h, float))
     return Psi
 
 
