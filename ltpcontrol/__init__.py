@@ -33,6 +33,8 @@ from ._canonical import to_canonical, matrix_errors, MatrixErrors
 from ._canonical import compare_ltp, LTPComparison
 from ._structure import select_structure, StructureSelection
 from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
+from ._arx import identify_arx
+from ._closed_loop import ClosedLoopOrbit, closed_loop_response, closed_loop_orbit
 from ._lyapunov import lyap, dlyap, gram
 from ._norms import norm
 from ._zeros import zeros
@@ -74,6 +76,9 @@ __all__ = [
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
     'compare_ltp', 'LTPComparison', 'select_structure', 'StructureSelection',
+    'identify_arx',
+    # feedback around orbits of hybrid plants
+    'ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit',
     # analysis: Lyapunov equations, gramians, zeros, norms
     'lyap', 'dlyap', 'gram', 'norm', 'zeros', 'harmonic_ss',
     # control design
