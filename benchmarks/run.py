@@ -5,7 +5,7 @@ Usage::
     python benchmarks/run.py [--quick] [--json PATH] [--only P1,P3] [--wall]
                              [--blas-threads N]
 
-Runs the workloads P1-P8 (one module each, see their docstrings), prints a
+Runs the workloads P1-P9 (one module each, see their docstrings), prints a
 table and writes the results as JSON (default ``benchmarks/results.json``).
 Every workload checks the accuracy both sides reached against an
 independent reference; a speed ratio is only claimed when both reached the
@@ -56,6 +56,7 @@ def main(argv=None):
     import p1_simulation, p2_htf, p3_realization, p4_scaling, p5_floquet, p6_limit
     import p7_riccati
     import p8_analysis
+    import p9_htf_memory
 
     if args.wall:
         _common.use_wall_clock()
@@ -63,6 +64,7 @@ def main(argv=None):
               'P4': p4_scaling, 'P5': p5_floquet, 'P6': p6_limit}
     suites['P7'] = p7_riccati
     suites['P8'] = p8_analysis
+    suites['P9'] = p9_htf_memory
     only = [s.strip().upper() for s in args.only.split(',')] if args.only else list(suites)
     unknown = set(only) - set(suites)
     if unknown:

@@ -2,7 +2,7 @@
 A clock-free hopping robot
 ==========================
 
-The hopper of `clockfree_hopper` lengthens its leg when the body reaches
+The hopper of ``clockfree_hopper`` lengthens its leg when the body reaches
 the bottom of stance — a controller that reacts to events, with no clock.
 Its hopping gait is an isolated limit cycle with an unknown period, found
 by `ltpcontrol.limit_cycle` with the apex (``v = 0`` in flight) as section.

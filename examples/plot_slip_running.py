@@ -2,19 +2,19 @@
 The running SLIP as an autonomous hybrid plant
 ==============================================
 
-`slip_model` predicts the strides of the extended spring-loaded inverted
+``slip_model`` predicts the strides of the extended spring-loaded inverted
 pendulum (thesis Chapter 2) by composing flight, stance and collision maps.
-`slip_running` writes the same model as a clock-free
+``slip_running`` writes the same model as a clock-free
 `ltpcontrol.HybridPlant`; the apex-to-apex (stride) map then comes from the
 orbit machinery, `ltpcontrol.poincare_map` on the apex section ``vz = 0``,
 with its Jacobian from the variational equations and the saltation
 matrices of touchdown and liftoff.
 
 Left: next-apex height and speed against the apex height, from the hybrid
-plant (lines) and from `slip_model.predict_stride` with the numerically
+plant (lines) and from ``slip_model.predict_stride`` with the numerically
 integrated damped stance ``"SLIPD"`` (markers).  Right: one stride of the
 body from both.  The printout compares the stride-map Jacobian with finite
-differences of `predict_stride`, and gives the multipliers of the lossless
+differences of ``predict_stride``, and gives the multipliers of the lossless
 running gait at the neutral touchdown angle: 1 (energy is conserved, so
 the gaits form a family) and the one that decides whether the apex height
 returns to the gait.

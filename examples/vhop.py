@@ -66,6 +66,14 @@ def _stance_jacobian(t, x, u, p):
                      [-p['k'] / p['M'], 0, -p['d'] / p['M'], 0], [0, 0, 0, 0]], float)
 
 
+def _flight_input(t, x, u, p):
+    return np.array([[0.0], [0.0], [1 / p['M']], [-1 / p['m']]])
+
+
+def _stance_input(t, x, u, p):
+    return np.array([[0.0], [0.0], [1 / p['M']], [0.0]])
+
+
 def _ground_reaction(t, x, u, p):
     # toe at rest on the ground: N = F + m g (liftoff when N = 0)
     return _leg_force(t, x, u, p) + p['m'] * p['g']
@@ -94,9 +102,10 @@ def vhop_plant(**params):
         raise TypeError(f"vhop_plant: unrecognized keyword(s): {sorted(unknown)}")
     modes = [
         ltp.HybridMode(_stance, guard=_ground_reaction, target='flight', name='stance',
-                       jacobian=_stance_jacobian),
+                       jacobian=_stance_jacobian, input_jacobian=_stance_input),
         ltp.HybridMode(_flight, guard=lambda t, x, u, p: x[1], reset=_touchdown,
-                       target='stance', name='flight', jacobian=_flight_jacobian),
+                       target='stance', name='flight', jacobian=_flight_jacobian,
+                       input_jacobian=_flight_input),
     ]
     return ltp.HybridPlant(modes, lambda t, x, u, p: [x[0]],
                            states=['h', 'h_t', 'hdot', 'hdot_t'], inputs=['u_c'],

@@ -11,6 +11,7 @@ Examples assume::
 
 from ._periodic_matrix import PeriodicMatrix
 from ._ltpsys import LTPStateSpace, ltpss, series, parallel, feedback, append, negate
+from ._interconnect import interconnect
 from ._timeresp import forced_response, step_response, initial_response, impulse_response
 from ._floquet import (monodromy, floquet_multipliers, floquet_exponents, is_stable,
                        floquet_transform)
@@ -33,6 +34,8 @@ from ._canonical import to_canonical, matrix_errors, MatrixErrors
 from ._canonical import compare_ltp, LTPComparison
 from ._structure import select_structure, StructureSelection
 from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
+from ._arx import identify_arx
+from ._closed_loop import ClosedLoopOrbit, closed_loop_response, closed_loop_orbit
 from ._lyapunov import lyap, dlyap, gram
 from ._norms import norm
 from ._zeros import zeros
@@ -54,6 +57,7 @@ __all__ = [
     # systems and periodic matrices
     'PeriodicMatrix', 'LTPStateSpace', 'ltpss',
     'series', 'parallel', 'feedback', 'append', 'negate',
+    'interconnect',
     # time responses
     'forced_response', 'step_response', 'initial_response', 'impulse_response',
     # Floquet theory
@@ -74,6 +78,9 @@ __all__ = [
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
     'compare_ltp', 'LTPComparison', 'select_structure', 'StructureSelection',
+    'identify_arx',
+    # feedback around orbits of hybrid plants
+    'ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit',
     # analysis: Lyapunov equations, gramians, zeros, norms
     'lyap', 'dlyap', 'gram', 'norm', 'zeros', 'harmonic_ss',
     # control design
@@ -82,3 +89,8 @@ __all__ = [
     # noisy data and Monte-Carlo studies
     'refine_ltp', 'RefineInfo', 'monte_carlo', 'MonteCarloResult',
 ]
+
+# python-control's entry points dispatch LTP systems to ltpcontrol (see _interop)
+from . import config  # noqa: E402
+from ._interop import install as _install_interop  # noqa: E402
+_install_interop()

@@ -28,6 +28,9 @@ import control as ct
 from scipy import sparse
 from control.exception import ControlArgument, ControlDimension
 
+from tqdm.auto import tqdm
+
+from . import config
 from ._validation import check_kwargs, check_period, check_positive_int, real_array
 
 __all__ = ['HTF', 'htf']
@@ -138,14 +141,22 @@ class HTF:
     # Evaluation
     #
 
-    def __call__(self, s):
+    def __call__(self, s, progress=None):
         """Evaluate the block matrix ``H(s)`` (``H(z)`` in discrete time).
+
+        Long requests are evaluated in chunks of points whose working
+        memory stays within ``ltp.config.defaults['htf.max_memory']``; a
+        request that cannot fit raises `MemoryError` with its estimated
+        size.
 
         Parameters
         ----------
         s : complex or 1D array_like of complex
             Evaluation points.  A data HTF accepts only ``s = jω`` with
             every ``ω + nω_p`` (n = -K..K) on its grid.
+        progress : bool, optional
+            Show a progress bar over the chunks (default
+            ``ltp.config.defaults['htf.progress']``).
 
         Returns
         -------
@@ -162,7 +173,7 @@ class HTF:
         sarr = real_array(s, 's', ndim=(0, 1), allow_complex=True).astype(complex)
         pts = np.atleast_1d(sarr)
         if self._hss is not None:
-            out = self._hss.evaluate(pts)
+            out = self._hss.evaluate(pts, progress=progress)
         else:
             out = self._data_matrix(pts)
         return out[0] if sarr.ndim == 0 else out
@@ -192,11 +203,14 @@ class HTF:
         >>> np.round(G0.frdata[0, 0, 0], 6)
         np.complex128(0.5-0.5j)
         """
-        k = _harmonic(k, self.nharmonics)
-        omega, G = self._components_on(omega, [k])
-        return ct.frd(G[0], omega, name=name or f"{self.name} G_{k}",
-                      inputs=self.input_labels, outputs=self.output_labels,
-                      dt=self.dt if self.dt else 0)
+        return self._frds([_harmonic(k, self.nharmonics)], omega, name=name)[0]
+
+    def _frds(self, ks, omega=None, name=None, progress=None):
+        """Components ``G_k`` for all `ks` from ONE evaluation of the block row."""
+        omega, G = self._components_on(omega, ks, progress=progress)
+        return [ct.frd(Gk, omega, name=name or f"{self.name} G_{k}",
+                       inputs=self.input_labels, outputs=self.output_labels,
+                       dt=self.dt if self.dt else 0) for k, Gk in zip(ks, G)]
 
     def components(self, omega=None):
         """All components ``G_k(jω)``, shape ``(2K+1, ny, nu, len(omega))``.
@@ -332,7 +346,7 @@ class HTF:
     # Internals
     #
 
-    def _components_on(self, omega, ks, interpolate=False):
+    def _components_on(self, omega, ks, interpolate=False, progress=None):
         K = self.nharmonics
         idx = [k + K for k in ks]
         if self._components is None:
@@ -341,7 +355,7 @@ class HTF:
             omega = real_array(omega, 'omega', ndim=(0, 1)).reshape(-1)
             s = (np.exp(1j * omega * self.dt) if self.dt else 1j * omega)
             # G_k = H_{0,-k}: central block row, block column -k
-            G = self._hss.evaluate(s, rows=[0], cols=[-k for k in ks])
+            G = self._hss.evaluate(s, rows=[0], cols=[-k for k in ks], progress=progress)
             ny, nu = self.noutputs, self.ninputs
             G = G.reshape(len(s), ny, len(ks), nu).transpose(2, 1, 3, 0)
             return omega, G
@@ -444,9 +458,13 @@ def htf(sys, nharmonics, *, internal_harmonics=None, method='auto', **kwargs):
         if 2 * K + 1 > N:
             raise ValueError(f"nharmonics={K} exceeds the {N} harmonics of a discrete "
                              f"system with {N} steps per period (need 2K+1 <= N)")
+        _check_setup_memory(N * sys.nstates, 0, 'htf')
         H._hss = _HarmonicStateSpace.discrete(sys, K, method)
     else:
         Ki = _internal_order(sys, K, internal_harmonics)
+        checked = internal_harmonics is None and not sys.A.is_constant
+        _check_setup_memory((2 * Ki + 1) * sys.nstates,
+                            (2 * Ki + 17) * sys.nstates if checked else 0, 'htf')
         H._hss = _HarmonicStateSpace.continuous(sys, K, Ki, method)
         if internal_harmonics is None and not H._hss.exact:
             _check_truncation(sys, K, Ki, H._hss, method)
@@ -481,7 +499,7 @@ class _HarmonicStateSpace:
         """Diagonalise F once when it pays off (or when asked to)."""
         if self.modal is not None or self.method == 'solve':
             return
-        if self.method == 'auto' and npoints < self.F.shape[0] / 4:
+        if self.method == 'auto' and npoints < _MODAL_BREAK_EVEN:
             return                  # a few dense solves are cheaper than eig(F)
         lam, V = np.linalg.eig(self.F)
         if self.method == 'modal' or np.linalg.cond(V) < 1e8:
@@ -500,7 +518,8 @@ class _HarmonicStateSpace:
         C_T = _toeplitz(sys.C.fourier(2 * Ki), Ki)
         D_T = _toeplitz(sys.D.fourier(2 * Ki), Ki)
         # F = A_T - N,  N = blkdiag(jnω_p I)
-        F = A_T - np.kron(np.diag(1j * w * harm), np.eye(n))
+        F = A_T
+        F[np.diag_indices_from(F)] -= 1j * w * np.repeat(harm, n)
         rows = _central(Ki, K, ny)
         cols = _central(Ki, K, nu)
         exact = sys.A.is_constant and _bandlimited(sys, Ki - K)
@@ -527,48 +546,113 @@ class _HarmonicStateSpace:
         return cls(F, G[:, cols], C_T[rows], D_T[np.ix_(rows, cols)], K, None, ny, nu,
                    method, True)
 
-    def evaluate(self, x, rows=None, cols=None):
-        """H(x) for points x; `rows`/`cols` select block harmonics (-K..K)."""
+    def evaluate(self, x, rows=None, cols=None, progress=None):
+        """H(x) for points x; `rows`/`cols` select block harmonics (-K..K).
+
+        The points are processed in chunks whose working memory stays
+        within ``ltp.config.defaults['htf.max_memory']``.
+        """
         K, ny, nu = self.K, self.ny, self.nu
-        r = slice(None) if rows is None else np.concatenate(
+        r = np.arange(self.Hc.shape[0]) if rows is None else np.concatenate(
             [np.arange((k + K) * ny, (k + K + 1) * ny) for k in rows])
-        c = slice(None) if cols is None else np.concatenate(
+        c = np.arange(self.G.shape[1]) if cols is None else np.concatenate(
             [np.arange((k + K) * nu, (k + K + 1) * nu) for k in cols])
-        J = self.J[r][:, c]
         self._ensure_modal(len(x))
-        if self.modal is not None:
-            lam, HV, VG = self.modal
-            gap = x[:, None] - lam[None, :]
-            if np.any(np.abs(gap) <= 1e-13 * np.maximum(1.0, np.abs(lam))):
-                raise ValueError("the HTF is not defined at a Floquet exponent "
-                                 "(evaluation point is a pole)")
-            # H(x)_{ij} = Σ_q HV_iq VG_qj / (x - λ_q): one matrix product with
-            # the residue matrix R_{q,(ij)} = HV_iq VG_qj, formed once
-            key = (None if rows is None else tuple(rows), None if cols is None else tuple(cols))
-            if key not in self._residues:
-                self._residues[key] = _residue_matrix(HV[r], VG[:, c])
-            flat, shape = self._residues[key]
-            if sparse.issparse(flat):
-                out = (flat.T @ (1.0 / gap).T).T
+        chunk, use_residues = self._plan(len(x), len(r), len(c))
+        J = self.J[np.ix_(r, c)]
+        out = np.empty((len(x), len(r), len(c)), complex)
+        starts = range(0, len(x), chunk)
+        for a in tqdm(starts, desc="HTF", unit="chunk", leave=False,
+                      disable=not config._get('htf.progress', progress) or len(starts) < 2):
+            sl = slice(a, a + chunk)
+            if self.modal is not None:
+                out[sl] = self._modal_chunk(x[sl], r, c, rows, cols, use_residues)
             else:
-                out = (1.0 / gap) @ flat
-            out = out.reshape((len(x),) + shape)
+                out[sl] = self._solve_chunk(x[sl], r, c)
             if J.any():
-                out += J
-            return out
-        ident = np.eye(self.F.shape[0])
-        M = x[:, None, None] * ident - self.F
+                out[sl] += J
+        return out
+
+    def _plan(self, npoints, nr, nc):
+        """Chunk length and modal variant that keep the working memory in budget."""
+        budget = float(config.defaults['htf.max_memory'])
+        nF = self.F.shape[0]
+        out_bytes = _BYTES * npoints * nr * nc
+        use_residues = False
+        if self.modal is not None:
+            # residue matrix R_{q,(ij)} = HV_iq VG_qj, formed once, when it fits
+            use_residues = _BYTES * nF * nr * nc <= budget / 2
+            fixed = _BYTES * nF * nr * nc if use_residues else 0
+            per_point = _BYTES * (2 * nF + 2 * nr * nc + (0 if use_residues else nr * nF))
+        else:
+            fixed = 0
+            per_point = _BYTES * (2 * nF ** 2 + 2 * nF * nc + 2 * nr * nc)
+        room = budget - fixed - out_bytes
+        if room < per_point:
+            raise MemoryError(
+                f"evaluating the HTF at {npoints} points needs about "
+                f"{_size(fixed + out_bytes + per_point)} (result {_size(out_bytes)}, "
+                f"harmonic state space of {nF} states), more than "
+                f"ltp.config.defaults['htf.max_memory'] = {_size(budget)}; evaluate fewer "
+                "points or components, or raise the limit")
+        return max(1, int(room // per_point)), use_residues
+
+    def _modal_chunk(self, x, r, c, rows, cols, use_residues):
+        # H(x)_{ij} = Σ_q HV_iq VG_qj / (x - λ_q)
+        lam, HV, VG = self.modal
+        gap = x[:, None] - lam[None, :]
+        if np.any(np.abs(gap) <= 1e-13 * np.maximum(1.0, np.abs(lam))):
+            raise ValueError("the HTF is not defined at a Floquet exponent "
+                             "(evaluation point is a pole)")
+        inv_gap = 1.0 / gap
+        if not use_residues:
+            return (HV[r][None] * inv_gap[:, None, :]) @ VG[:, c]
+        key = (None if rows is None else tuple(rows), None if cols is None else tuple(cols))
+        if key not in self._residues:
+            self._residues[key] = _residue_matrix(HV[r], VG[:, c])
+        flat, shape = self._residues[key]
+        prod = (flat.T @ inv_gap.T).T if sparse.issparse(flat) else inv_gap @ flat
+        return prod.reshape((len(x),) + shape)
+
+    def _solve_chunk(self, x, r, c):
+        M = -np.broadcast_to(self.F, (len(x),) + self.F.shape)
+        idx = np.arange(self.F.shape[0])
+        M[:, idx, idx] += x[:, None]
+        Gc = self.G[:, c]
         try:
-            X = np.linalg.solve(M, np.broadcast_to(self.G[:, c], (len(x),) + self.G[:, c].shape))
+            X = np.linalg.solve(M, np.broadcast_to(Gc, (len(x),) + Gc.shape))
         except np.linalg.LinAlgError:
             raise ValueError("the HTF is not defined at a pole of the harmonic "
                              "state space (singular resolvent)") from None
-        return self.Hc[r] @ X + J
+        return self.Hc[r] @ X
 
 
 #
 # Helpers
 #
+
+_BYTES = 16                 # one complex128
+# eig(F) costs about as much as 25-35 dense resolvent solves of the same size
+# (measured for 100 to 800 harmonic states), plus the inverse eigenvectors
+_MODAL_BREAK_EVEN = 40
+
+
+def _size(nbytes):
+    return f"{nbytes / 1e9:.3g} GB" if nbytes >= 1e8 else f"{nbytes / 1e6:.3g} MB"
+
+
+def _check_setup_memory(nF, nF_check, where):
+    """Refuse a harmonic state space whose construction cannot fit the budget."""
+    # F, its Toeplitz parts and eigenvectors V, V^{-1} (6 nF^2); the
+    # truncation check builds one more of nF_check states (3 nF_check^2)
+    need = _BYTES * (6 * nF ** 2 + 3 * nF_check ** 2)
+    budget = float(config.defaults['htf.max_memory'])
+    if need > budget:
+        raise MemoryError(
+            f"{where}: the harmonic state space has {nF} states and needs about "
+            f"{_size(need)}, more than ltp.config.defaults['htf.max_memory'] = "
+            f"{_size(budget)}; lower nharmonics or internal_harmonics, or raise the limit")
+
 
 def _residue_matrix(HV, VG):
     """Residues ``R_{q,(ij)} = HV_iq VG_qj`` of the modal form, sparse when mostly zero.

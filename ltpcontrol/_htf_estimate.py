@@ -305,6 +305,10 @@ def _solve_joint(phi, Yb, alpha, penalty, scale, want_var, max_entries=2 ** 22):
         return scipy.linalg.cho_solve_banded(chol, rhs)
 
     g = solve(puy.reshape(nfreq * nunk, -1)).reshape(nfreq, nunk, -1)
+    if not want_var:
+        # tr H = tr(A⁻¹ B) = Σ_f tr(Z_ff Φ_UU(f)), Z_ff the diagonal blocks of A⁻¹
+        Zff = _inverse_diagonal_blocks(amat.tocsr(), nfreq, nunk)
+        return g, float(np.real(np.einsum('fab,fba->', Zff, puu))), None
     # tr H = tr(A⁻¹ B) and diag(A⁻¹ B A⁻¹) with B = Σ_f L_f L_fᴴ, column by column
     lf = _factor_blocks(phi, puu)                               # (F, P, c)
     ncol = lf.shape[2]
@@ -320,6 +324,37 @@ def _solve_joint(phi, Yb, alpha, penalty, scale, want_var, max_entries=2 ** 22):
         if want_var:
             var += np.sum(np.abs(x) ** 2, axis=1)
     return g, trace, (var.reshape(nfreq, nunk) if want_var else None)
+
+
+def _inverse_diagonal_blocks(A, nfreq, nunk):
+    """Diagonal P x P blocks of A⁻¹ for the Hermitian positive definite A of (3.35).
+
+    A couples bins f and f ± 2 only, so with super-blocks of two bins it is
+    block tridiagonal.  Two sweeps of Schur complements (positive definite,
+    hence stable) give the diagonal super-blocks of the inverse,
+
+        L_s = A_ss - A_s,s-1 L_{s-1}⁻¹ A_s-1,s,   R_s = A_ss - A_s,s+1 R_{s+1}⁻¹ A_s+1,s,
+        (A⁻¹)_ss = (L_s + R_s - A_ss)⁻¹,
+
+    in O(F P³) instead of the O(F² P) of solving for every column.
+    """
+    P2 = 2 * nunk
+    edges = list(range(0, nfreq * nunk, P2)) + [nfreq * nunk]
+    S = len(edges) - 1
+    diag = [A[a:b, a:b].toarray() for a, b in zip(edges[:-1], edges[1:])]
+    upper = [A[a:b, b:c].toarray() for a, b, c in zip(edges[:-2], edges[1:-1], edges[2:])]
+    left, right = [None] * S, [None] * S
+    left[0], right[-1] = diag[0], diag[-1]
+    for s in range(1, S):
+        left[s] = diag[s] - upper[s - 1].conj().T @ np.linalg.solve(left[s - 1], upper[s - 1])
+    for s in range(S - 2, -1, -1):
+        right[s] = diag[s] - upper[s] @ np.linalg.solve(right[s + 1], upper[s].conj().T)
+    blocks = np.empty((nfreq, nunk, nunk), complex)
+    for s in range(S):
+        Z = np.linalg.inv(left[s] + right[s] - diag[s])
+        for j in range(Z.shape[0] // nunk):
+            blocks[2 * s + j] = Z[j * nunk:(j + 1) * nunk, j * nunk:(j + 1) * nunk]
+    return blocks
 
 
 def _residual(phi, Yb, g):

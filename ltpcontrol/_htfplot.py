@@ -21,7 +21,7 @@ __all__ = ['htf_response', 'bode_htf', 'htf_map_plot']
 
 
 def htf_response(htfs, omega=None, harmonics=(-1, 0, 1), *, omega_limits=None,
-                 omega_num=None):
+                 omega_num=None, progress=None):
     """Components ``G_k(jω)`` of one or several HTFs as FRDs.
 
     Parameters
@@ -36,6 +36,9 @@ def htf_response(htfs, omega=None, harmonics=(-1, 0, 1), *, omega_limits=None,
         Frequency range of the default grid for model HTFs.
     omega_num : int, optional
         Number of points of the default grid (default 500).
+    progress : bool, optional
+        Progress bar over long evaluations (default
+        ``ltp.config.defaults['htf.progress']``).
 
     Returns
     -------
@@ -60,13 +63,14 @@ def htf_response(htfs, omega=None, harmonics=(-1, 0, 1), *, omega_limits=None,
             w = _grid(H, omega_limits, omega_num)
         elif w is not None:
             w = real_array(w, 'omega', ndim=1)
-        out.append([H.component(k, w) for k in harmonics])
+        # one evaluation of the central block row serves every component
+        out.append(H._frds(harmonics, w, progress=progress))
     return out
 
 
 def bode_htf(htfs, omega=None, *fmt, harmonics=(-1, 0, 1), omega_limits=None,
              omega_num=None, plot_phase=None, label=None, ax=None, title=None,
-             **kwargs):
+             progress=None, **kwargs):
     """Bode plot of selected HTF components ``G_k(jω)``.
 
     Magnitude and phase of components k (default -1, 0, 1) of one or several
@@ -93,6 +97,8 @@ def bode_htf(htfs, omega=None, *fmt, harmonics=(-1, 0, 1), omega_limits=None,
         Axes to draw into (for overlaying onto an existing plot).
     title : str, optional
         Figure title.
+    progress : bool, optional
+        Progress bar over long evaluations (see `htf_response`).
     **kwargs
         Passed to `control.bode_plot` (``dB``, ``Hz``, ``deg``, ``grid``,
         matplotlib line properties, ...).
@@ -111,7 +117,7 @@ def bode_htf(htfs, omega=None, *fmt, harmonics=(-1, 0, 1), omega_limits=None,
     htfs = _htf_list(htfs)
     harmonics = _harmonic_list(harmonics)
     resp = htf_response(htfs, omega, harmonics, omega_limits=omega_limits,
-                        omega_num=omega_num)
+                        omega_num=omega_num, progress=progress)
     frds, labels = [], []
     for H, comps in zip(htfs, resp):
         for k, frd in zip(harmonics, comps):
@@ -127,6 +133,8 @@ def bode_htf(htfs, omega=None, *fmt, harmonics=(-1, 0, 1), omega_limits=None,
             raise ValueError(f"label must have {len(frds)} entries, got {len(labels)}")
     if title is None:
         title = "HTF components of " + ", ".join(H.name for H in htfs)
+    if label is None and frds[0].noutputs * frds[0].ninputs > 1:
+        labels = None           # MIMO: python-control's labels from the FRD names (G_k)
     return ct.bode_plot(frds, None, *fmt, plot_phase=plot_phase, label=labels, ax=ax,
                         title=title, **kwargs)
 

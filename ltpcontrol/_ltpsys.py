@@ -132,16 +132,18 @@ class LTPStateSpace(NonlinearIOSystem):
         return self._repr_info_()
 
     def __str__(self):
-        lines = [f"<LTPStateSpace>: {self.name}",
-                 f"Inputs ({self.ninputs}): {self.input_labels}",
-                 f"Outputs ({self.noutputs}): {self.output_labels}",
-                 f"States ({self.nstates}): {self.state_labels}",
-                 f"period = {self.period:g}"]
-        if self.isdtime():
-            lines.append(f"dt = {self.dt:g} ({self.nsteps} steps per period)")
-        for label, M in (('A', self.A), ('B', self.B), ('C', self.C), ('D', self.D)):
-            lines.append(f"{label}: {M!r}")
-        return "\n".join(lines)
+        from ._display import text
+        return text(self)
+
+    def _repr_html_(self):
+        """Info line and LaTeX equations (python-control's notebook display).
+
+        As for `control.StateSpace`, ``_repr_latex_`` returns None so that
+        Jupyter uses this form, and None is returned when the system is
+        larger than ``ct.config.defaults['statesp.latex_maxsize']``.
+        """
+        from ._display import html
+        return html(self)
 
     #
     # Conversions
@@ -171,13 +173,23 @@ class LTPStateSpace(NonlinearIOSystem):
         t0 = 0.0
         return ct.ss(self.A(t0), self.B(t0), self.C(t0), self.D(t0), self.dt, **kwargs)
 
-    def linearize(self, t=0.0, **kwargs):
+    def linearize(self, x0=None, u0=None, t=0.0, params=None, **kwargs):
         """Frozen-time `control.StateSpace` ``(A(t), B(t), C(t), D(t))``.
+
+        The signature is python-control's (`control.linearize`); a linear
+        system is its own linearization about any ``(x0, u0)``, so only the
+        time matters.
 
         Parameters
         ----------
+        x0, u0 : array_like, optional
+            Operating point (checked for size, otherwise unused).
         t : float
             Time at which the matrices are frozen.
+        params : None
+            An LTP system has no parameters.
+        **kwargs
+            Keywords of the result (``name``, ``inputs``, ...).
 
         Returns
         -------
@@ -186,12 +198,28 @@ class LTPStateSpace(NonlinearIOSystem):
         Examples
         --------
         >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
-        >>> sys.linearize(0.25).A
+        >>> sys.linearize(t=0.25).A
+        array([[-1.]])
+        >>> ct.linearize(sys, 0, 0, t=0.25).A
         array([[-1.]])
         """
+        if params:
+            raise ControlArgument("linearize: an LTPStateSpace has no parameters (params)")
+        for val, count, what in ((x0, self.nstates, 'x0'), (u0, self.ninputs, 'u0')):
+            if val is not None and np.size(val) not in (1, count):
+                raise ControlDimension(f"linearize: {what} must have {count} elements, "
+                                       f"got {np.size(val)}")
         t = float(real_array(t, 't', ndim=0))
+        kwargs.pop('copy_names', None)
         kwargs.setdefault('name', self.name + '$frozen')
+        for key in ('inputs', 'outputs', 'states'):
+            kwargs.setdefault(key, getattr(self, key[:-1] + '_labels'))
         return ct.ss(self.A(t), self.B(t), self.C(t), self.D(t), self.dt, **kwargs)
+
+    def __call__(self, *args, **kwargs):
+        from ._interop import _refusal
+        raise _refusal("evaluation sys(s) of a transfer function",
+                       "ltp.htf(sys, nharmonics)(s), the harmonic transfer function")
 
     def average(self, **kwargs):
         """Averaged LTI system with the mean matrices ``A_0, B_0, C_0, D_0``.
@@ -246,14 +274,13 @@ class LTPStateSpace(NonlinearIOSystem):
     # -- LTI-only requests: a clear pointer to the LTP counterpart --
     def frequency_response(self, omega=None, squeeze=None):
         """Not defined for an LTP system: its frequency response is the HTF (`ltpcontrol.htf`)."""
-        raise ControlArgument(f"{self.name} is time-periodic: it has no LTI frequency "
-                              "response; use ltp.htf(sys, nharmonics) (or "
-                              "ltp.harmonic_ss) for its harmonic transfer function")
+        from ._interop import refusal
+        raise refusal('frequency_response')
 
     def dcgain(self, warn_infinite=False):
         """Not defined for an LTP system; see `ltpcontrol.htf`."""
-        raise ControlArgument(f"{self.name} is time-periodic: it has no DC gain; use "
-                              "ltp.htf(sys, nharmonics)(0) for its harmonic DC response")
+        from ._interop import refusal
+        raise refusal('dcgain')
 
     def zeros(self, nharmonics=None, *, rtol=1e-8):
         """Transmission zeros; see `ltpcontrol.zeros` (so `control.zeros` works)."""
@@ -287,28 +314,28 @@ class LTPStateSpace(NonlinearIOSystem):
 
     def __add__(self, other):
         other = _to_ltp_or_none(other, self)
-        return NotImplemented if other is None else parallel(self, other)
+        return NotImplemented if other is None else _parallel(self, other)
 
     def __radd__(self, other):
         other = _to_ltp_or_none(other, self)
-        return NotImplemented if other is None else parallel(other, self)
+        return NotImplemented if other is None else _parallel(other, self)
 
     def __sub__(self, other):
         other = _to_ltp_or_none(other, self)
-        return NotImplemented if other is None else parallel(self, negate(other))
+        return NotImplemented if other is None else _parallel(self, negate(other))
 
     def __rsub__(self, other):
         other = _to_ltp_or_none(other, self)
-        return NotImplemented if other is None else parallel(other, negate(self))
+        return NotImplemented if other is None else _parallel(other, negate(self))
 
     def __mul__(self, other):
         # sys * other: other acts first (python-control convention)
         other = _to_ltp_or_none(other, self)
-        return NotImplemented if other is None else series(other, self)
+        return NotImplemented if other is None else _series(other, self)
 
     def __rmul__(self, other):
         other = _to_ltp_or_none(other, self)
-        return NotImplemented if other is None else series(self, other)
+        return NotImplemented if other is None else _series(self, other)
 
     def feedback(self, other=1, sign=-1, params=None):
         """Feedback interconnection with ``other`` in the return path; see `ltpcontrol.feedback`."""
@@ -334,7 +361,9 @@ def ltpss(*args, **kwargs):
     ``ltpss(A, B, C, D, period[, dt])`` builds ``ẋ = A(t)x + B(t)u,
     y = C(t)x + D(t)u``; ``ltpss(sys, period)`` converts a python-control
     LTI system (`StateSpace` or `TransferFunction`) into an LTP system
-    with constant matrices and the given period.
+    with constant matrices and the given period; ``ltpss(K)`` makes the
+    static periodic gain ``y = K(t) u`` of a `PeriodicMatrix` K (a block for
+    `interconnect`, period ``K.period`` unless given).
 
     Parameters
     ----------
@@ -381,6 +410,11 @@ def ltpss(*args, **kwargs):
     >>> sys.nstates, sys.ninputs, sys.noutputs, sys.period
     (2, 1, 1, 0.5)
     """
+    if len(args) == 1 and isinstance(args[0], PeriodicMatrix):
+        K = args[0]
+        p, m = K.shape
+        return LTPStateSpace(np.zeros((0, 0)), np.zeros((0, m)), np.zeros((p, 0)), K,
+                             kwargs.pop('period', K.period), **kwargs)
     if 'period' in kwargs and len(args) in (1, 4):
         args = args + (kwargs.pop('period'),)
     if len(args) == 2 and isinstance(args[0], (ct.StateSpace, ct.TransferFunction)):
@@ -404,13 +438,16 @@ def ltpss(*args, **kwargs):
 # Interconnections
 #
 
-def series(sys1, sys2, **kwargs):
-    """Series connection ``y = sys2(sys1(u))``.
+def series(*systems, **kwargs):
+    """series(sys1, sys2[, ..., sysn])
+
+    Series connection: the output of each system drives the next, ``y = sys2(sys1(u))``.
 
     Parameters
     ----------
-    sys1, sys2 : LTPStateSpace, control.StateSpace, TransferFunction or array_like
-        Systems in signal-flow order; at least one must be an `LTPStateSpace`.
+    *systems : LTPStateSpace, control.StateSpace, TransferFunction, PeriodicMatrix or array_like
+        Systems in signal-flow order (a `PeriodicMatrix` or array is a
+        static gain); at least one must be periodic.
     name : str, optional
         Name of the result.
 
@@ -426,6 +463,10 @@ def series(sys1, sys2, **kwargs):
     >>> ltp.series(P, ct.tf([1], [1, 2])).nstates
     2
     """
+    return _chain(_series, systems, kwargs)
+
+
+def _series(sys1, sys2, **kwargs):
     s1, s2, period, dt = _common(sys1, sys2)
     if s1.noutputs != s2.ninputs:
         raise ControlDimension(f"series: sys1 has {s1.noutputs} outputs but sys2 has "
@@ -439,13 +480,16 @@ def series(sys1, sys2, **kwargs):
                          outputs=s2.output_labels, **kwargs)
 
 
-def parallel(sys1, sys2, **kwargs):
-    """Parallel connection ``y = sys1(u) + sys2(u)``.
+def parallel(*systems, **kwargs):
+    """parallel(sys1, sys2[, ..., sysn])
+
+    Parallel connection: the outputs of all systems are summed, ``y = sys1(u) + sys2(u)``.
 
     Parameters
     ----------
-    sys1, sys2 : LTPStateSpace, control.StateSpace, TransferFunction or array_like
-        Systems with the same numbers of inputs and outputs.
+    *systems : LTPStateSpace, control.StateSpace, TransferFunction, PeriodicMatrix or array_like
+        Systems with the same numbers of inputs and outputs (a
+        `PeriodicMatrix` or array is a static gain).
     name : str, optional
         Name of the result.
 
@@ -459,6 +503,10 @@ def parallel(sys1, sys2, **kwargs):
     >>> (P + 2).D(0.0)
     array([[2.]])
     """
+    return _chain(_parallel, systems, kwargs)
+
+
+def _parallel(sys1, sys2, **kwargs):
     s1, s2, period, dt = _common(sys1, sys2)
     if s1.shape != s2.shape:
         raise ControlDimension(f"parallel: systems have shapes {s1.shape} and {s2.shape}")
@@ -479,7 +527,7 @@ def feedback(sys1, sys2=1, sign=-1, **kwargs):
         Forward system.
     sys2 : LTPStateSpace, control.StateSpace, TransferFunction, PeriodicMatrix or array_like
         Return-path system (default: unity); a `PeriodicMatrix` is a
-        periodic static gain such as the state feedback ``K(t)`` of `lqr`.
+        periodic static gain ``u1 = u + sign K(t) y1``.
     sign : {-1, 1}
         Feedback sign (default negative).
     name : str, optional
@@ -509,14 +557,7 @@ def feedback(sys1, sys2=1, sign=-1, **kwargs):
         raise ControlDimension("feedback: sys2 must map the outputs of sys1 to its inputs "
                                f"(sys1 {s1.shape}, sys2 {s2.shape})")
     n1, n2, p1 = s1.nstates, s2.nstates, s1.noutputs
-    loop = np.eye(p1) - sign * (s1.D @ s2.D)
-    if loop.is_constant:
-        Lc = loop(0.0)
-        if abs(np.linalg.det(Lc)) < 1e-12:
-            raise ValueError("feedback: algebraic loop I - sign*D1*D2 is singular")
-        F = PeriodicMatrix.constant(np.linalg.inv(Lc), period)
-    else:
-        F = _pointwise_inverse(loop)
+    F = _loop_inverse(np.eye(p1) - sign * (s1.D @ s2.D), "feedback")
     # y1 = F (C1 x1 + s D1 C2 x2 + D1 u);  u1 = u + s (C2 x2 + D2 y1)
     Cy = PeriodicMatrix.block([[F @ s1.C, sign * (F @ s1.D @ s2.C)]])
     Dy = F @ s1.D
@@ -551,13 +592,7 @@ def append(*systems, **kwargs):
     """
     if not systems:
         raise ValueError("append needs at least one system")
-    ref = next((s for s in systems if isinstance(s, LTPStateSpace)), None)
-    if ref is None:
-        raise ControlArgument("append: at least one system must be an LTPStateSpace")
-    period, dt = ref.period, ref.dt
-    for s in systems:
-        if isinstance(s, LTPStateSpace):
-            period = _merge_period(period, s.period)
+    period, dt = _period_and_dt(systems, "append")
     systems = [_to_ltp(s, period, dt) for s in systems]
     out = systems[0]
     for s in systems[1:]:
@@ -635,14 +670,28 @@ def _system_matrix(M, period, name, nsteps, rows=None, cols=None, zero_ok=False)
     return P
 
 
-def _pointwise_inverse(P):
+def _chain(pair, systems, kwargs):
+    """Fold a binary connection over two or more systems."""
+    if len(systems) < 2:
+        raise ControlArgument(f"{pair.__name__[1:]} needs at least two systems, "
+                              f"got {len(systems)}")
+    out = systems[0]
+    for s in systems[1:-1]:
+        out = pair(out, s)
+    return pair(out, systems[-1], **kwargs)
+
+
+def _loop_inverse(loop, where):
+    """``loop(t)^{-1}`` of an algebraic loop ``I - ...`` (periodic or constant)."""
     def inv(values):
-        det = np.linalg.det(values)
-        if np.any(np.abs(det) < 1e-12):
-            raise ValueError("feedback: algebraic loop I - sign*D1*D2 is singular")
+        if np.any(np.abs(np.linalg.det(values)) < 1e-12):
+            raise ValueError(f"{where}: the algebraic loop is singular (I - D-loop gain "
+                             "is not invertible)")
         return np.linalg.inv(values)
-    return PeriodicMatrix._new(P.period, P.shape, combine=(inv, [P]),
-                               breakpoints=P.breakpoints)
+    if loop.is_constant:
+        return PeriodicMatrix.constant(inv(loop(0.0)[None])[0], loop.period)
+    return PeriodicMatrix._new(loop.period, loop.shape, combine=(inv, [loop]),
+                               breakpoints=loop.breakpoints)
 
 
 def _merge_period(p1, p2):
@@ -654,9 +703,9 @@ def _merge_period(p1, p2):
 
 def _to_ltp(obj, period, dt):
     if isinstance(obj, LTPStateSpace):
-        if obj.dt != dt:
+        if obj.dt != dt and obj.nstates:      # a static gain fits any timebase
             raise ValueError(f"systems have incompatible timebases (dt={obj.dt} and dt={dt})")
-        if obj.period == period:
+        if obj.period == period and obj.dt == dt:
             return obj
         return LTPStateSpace(obj.A, obj.B, obj.C, obj.D, period, dt=dt,
                              inputs=obj.input_labels, outputs=obj.output_labels,
@@ -672,12 +721,9 @@ def _to_ltp(obj, period, dt):
     if isinstance(obj, ct.InputOutputSystem):
         raise ControlArgument(f"cannot combine an LTPStateSpace with {type(obj).__name__}")
     if isinstance(obj, PeriodicMatrix):
-        # a periodic static gain, e.g. a state-feedback gain K(t)
-        rows, cols = obj.shape
-        return LTPStateSpace(np.zeros((0, 0)), np.zeros((0, cols)), np.zeros((rows, 0)),
-                             obj, period, dt=dt)
-    gain = real_array(obj, 'gain', ndim=(0, 1, 2))
-    gain = np.atleast_2d(gain)
+        gain = obj.with_period(period)
+    else:
+        gain = np.atleast_2d(real_array(obj, 'gain', ndim=(0, 1, 2)))
     return LTPStateSpace(np.zeros((0, 0)), np.zeros((0, gain.shape[1])),
                          np.zeros((gain.shape[0], 0)), gain, period, dt=dt)
 
@@ -689,24 +735,37 @@ def _to_ltp_or_none(obj, ref):
     if isinstance(obj, (int, float, np.number)) and not isinstance(obj, bool):
         # a scalar acts on every channel, as in python-control
         return _to_ltp(float(obj) * np.eye(ref.noutputs), ref.period, ref.dt)
-    if isinstance(obj, (ct.StateSpace, ct.TransferFunction, np.ndarray, list, PeriodicMatrix)):
+    if isinstance(obj, PeriodicMatrix):
+        return _to_ltp(obj, _merge_period(ref.period, obj.period), ref.dt)
+    if isinstance(obj, (ct.StateSpace, ct.TransferFunction, np.ndarray, list)):
         return _to_ltp(obj, ref.period, ref.dt)
     return None
 
 
+def _period_and_dt(systems, where):
+    """Common period of the periodic operands and timebase of the dynamic ones."""
+    periodic = [s for s in systems if isinstance(s, (LTPStateSpace, PeriodicMatrix))]
+    if not periodic:
+        raise ControlArgument(f"{where}: at least one system must be an LTPStateSpace or a "
+                              "PeriodicMatrix gain")
+    period = periodic[0].period
+    for s in periodic[1:]:
+        period = _merge_period(period, s.period)
+    # static operands (no states) fit any timebase
+    dts = {s.dt for s in systems if isinstance(s, ct.InputOutputSystem)
+           and s.dt not in (None, True) and s.nstates}
+    if len(dts) > 1:
+        raise ValueError(f"{where}: systems have incompatible timebases {sorted(dts)}")
+    return period, (dts.pop() if dts else 0.0)
+
+
 def _common(sys1, sys2):
-    ref = sys1 if isinstance(sys1, LTPStateSpace) else sys2
-    if not isinstance(ref, LTPStateSpace):
-        raise ControlArgument("at least one system must be an LTPStateSpace")
-    period = ref.period
-    for s in (sys1, sys2):
-        if isinstance(s, LTPStateSpace):
-            period = _merge_period(period, s.period)
-    s1 = _to_ltp(sys1, period, ref.dt)
-    s2 = _to_ltp(sys2, period, ref.dt)
+    period, dt = _period_and_dt((sys1, sys2), "block diagram")
+    s1 = _to_ltp(sys1, period, dt)
+    s2 = _to_ltp(sys2, period, dt)
     if isinstance(sys2, (int, float)) and s1.noutputs != 1:
-        s2 = _to_ltp(float(sys2) * np.eye(s1.noutputs), period, ref.dt)
-    return s1, s2, period, ref.dt
+        s2 = _to_ltp(float(sys2) * np.eye(s1.noutputs), period, dt)
+    return s1, s2, period, dt
 
 
 def _index_list(spec, labels, what):

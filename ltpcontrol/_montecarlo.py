@@ -86,7 +86,7 @@ def monte_carlo(func, ndraws, *, seed=None, n_jobs=None, timeout=None, progress=
     func : callable
         ``func(rng, *args, **kwargs)`` returns the outcome of one draw (an
         array of fixed shape, real or complex), using only the
-        `numpy.random.Generator` `rng` for randomness.  With process-based
+        `numpy.random.Generator` ``rng`` for randomness.  With process-based
         backends it must be picklable by joblib (module-level functions
         always are).
     ndraws : int

@@ -323,10 +323,9 @@ class PeriodicMatrix:
     def __repr__(self):
         if self._coeffs is not None:
             form = f"K={self.nharmonics}"
-        elif self._pieces is not None:
-            form = f"switching at {np.round(self._times, 6).tolist()}"
-        elif self._func is not None:
-            form = "function"
+        elif self._pieces is not None or self._func is not None:
+            from ._display import describe
+            form = describe(self)
         else:
             form = "combination"
         return f"<PeriodicMatrix {self.shape[0]}x{self.shape[1]}, period={self.period:g}, {form}>"

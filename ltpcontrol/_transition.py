@@ -195,6 +195,8 @@ def expm_batch(X):
     degree = np.full(len(X), 13)
     for m in (9, 7, 5, 3):
         degree[norms <= _THETA[m]] = m
+    if len(X) and np.all(degree == degree[0]):
+        return _pade(X, norms, int(degree[0]))
     for m in (3, 5, 7, 9, 13):
         sel = np.flatnonzero(degree == m)
         if sel.size:

@@ -196,21 +196,34 @@ def real_array(data, name, ndim=None, allow_complex=False):
     return arr
 
 
-def commensurate(a, b, rtol=1e-9):
-    """Return the common period of `a` and `b` if one is an integer multiple of the other.
+def commensurate(a, b, rtol=None, max_multiple=None):
+    """Return the common period ``q a = p b`` of periods `a` and `b`.
+
+    The ratio ``a/b`` must equal a fraction ``p/q`` in lowest terms within
+    the relative tolerance `rtol`, with ``p, q <= max_multiple`` (defaults:
+    ``ltp.config.defaults['period.rtol']`` and ``['period.max_multiple']``);
+    otherwise the periods are taken as incommensurate and `ValueError` is
+    raised.
 
     Examples
     --------
     >>> from ltpcontrol._validation import commensurate
     >>> commensurate(0.5, 1.5)
     1.5
+    >>> commensurate(1.0, 1.5)
+    3.0
     """
-    big, small = max(a, b), min(a, b)
-    ratio = big / small
-    if abs(ratio - round(ratio)) <= rtol * ratio:
-        return big
-    raise ValueError(f"periods {a} and {b} are not commensurate "
-                     "(one must be an integer multiple of the other)")
+    from fractions import Fraction
+    from .config import _get
+    rtol, qmax = _get('period.rtol', rtol), _get('period.max_multiple', max_multiple)
+    ratio = a / b
+    frac = Fraction(ratio).limit_denominator(int(qmax))
+    p, q = frac.numerator, frac.denominator
+    if 1 <= p <= qmax and abs(ratio - p / q) <= rtol * ratio:
+        return max(a, b) if 1 in (p, q) else q * a
+    raise ValueError(f"periods {a} and {b} are incommensurate: their ratio {ratio:.12g} "
+                     f"is no fraction p/q with p, q <= {qmax} (tolerance {rtol:g}; see "
+                     "ltp.config.defaults['period.max_multiple'])")
 
 
 def steps_per_period(period, dt, name="dt"):

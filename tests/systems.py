@@ -47,3 +47,14 @@ def fd_period_map_jacobian(plant, period, x0, mode0=0, h=1e-4):
         jac[:, j] = (period_map(plant, period, x0 + dx, mode0)[0]
                      - period_map(plant, period, x0 - dx, mode0)[0]) / (2 * h)
     return jac
+
+
+def random_periodic_plant(n, ninputs=1, seed=0, period=1.0, name=None):
+    """Stable random plant with time-varying ``A(t) = A_0 + A_1 cos ω_p t``, one output."""
+    rng = np.random.default_rng(seed)
+    A0 = rng.standard_normal((n, n)) / np.sqrt(n)
+    A0 -= (np.max(np.linalg.eigvals(A0).real) + 1.0) * np.eye(n)
+    A1 = 0.3 * rng.standard_normal((n, n)) / np.sqrt(n)
+    w = 2 * np.pi / period
+    return ltp.ltpss(lambda t: A0 + A1 * np.cos(w * t), rng.standard_normal((n, ninputs)),
+                     rng.standard_normal((1, n)), 0, period=period, name=name)

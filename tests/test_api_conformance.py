@@ -79,6 +79,8 @@ KWARG_CALLS = {
     'feedback': lambda **kw: ltp.feedback(SYS, 1.0, **kw),
     'append': lambda **kw: ltp.append(SYS, SYS, **kw),
     'negate': lambda **kw: ltp.negate(SYS, **kw),
+    'interconnect': lambda **kw: ltp.interconnect([SYS, 2.0], inplist='sys[1].u[0]',
+                                                  outlist='y[0]', check_unused=False, **kw),
     'forced_response': lambda **kw: ltp.forced_response(SYS, [0, 0.5, 1], **kw),
     'step_response': lambda **kw: ltp.step_response(SYS, 1.0, **kw),
     'initial_response': lambda **kw: ltp.initial_response(SYS, 1.0, 1.0, **kw),
@@ -124,6 +126,13 @@ KWARG_CALLS = {
     'LTPStateSpace.htf': lambda **kw: SYS.htf(1, **kw),
     'LTPStateSpace.sample': lambda **kw: SYS.sample(0.1, **kw),
     'HTF.plot': lambda **kw: H.plot(omega_num=5, **kw),
+    # feedback around orbits
+    'closed_loop_response': lambda **kw: ltp.closed_loop_response(
+        FORCED, ct.ss([], [], [], [[-1.0]]), ltp.periodic_orbit(FORCED, T, [0.0]), [0, 0.5],
+        **kw),
+    'closed_loop_orbit': lambda **kw: ltp.closed_loop_orbit(
+        FORCED, ct.ss([], [], [], [[-1.0]]), ltp.periodic_orbit(FORCED, T, [0.0]), **kw),
+    'identify_arx': lambda **kw: ltp.identify_arx(DATA, T, 1, 1, ridge=1e-6, **kw),
     'compare_ltp': lambda **kw: ltp.compare_ltp(SYS, SYS, [1.0], **kw),
     'select_structure': lambda **kw: ltp.select_structure(ltp.lifted_frequency_response(
         _SINE_RESPONSE, 0.5, 1, transient=6.0), 0.5, [1], [0], **kw),
@@ -201,6 +210,7 @@ def test_unknown_keyword_is_rejected(name):
 _RESULT_CLASSES = {'Excitation', 'HTFFit', 'DelayEstimate', 'FDSubspaceInfo',
                    'PeriodicOrbit', 'FloquetRealization', 'MatrixErrors', 'LTPSubspaceInfo',
                    'LTPComparison', 'StructureSelection'}
+_RESULT_CLASSES |= {'ClosedLoopOrbit'}
 _RESULT_CLASSES |= {'OrbitBranch', 'Bifurcation'}
 _RESULT_CLASSES |= {'LMIDesign'}
 _RESULT_CLASSES |= {'RefineInfo', 'MonteCarloResult'}

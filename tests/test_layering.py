@@ -19,9 +19,12 @@ PACKAGE = pathlib.Path(__file__).resolve().parents[1] / 'ltpcontrol'
 #: layers listed before it.
 LAYERS = {
     # systems, periodic matrices, simulation, Floquet theory, frequency domain
-    'core': ['_validation', '_transition', '_march', '_steps', '_periodic_matrix',
+    'core': ['config', '_validation', '_transition', '_march', '_steps', '_periodic_matrix',
              '_ltpsys', '_timeresp', '_floquet', '_htf', '_htfplot', '_harmonic_ss',
-             '_discretize', '_lifting', '_metrics'],
+             '_display', '_discretize', '_lifting', '_metrics',
+             # python-control's entry points: reaches higher layers only by name,
+             # through the public namespace, when called
+             '_interop'],
     # analysis and synthesis on LTP models
     'analysis': ['_lyapunov', '_riccati', '_norms', '_zeros', '_design', '_place', '_lmi',
                  '_reduction', '_interconnect'],
@@ -30,7 +33,7 @@ LAYERS = {
     # experiments and identification from data
     'identification': ['_excitation', '_htf_estimate', '_htf_fit', '_fdsubspace',
                        '_hybrid_ls', '_realization', '_floquet_fit', '_canonical',
-                       '_structure', '_ltp_subspace', '_refine', '_montecarlo'],
+                       '_structure', '_ltp_subspace', '_refine', '_montecarlo', '_arx'],
 }
 
 #: Method aliases: methods of a class that call a public function of a higher

@@ -1,0 +1,88 @@
+"""Steps of the data-to-controller chain shared by the control examples.
+
+1. `record`: input–output records of a hybrid plant about its orbit
+   (output deviation ``y − ȳ(t)`` sampled every ``dt``), optionally with
+   white measurement noise on input and output at a given SNR (thesis
+   §3.7.5: ``SNR = (A_signal / A_noise)²`` with RMS amplitudes).
+2. `output_lqg`: periodic LQG on a discrete LTP model, weighting the
+   output: ``Σ y² + r u²``, process noise on the input, sensor noise ``rn``.
+3. `push_recovery`: response to a velocity push, open and closed loop, and
+   the strides taken to return within 1 % of the orbit.
+"""
+
+import numpy as np
+from joblib import Parallel, delayed
+
+import ltpcontrol as ltp
+
+
+def _orbit_mode(orbit, t):
+    return int(orbit._flow.evaluate([np.mod(t, orbit.period)])[1][0])
+
+
+def _simulate_record(plant, orbit, exc, seg, solver):
+    a, b = exc.segments[seg]
+    t = exc.time[a:b]
+    x0 = orbit(np.mod(t[0], orbit.period))
+    resp = ltp.simulate_hybrid(plant, t, x0, _orbit_mode(orbit, t[0]),
+                               inputs=lambda s: np.atleast_1d(exc.signal(np.atleast_1d(s))),
+                               **solver)
+    xbar = orbit(np.mod(t, orbit.period))
+    ybar = [plant.outfcn(tk, xk, orbit.u0, orbit.params)[0] for tk, xk in zip(t, xbar.T)]
+    return resp.outputs - np.array(ybar)
+
+
+def record(plant, orbit, exc, *, snr=None, seed=0, solver=None, n_jobs=2):
+    """Records ``(t, u, y)`` of every analysis segment of `exc`, started on the orbit.
+
+    Each segment of the excitation is an independent experiment that starts
+    on the orbit at the segment's phase.  With `snr`, white noise of RMS
+    ``rms(signal) / sqrt(snr)`` is added to the recorded input and output.
+    """
+    solver = solver or {'rtol': 1e-8, 'atol': 1e-11}
+    ys = Parallel(n_jobs=n_jobs)(delayed(_simulate_record)(plant, orbit, exc, seg, solver)
+                                 for seg in range(len(exc.segments)))
+    u = exc.inputs.copy()
+    y = np.concatenate(ys)
+    if snr is not None:
+        rng = np.random.default_rng(seed)
+        u = u + rng.standard_normal(u.shape) * np.sqrt(np.mean(u ** 2) / snr)
+        y = y + rng.standard_normal(y.shape) * np.sqrt(np.mean(y ** 2) / snr)
+    return exc.time, u, y
+
+
+def output_lqg(model, r, rn, qn=1.0):
+    """Periodic LQG of a discrete LTP model for the cost ``Σ y[k]² + r u[k]²``."""
+    C = model.C.sample(model.nsteps)
+    Q = np.einsum('kij,kil->kjl', C, C)
+    return ltp.lqg(model, Q, [[r]], [[qn]], [[rn]], name='lqg')
+
+
+def strides_to_recover(resp, orbit, t_push, nstrides, tol=0.01):
+    """Strides after the push until the state stays within `tol` of the orbit.
+
+    The stroboscopic deviation at ``t_push + kT`` is measured per plant
+    state relative to that state's range on the orbit.
+    """
+    T = orbit.period
+    scale = np.ptp(orbit.states, axis=1)
+    ref = orbit(np.mod(t_push, T))
+    n = orbit.plant.nstates
+    dev = np.array([np.max(np.abs(resp.states[:n, np.argmin(np.abs(resp.time - t_push - k * T))]
+                                  - ref) / scale) for k in range(nstrides + 1)])
+    above = np.nonzero(dev > tol)[0]
+    strides = 0 if above.size == 0 else int(above[-1] + 1)
+    return (strides if strides <= nstrides else None), dev
+
+
+def push_recovery(plant, orbit, controller, t_push, dv, nstrides, *, npoints=40,
+                  saturation=None, progress=False):
+    """Open- and closed-loop responses to a push ``Δv`` on the state at `t_push`."""
+    T = orbit.period
+    t = t_push + np.linspace(0, nstrides * T, nstrides * npoints + 1)
+    x0 = orbit(np.mod(t_push, T)) + dv
+    mode = _orbit_mode(orbit, t_push)
+    opened = ltp.simulate_hybrid(plant, t, x0, mode)
+    closed = ltp.closed_loop_response(plant, controller, orbit, t, x0, mode0=mode,
+                                      saturation=saturation, progress=progress)
+    return opened, closed

@@ -1,0 +1,679 @@
+"""Feedback loops of a hybrid plant and a controller about a periodic orbit.
+
+A controller ``K`` (an `LTPStateSpace`, a python-control LTI system or a
+`control.NonlinearIOSystem`; continuous or discrete time) closes the loop
+around the nominal orbit ``x̄(t)``, ``u0``, ``ȳ(t) = h(t, x̄(t), u0)`` of a
+`HybridPlant` (or a smooth `control.NonlinearIOSystem`), in the deviation
+coordinates of `linearize_orbit`::
+
+    e(t) = y(t) + v(t) − ȳ(t)      controller input (v: measurement noise)
+    u(t) = sat(u0 + w(t))           plant input (w: controller output)
+
+The controller output is added to the plant input as it is (no sign flip),
+as for estimator-based controllers ``w = −K x̂``.
+
+Phase lock: the controller runs on the plant's clock.  Its time argument is
+the plant time t, so the controller's ``t = 0`` is the orbit's ``t = 0``
+(the phase of the periodic forcing), whatever the simulation start.  A
+discrete controller samples ``e`` at ``t = k dt`` and holds ``u`` on
+``[k dt, (k+1) dt)``; it uses its matrices of step ``k mod N``.
+
+A continuous controller makes the loop a `HybridPlant` with states
+``[x, x_c]``, so orbits, saltation matrices and the exact return map come
+from `periodic_orbit`.  A discrete controller gives a sampled-data loop whose
+period map is the composition of its samples and hybrid flows between
+samples, with the Jacobian composed alike.
+"""
+
+import numbers
+from dataclasses import dataclass
+from types import SimpleNamespace
+from typing import Optional
+
+import numpy as np
+import control as ct
+from control.exception import ControlArgument, ControlDimension
+
+from ._hybrid import (HybridMode, HybridPlant, _central_jacobian, _Flow, _input_function,
+                      _solver_options)
+from ._ltpsys import LTPStateSpace
+from ._orbits import PeriodicOrbit, _as_hybrid, periodic_orbit
+from ._validation import check_kwargs, check_positive_int, real_array, steps_per_period
+
+__all__ = ['ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit']
+
+
+class _Loop:
+    """Validated plant, controller, orbit and saturation of one feedback loop."""
+
+    def __init__(self, plant, controller, orbit, saturation):
+        plant = _as_hybrid(plant, None)
+        if not isinstance(orbit, PeriodicOrbit):
+            raise ControlArgument(f"orbit must be a PeriodicOrbit, got {type(orbit).__name__}")
+        if orbit.plant.nstates != plant.nstates or orbit.plant.mode_names != plant.mode_names:
+            raise ValueError("orbit was computed for a plant with different states or modes")
+        if plant.ninputs == 0:
+            raise ValueError("plant has no inputs: a controller cannot act on it")
+        self.plant, self.orbit, self.T = plant, orbit, orbit.period
+        self.params, self.u0 = orbit.params, orbit.u0
+        self.n, self.m, self.p = plant.nstates, plant.ninputs, plant.noutputs
+        self.ctrl = _controller(controller, self.T)
+        if self.ctrl.ninputs != self.p or self.ctrl.noutputs != self.m:
+            raise ControlDimension(
+                f"controller must map the plant's {self.p} output(s) to its {self.m} "
+                f"input(s), got {self.ctrl.ninputs} input(s) and {self.ctrl.noutputs} output(s)")
+        self.nc, self.dt = self.ctrl.nstates, float(self.ctrl.dt)
+        self.nsamples = steps_per_period(self.T, self.dt, 'controller.dt') if self.dt else None
+        self.lower, self.upper = _saturation(saturation, self.m)
+        self.linear = isinstance(self.ctrl, LTPStateSpace)
+        if self.linear:
+            mats = (self.ctrl.A, self.ctrl.B, self.ctrl.C, self.ctrl.D)
+            self._fixed = [M(0.0) if M.is_constant else None for M in mats]
+            self._varying = [M for M in mats]
+            self._last = (None, None)
+        self._ybar = _output_interpolant(plant, orbit)
+        self._check_algebraic_loop()
+
+    def _check_algebraic_loop(self):
+        # y is evaluated at u0: exact unless both h and the controller pass u through
+        t, x = 0.0, self.orbit.x0
+        dh_du = _central_jacobian(lambda u: self.plant._h(t, x, u, self.params), self.u0)
+        dk_de = _central_jacobian(lambda e: self.ctrl_out(t, np.zeros(self.nc), e),
+                                  np.zeros(self.p))
+        if np.any(dh_du != 0) and np.any(dk_de != 0):
+            raise ValueError("algebraic loop: the plant output depends on its input and the "
+                             "controller has direct feedthrough; make one of them strictly "
+                             "proper")
+
+    def matrices(self, t):
+        """Controller matrices ``A_c, B_c, C_c, D_c`` at time t (linear controllers).
+
+        The last evaluation is kept: the loop's field, output and Jacobian
+        ask for the same t in turn, and designed gains (Riccati solutions)
+        are costly to evaluate.
+        """
+        if t != self._last[0]:
+            self._last = (t, [F if F is not None else M._eval(np.array([t]))[0]
+                              for F, M in zip(self._fixed, self._varying)])
+        return self._last[1]
+
+    def ctrl_rhs(self, t, xc, e):
+        if not self.linear:
+            return self.ctrl._rhs(t, xc, e)
+        A, B, _, _ = self.matrices(t)
+        return A @ xc + B @ e
+
+    def ctrl_out(self, t, xc, e):
+        if not self.linear:
+            return self.ctrl._out(t, xc, e)
+        _, _, C, D = self.matrices(t)
+        return C @ xc + D @ e
+
+    def ybar(self, t):
+        return self._ybar(t)
+
+    def error(self, t, x, v):
+        return self.plant._h(t, x, self.u0, self.params) + v - self.ybar(t)
+
+    def actuate(self, w):
+        return np.clip(self.u0 + w, self.lower, self.upper)
+
+
+def _output_interpolant(plant, orbit, tol=1e-11):
+    """``ȳ(t)`` from Chebyshev interpolants on each mode interval of the orbit.
+
+    The orbit's dense output is continuous only to the solver's tolerance
+    at its step boundaries; fed back through a controller such ripples
+    force the step-size control of the loop's integration into rejections.
+    The orbit is smooth within each mode interval, so a Chebyshev
+    interpolant there is smooth and accurate (degree doubled up to 256 until
+    it reproduces the orbit to `tol` relative at intermediate points).
+    """
+    cheb = np.polynomial.chebyshev
+    T, u0, params = orbit.period, orbit.u0, orbit.params
+    breaks = np.concatenate([[0.0], orbit.switching_times, [T]])
+
+    def ybar_exact(t):
+        return np.column_stack([plant._h(tk, x, u0, params)
+                                for tk, x in zip(t, orbit(t).T)])
+
+    pieces = []
+    for a, b in zip(breaks[:-1], breaks[1:]):
+        check = a + (b - a) * (0.5 + 0.49 * np.cos(np.linspace(0.1, 3.0, 17)))
+        y_check = ybar_exact(check)
+        scale = 1 + np.max(np.abs(y_check))
+        for deg in (16, 32, 64, 128, 256):
+            nodes = cheb.chebpts1(deg + 1)   # interior points: events excluded
+            coef = cheb.chebfit(nodes, ybar_exact(a + (b - a) * (nodes + 1) / 2).T, deg)
+            err = np.max(np.abs(cheb.chebval(2 * (check - a) / (b - a) - 1, coef) - y_check))
+            if err <= tol * scale:
+                break
+        pieces.append((a, b - a, coef))
+
+    def ybar(t):
+        tau = t % T
+        a, w, coef = pieces[min(np.searchsorted(breaks, tau, side='right') - 1, len(pieces) - 1)]
+        # Σ c_k T_k(s) with T_k(s) = cos(k arccos s)
+        s = np.clip(2 * (tau - a) / w - 1, -1.0, 1.0)
+        return np.cos(np.arange(len(coef)) * np.arccos(s)) @ coef
+    return ybar
+
+
+def _controller(controller, period):
+    """The controller as a `NonlinearIOSystem` phase-locked to `period`."""
+    if isinstance(controller, (ct.StateSpace, ct.TransferFunction)):
+        lti = ct.ss(controller) if isinstance(controller, ct.TransferFunction) else controller
+        dt = 0.0 if lti.dt in (0, None) else lti.dt
+        if dt is True:
+            raise ValueError("controller must have a numeric sampling time, got dt=True")
+        controller = LTPStateSpace(lti.A, lti.B, lti.C, lti.D, period, dt=dt,
+                                   name=lti.name, inputs=lti.input_labels,
+                                   outputs=lti.output_labels, states=lti.state_labels)
+    if not isinstance(controller, ct.NonlinearIOSystem):
+        raise ControlArgument("controller must be an LTPStateSpace, a control.StateSpace/"
+                              f"TransferFunction or a NonlinearIOSystem, got "
+                              f"{type(controller).__name__}")
+    if controller.dt is True or controller.dt is None:
+        raise ValueError(f"controller must have a numeric sampling time, got "
+                         f"dt={controller.dt}")
+    if isinstance(controller, LTPStateSpace):
+        ratio = period / controller.period
+        if abs(ratio - round(ratio)) > 1e-9 * ratio or round(ratio) < 1:
+            raise ValueError(f"controller period {controller.period:g} does not divide the "
+                             f"orbit period {period:g}: the loop would not be phase-locked")
+    return controller
+
+
+def _saturation(saturation, m):
+    if saturation is None:
+        return np.full(m, -np.inf), np.full(m, np.inf)
+    try:
+        lower, upper = saturation
+    except (TypeError, ValueError):
+        raise ControlArgument(f"saturation must be a pair (lower, upper), got "
+                              f"{saturation!r}") from None
+    bounds = []
+    for value, label in ((lower, 'lower'), (upper, 'upper')):
+        arr = np.asarray(value, float).reshape(-1)
+        if arr.size == 1:
+            arr = np.full(m, arr[0])
+        if arr.size != m:
+            raise ControlDimension(f"saturation {label} bound must have {m} entries")
+        if np.any(np.isnan(arr)):
+            raise ValueError(f"saturation {label} bound contains NaN")
+        bounds.append(arr)
+    if np.any(bounds[0] >= bounds[1]):
+        raise ValueError(f"saturation needs lower < upper, got {saturation!r}")
+    return bounds
+
+
+#
+# Continuous controller: the loop is a hybrid plant with states [x, x_c]
+#
+
+def _loop_plant(loop):
+    """`HybridPlant` of the continuous loop: input v (noise), outputs [y, u]."""
+    plant, ctrl, n, params = loop.plant, loop.ctrl, loop.n, loop.params
+
+    def signals(t, z, v):
+        e = loop.error(t, z[:n], v)
+        return e, loop.actuate(loop.ctrl_out(t, z[n:], e))
+
+    def mode(i):
+        src = plant.modes[i]
+
+        def updfcn(t, z, v, p):
+            e, u = signals(t, z, v)
+            return np.concatenate([plant._f(i, t, z[:n], u, params), loop.ctrl_rhs(t, z[n:], e)])
+
+        def jacobian(t, z, v, p):
+            # chain rule through e = h(x) + v − ȳ and u = sat(u0 + C_c x_c + D_c e)
+            e, u = signals(t, z, v)
+            Ac, Bc, Cc, Dc = loop.matrices(t)
+            H = _central_jacobian(lambda x: plant._h(t, x, loop.u0, params), z[:n])
+            active = ((u > loop.lower) & (u < loop.upper))[:, None]
+            du_dz = active * np.hstack([Dc @ H, Cc])
+            top = np.hstack([plant._dfdx(i, t, z[:n], u, params), np.zeros((n, loop.nc))])
+            top += plant._dfdu(i, t, z[:n], u, params) @ du_dz
+            return np.vstack([top, np.hstack([Bc @ H, Ac])])
+
+        guard = reset = None
+        if src.guard is not None:
+            def guard(t, z, v, p):
+                return plant._g(i, t, z[:n], signals(t, z, v)[1], params)
+
+            def reset(t, z, v, p):
+                return np.concatenate([plant._r(i, t, z[:n], signals(t, z, v)[1], params),
+                                       z[n:]])
+        return HybridMode(updfcn, guard=guard, reset=reset, name=plant.mode_names[i],
+                          target=plant._targets[i], jacobian=jacobian if loop.linear else None)
+
+    return HybridPlant([mode(i) for i in range(len(plant.modes))],
+                       lambda t, z, v, p: np.concatenate([plant._h(t, z[:n], signals(t, z, v)[1],
+                                                                   params),
+                                                          signals(t, z, v)[1]]),
+                       states=plant.state_labels + ctrl.state_labels,
+                       inputs=[f'v[{k}]' for k in range(loop.p)],
+                       outputs=plant.output_labels + plant.input_labels,
+                       params=params, name=f'{plant.name}+{ctrl.name}')
+
+
+#
+# Discrete controller: samples at t = k dt, flows of the plant with held input
+#
+
+def _held_plant(loop):
+    """The plant with its held input appended to the state (``u̇ = 0``)."""
+    plant, n, params = loop.plant, loop.n, loop.params
+
+    def mode(i):
+        src = plant.modes[i]
+        guard = reset = None
+        if src.guard is not None:
+            def guard(t, z, _, p):
+                return plant._g(i, t, z[:n], z[n:], params)
+
+            def reset(t, z, _, p):
+                return np.concatenate([plant._r(i, t, z[:n], z[n:], params), z[n:]])
+
+        def jacobian(t, z, _, p):
+            J = np.zeros((n + loop.m, n + loop.m))
+            J[:n, :n] = plant._dfdx(i, t, z[:n], z[n:], params)
+            J[:n, n:] = plant._dfdu(i, t, z[:n], z[n:], params)
+            return J
+        return HybridMode(lambda t, z, _, p: np.concatenate([plant._f(i, t, z[:n], z[n:], params),
+                                                             np.zeros(loop.m)]),
+                          guard=guard, reset=reset, target=plant._targets[i],
+                          name=plant.mode_names[i], jacobian=jacobian)
+
+    return HybridPlant([mode(i) for i in range(len(plant.modes))],
+                       states=plant.state_labels + plant.input_labels, params=params)
+
+
+class _Sampled:
+    """Sampled-data loop: state ``[x, x_c]`` just before a sample."""
+
+    def __init__(self, loop, opts):
+        self.loop, self.opts, self.held = loop, opts, _held_plant(loop)
+
+    def sample(self, k, z, v):
+        """``[x, x_c⁺, u_k]`` from ``[x, x_c]`` at the sample ``t = k dt``."""
+        loop, n = self.loop, self.loop.n
+        t = k * loop.dt
+        e = loop.error(t, z[:n], v)
+        tk = self._ctrl_time(k)
+        return np.concatenate([z[:n], loop.ctrl_rhs(tk, z[n:], e),
+                               loop.actuate(loop.ctrl_out(tk, z[n:], e))])
+
+    def _ctrl_time(self, k):
+        # middle of the step for LTP matrices held on [k dt, (k+1) dt): immune to rounding
+        loop = self.loop
+        return (k + 0.5) * loop.dt if isinstance(loop.ctrl, LTPStateSpace) else k * loop.dt
+
+    def step(self, k, z, mode, v, variational=False, t_end=None):
+        """Sample at ``k dt`` and flow to ``(k+1) dt`` (or `t_end`).
+
+        Returns the state before the next sample, its mode, the flow (or the
+        step's Jacobian with `variational`) and the held input.
+        """
+        loop, n, nc = self.loop, self.loop.n, self.loop.nc
+        s = self.sample(k, z, v)
+        t1 = (k + 1) * loop.dt if t_end is None else t_end
+        flow = _Flow(self.held, k * loop.dt, t1, np.concatenate([s[:n], s[n + nc:]]), mode,
+                     lambda t: np.zeros(0), loop.params, variational=variational, **self.opts)
+        z1 = np.concatenate([flow.x_final[:n], s[n:n + nc]])
+        if not variational:
+            return z1, flow.mode_final, flow, s[n + nc:]
+        # ds/dz by central differences (exact for linear controllers), then the
+        # flow Jacobian of the plant with held input [x, u]
+        S = _central_jacobian(lambda w: self.sample(k, w, v), z)
+        xu = flow.phi @ S[np.r_[0:n, n + nc:n + nc + loop.m]]
+        return z1, flow.mode_final, np.vstack([xu[:n], S[n:n + nc]]), s[n + nc:]
+
+    def period_map(self, z, mode, jacobian=False):
+        J = np.eye(len(z))
+        for k in range(self.loop.nsamples):
+            z, mode, Jk, _ = self.step(k, z, mode, 0.0, jacobian)
+            if jacobian:
+                J = Jk @ J
+        return z, mode, J
+
+
+@dataclass(repr=False)
+class ClosedLoopOrbit:
+    """Periodic orbit of a closed hybrid loop and its return map.
+
+    Returned by `closed_loop_orbit`; not meant to be built directly.
+
+    Attributes
+    ----------
+    period : float
+        The period T of the loop (the plant's orbit period).
+    x0 : ndarray
+        Plant state at t = 0 on the closed-loop orbit.
+    controller_state : ndarray
+        Controller state at t = 0 (before the sample at t = 0 for a
+        discrete controller).
+    mode0 : int
+        Plant mode at t = 0.
+    monodromy : ndarray, shape (n + n_c, n + n_c)
+        Jacobian of the closed-loop period map at ``[x0, controller_state]``,
+        saltation matrices of the hybrid events included.
+    multipliers : ndarray
+        Its eigenvalues, sorted by decreasing magnitude.
+    dominant_multiplier : float
+        Largest multiplier magnitude.
+    is_stable : bool
+        True when all multipliers lie strictly inside the unit circle.
+    orbit : PeriodicOrbit or None
+        The orbit of the loop as a hybrid plant with states ``[x, x_c]``
+        (continuous controllers), for plotting and evaluation; None for a
+        discrete controller.
+    residual : float
+        Relative fixed-point residual of the period map.
+
+    Examples
+    --------
+    Proportional feedback doubles the decay rate of ``ẋ = −x + cos t + u``:
+
+    >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t) + u, None, states=1, inputs=1)
+    >>> orbit = ltp.periodic_orbit(sys, 2 * np.pi, [0.0])
+    >>> cl = ltp.closed_loop_orbit(sys, ct.ss([], [], [], [[-1.0]]), orbit)
+    >>> bool(np.isclose(cl.dominant_multiplier, np.exp(-4 * np.pi)))
+    True
+    """
+
+    period: float
+    x0: np.ndarray
+    controller_state: np.ndarray
+    mode0: int
+    monodromy: np.ndarray
+    multipliers: np.ndarray
+    dominant_multiplier: float
+    is_stable: bool
+    orbit: Optional[PeriodicOrbit]
+    residual: float
+
+    def __repr__(self):
+        return (f"<ClosedLoopOrbit period={self.period:g}, dominant |multiplier|="
+                f"{self.dominant_multiplier:.4g}, stable={self.is_stable}>")
+
+
+def _result(period, z0, n, mode0, monodromy, orbit, residual):
+    """`ClosedLoopOrbit` with the multipliers sorted by decreasing magnitude."""
+    mult = np.linalg.eigvals(monodromy)
+    mult = mult[np.argsort(-np.abs(mult), kind='stable')]
+    dominant = float(np.abs(mult[0]))
+    return ClosedLoopOrbit(period, np.array(z0[:n]), np.array(z0[n:]), mode0, monodromy, mult,
+                           dominant, bool(dominant < 1), orbit, residual)
+
+
+def _initial(loop, initial_state, controller_state, mode0, t0):
+    if initial_state is None:
+        x0 = loop.orbit(np.mod(t0, loop.T))
+        if mode0 is None:
+            mode0 = int(loop.orbit._flow.evaluate([np.mod(t0, loop.T)])[1][0])
+    else:
+        x0 = real_array(initial_state, 'initial_state', ndim=(0, 1)).reshape(-1)
+        if x0.size != loop.n:
+            raise ControlDimension(f"initial_state must have {loop.n} entries, got {x0.size}")
+    mode0 = loop.orbit.mode0 if mode0 is None else loop.plant.mode_index(mode0, 'mode0')
+    xc0 = real_array(controller_state, 'controller_state', ndim=(0, 1)).reshape(-1)
+    if xc0.size == 1 and loop.nc != 1:
+        xc0 = np.full(loop.nc, xc0[0])
+    if xc0.size != loop.nc:
+        raise ControlDimension(f"controller_state must have {loop.nc} entries, got {xc0.size}")
+    return np.concatenate([x0, xc0]), mode0
+
+
+def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
+                         controller_state=0.0, *, mode0=None, noise=None, saturation=None,
+                         progress=False, **kwargs):
+    """Simulate a hybrid plant with a controller in the loop.
+
+    The controller sees the measured output deviation ``e = y + v − ȳ(t)``
+    from the orbit's output and its output ``w`` drives the plant through
+    ``u = sat(u0 + w)`` (no sign flip: an estimator-based controller outputs
+    ``w = −K x̂``).  The controller runs on the plant's clock: its ``t = 0``
+    is the orbit's ``t = 0`` (see the module notes); a discrete controller
+    samples at ``t = k dt`` and holds its output in between.
+
+    Parameters
+    ----------
+    plant : HybridPlant or control.NonlinearIOSystem
+        The plant (a continuous-time smooth system acts as one mode).
+    controller : LTPStateSpace, control.StateSpace, control.TransferFunction or control.NonlinearIOSystem
+        Continuous or discrete controller from the plant's outputs to its
+        inputs; an LTP controller's period must divide the orbit's period.
+    orbit : PeriodicOrbit
+        Nominal orbit of `plant` (from `periodic_orbit`); it supplies the
+        period, ``ȳ(t)``, the nominal input ``u0`` and the parameters.
+    timepts : array_like
+        Increasing time points on the plant's clock; the simulation runs
+        from ``timepts[0]`` to ``timepts[-1]`` (for a discrete controller
+        ``timepts[0]`` must be a sampling instant ``k dt``).
+    initial_state : array_like, optional
+        Plant state at ``timepts[0]`` (default: the orbit's state there).
+    controller_state : array_like, optional
+        Controller state at ``timepts[0]`` (default 0).
+    mode0 : int or str, optional
+        Plant mode at ``timepts[0]`` (default: the orbit's mode there, or
+        the orbit's mode at t = 0 when `initial_state` is given).
+    noise : array_like or callable, optional
+        Measurement noise ``v``: an array of shape ``(noutputs,
+        len(timepts))`` (linearly interpolated) or a callable ``v(t)``.
+    saturation : (lower, upper), optional
+        Bounds of the plant input ``u`` (scalars or one per input).
+    progress : bool, optional
+        Show a progress bar over the periods simulated (default False).
+    rtol, atol, method, max_events : optional
+        Integration settings, as in `simulate_hybrid`.
+
+    Returns
+    -------
+    resp : control.TimeResponseData
+        ``outputs`` are the plant outputs (without noise), ``states`` the
+        plant states followed by the controller states, ``inputs`` the plant
+        inputs ``u`` after saturation.  Extra attributes: ``modes``,
+        ``event_times``, ``noise`` (v on `timepts`).
+
+    Examples
+    --------
+    A forced oscillator hitting a wall at ``x = 0`` (restitution 0.7), its
+    hopping orbit, and a proportional controller recovering from a push:
+
+    >>> def free(t, x, u, p):
+    ...     return [x[1], -40 * (x[0] - 0.1) - x[1] + 5 * np.cos(2 * np.pi * t) + u[0]]
+    >>> mode = ltp.HybridMode(free, guard=lambda t, x, u, p: x[0],
+    ...                       reset=lambda t, x, u, p: [x[0], -0.7 * x[1]], target=0)
+    >>> wall = ltp.HybridPlant([mode], lambda t, x, u, p: [x[0]], states=2,
+    ...                        inputs=1, outputs=1)
+    >>> orbit = ltp.periodic_orbit(wall, 1.0, [0.2, 0.0], warmup=30)
+    >>> K = ct.ss([], [], [], [[-5.0]])
+    >>> resp = ltp.closed_loop_response(wall, K, orbit, np.linspace(0, 3, 31),
+    ...                                 orbit.x0 + [0.0, 0.5], saturation=(-2, 2))
+    >>> resp.states.shape, bool(np.abs(resp.inputs).max() <= 2)
+    ((2, 31), True)
+    """
+    opts = _solver_options(kwargs, 'closed_loop_response')
+    check_kwargs(kwargs, 'closed_loop_response')
+    loop = _Loop(plant, controller, orbit, saturation)
+    plant = loop.plant
+    timepts = real_array(timepts, 'timepts', ndim=1)
+    if timepts.size < 2 or np.any(np.diff(timepts) <= 0):
+        raise ValueError("timepts must be strictly increasing with at least 2 points")
+    z0, mode = _initial(loop, initial_state, controller_state, mode0, timepts[0])
+    # the noise has one entry per plant output
+    vfun = _input_function(SimpleNamespace(ninputs=loop.p), 0.0 if noise is None else noise,
+                           timepts)
+    bar = _progress(progress, timepts)
+    if loop.dt:
+        states, modes, events, u = _run_sampled(loop, opts, timepts, z0, mode, vfun, bar)
+    else:
+        states, modes, events, u = _run_continuous(loop, opts, timepts, z0, mode, vfun, bar)
+    bar.close()
+    n = loop.n
+    v = np.array([vfun(t) for t in timepts]).reshape(len(timepts), loop.p).T
+    y = np.column_stack([plant._h(t, states[:n, k], loop.u0, loop.params)
+                         for k, t in enumerate(timepts)])
+    resp = ct.TimeResponseData(
+        timepts, y, states, u, issiso=loop.m == 1 and loop.p == 1,
+        output_labels=plant.output_labels, input_labels=plant.input_labels,
+        state_labels=plant.state_labels + loop.ctrl.state_labels,
+        sysname=f'{plant.name}+{loop.ctrl.name}', return_x=True, plot_inputs=True,
+        title=f"Closed-loop response of {plant.name} with {loop.ctrl.name}")
+    resp.modes, resp.event_times, resp.noise = modes, np.array(events), v
+    return resp
+
+
+def _progress(progress, timepts):
+    from tqdm.auto import tqdm
+    if not isinstance(progress, (bool, np.bool_)):
+        raise ControlArgument(f"progress must be True or False, got {progress!r}")
+    return tqdm(total=float(timepts[-1] - timepts[0]), desc='closed loop', unit='s',
+                disable=not progress, leave=False,
+                bar_format='{l_bar}{bar}| {n:.3g}/{total:.3g} s')
+
+
+def _chunks(timepts, T):
+    """Breakpoints at the period boundaries between the first and last time."""
+    inner = np.arange(np.floor(timepts[0] / T) + 1, np.ceil(timepts[-1] / T)) * T
+    return np.concatenate([[timepts[0]], inner[inner > timepts[0]], [timepts[-1]]])
+
+
+def _run_sampled(loop, opts, timepts, z, mode, vfun, bar):
+    k0 = timepts[0] / loop.dt
+    if abs(k0 - round(k0)) > 1e-9 * max(1.0, abs(k0)):
+        raise ValueError(f"timepts[0]={timepts[0]:g} is not a sampling instant of the "
+                         f"discrete controller (dt={loop.dt:g})")
+    sampled = _Sampled(loop, opts)
+    n = loop.n
+    states = np.empty((n + loop.nc, timepts.size))
+    u = np.empty((loop.m, timepts.size))
+    modes = np.empty(timepts.size, int)
+    events = []
+    k, t = int(round(k0)), timepts[0]
+    while t < timepts[-1]:
+        t1 = min((k + 1) * loop.dt, timepts[-1])
+        z1, mode1, flow, held = sampled.step(k, z, mode, vfun(k * loop.dt), t_end=t1)
+        inside = (timepts >= t) & (timepts < t1)
+        xs, modes[inside] = flow.evaluate(timepts[inside])
+        # x_c[k] and u[k] hold on [k dt, (k+1) dt)
+        states[:n, inside], states[n:, inside], u[:, inside] = xs[:n], z[n:, None], held[:, None]
+        events += [e[0] for e in flow.events]
+        bar.update(t1 - t)
+        z, mode, t, k = z1, mode1, t1, k + 1
+    states[:, -1], modes[-1] = z, mode
+    u[:, -1] = sampled.sample(k, z, vfun(k * loop.dt))[n + loop.nc:]
+    return states, modes, events, u
+
+
+def _run_continuous(loop, opts, timepts, z, mode, vfun, bar):
+    lp = _loop_plant(loop)
+    states = np.empty((loop.n + loop.nc, timepts.size))
+    modes = np.empty(timepts.size, int)
+    events = []
+    edges = _chunks(timepts, loop.T)
+    for a, b in zip(edges[:-1], edges[1:]):
+        flow = _Flow(lp, a, b, z, mode, vfun, loop.params, **opts)
+        inside = (timepts >= a) & (timepts < b)
+        states[:, inside], modes[inside] = flow.evaluate(timepts[inside])
+        events += [e[0] for e in flow.events]
+        z, mode = flow.x_final, flow.mode_final
+        bar.update(b - a)
+    states[:, -1], modes[-1] = z, mode
+    u = np.column_stack([lp._h(t, states[:, j], vfun(t), loop.params)[loop.p:]
+                         for j, t in enumerate(timepts)])
+    return states, modes, events, u
+
+
+def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_state=None,
+                      tol=1e-10, max_iter=20, max_periods=20, **kwargs):
+    """Periodic orbit of the closed hybrid loop and its Floquet multipliers.
+
+    The loop of `closed_loop_response` (noise-free) is T-periodic; its
+    period map acts on the plant state and the controller state at
+    ``t = 0``.  The orbit is found by Newton's method on that map starting
+    from the plant orbit and `controller_state` (for a linear controller
+    and an inactive saturation the plant orbit with zero controller state is
+    already the closed-loop orbit), with the exact Jacobian: variational
+    equations, saltation matrices of the plant's events and, for a
+    discrete controller, the Jacobians of the samples.  Its eigenvalues
+    are the closed-loop Floquet multipliers, which verify a design on the
+    nonlinear hybrid plant.
+
+    Parameters
+    ----------
+    plant, controller, orbit, saturation
+        As in `closed_loop_response`.
+    controller_state : array_like, optional
+        Guess of the controller state at t = 0 (default 0).
+    tol, max_iter, max_periods : optional
+        As in `periodic_orbit` (defaults 1e-10, 20, 20; continuous
+        controllers); discrete
+        controllers use `tol` and `max_iter` for Newton and fall back to
+        `max_periods` periods of simulation.
+    rtol, atol, method, max_events : optional
+        Integration settings, as in `simulate_hybrid`.
+
+    Returns
+    -------
+    ClosedLoopOrbit
+        With ``is_stable`` False when the controller destabilises the loop.
+
+    Raises
+    ------
+    RuntimeError
+        If no closed-loop orbit is found (for example, the loop diverges
+        from a destabilising nonlinear controller's guess).
+
+    Examples
+    --------
+    Output feedback on ``ẋ = −x + cos t + u``: negative feedback speeds up
+    the return to the orbit, positive feedback beyond 1 destabilises it:
+
+    >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t) + u, None, states=1, inputs=1)
+    >>> orbit = ltp.periodic_orbit(sys, 2 * np.pi, [0.0])
+    >>> ltp.closed_loop_orbit(sys, ct.ss([], [], [], [[-2.0]]), orbit).is_stable
+    True
+    >>> cl = ltp.closed_loop_orbit(sys, ct.ss([], [], [], [[3.0]]), orbit)
+    >>> cl.is_stable, bool(np.isclose(cl.dominant_multiplier, np.exp(4 * np.pi)))
+    (False, True)
+    """
+    opts = _solver_options(kwargs, 'closed_loop_orbit')
+    check_kwargs(kwargs, 'closed_loop_orbit')
+    loop = _Loop(plant, controller, orbit, saturation)
+    z0, mode0 = _initial(loop, orbit.x0, 0.0 if controller_state is None else controller_state,
+                         orbit.mode0, 0.0)
+    if not loop.dt:
+        cl = periodic_orbit(_loop_plant(loop), loop.T, z0, mode0, tol=tol, max_iter=max_iter,
+                            max_periods=max_periods, **opts)
+        return _result(loop.T, cl.x0, loop.n, cl.mode0, cl.monodromy, cl, cl.residual)
+    return _sampled_orbit(_Sampled(loop, opts), z0, mode0, tol, max_iter, max_periods)
+
+
+def _sampled_orbit(sampled, z, mode, tol, max_iter, max_periods):
+    """Newton's method on the sampled-data period map, with simulation fallback."""
+    if not isinstance(tol, numbers.Real) or not 0 < tol < 1:
+        raise ValueError(f"tol must be a number in (0, 1), got {tol!r}")
+    max_iter = check_positive_int(max_iter, 'max_iter')
+    max_periods = check_positive_int(max_periods, 'max_periods', minimum=0)
+    loop, periods = sampled.loop, 0
+    while True:
+        for _ in range(max_iter + 1):
+            zT, modeT, J = sampled.period_map(z, mode, jacobian=True)
+            res = np.max(np.abs(zT - z)) / (1 + np.max(np.abs(z)))
+            if modeT == mode and res <= tol:
+                return _result(loop.T, z, loop.n, mode, J, None, res)
+            if modeT != mode or not np.all(np.isfinite(zT)):
+                break
+            step = np.linalg.lstsq(J - np.eye(len(z)), z - zT, rcond=None)[0]
+            if np.max(np.abs(step)) > 10 * (1 + np.max(np.abs(z))):
+                break
+            z = z + step
+        if periods >= max_periods:
+            raise RuntimeError(f"closed_loop_orbit: no T-periodic orbit of the sampled-data "
+                               f"loop found (tol={tol:g}) after {periods} simulated periods")
+        for _ in range(min(10, max_periods - periods)):
+            z, mode, _ = sampled.period_map(z, mode)
+            periods += 1

@@ -1,0 +1,242 @@
+"""python-control's entry points called on linear time-periodic systems.
+
+python-control's functions treat an `LTPStateSpace` as a generic nonlinear
+I/O system (time responses by a default-tolerance ODE solver) or fail deep
+inside with an unrelated message.  At import, ltpcontrol wraps the entry
+points listed below (in every python-control module that holds them) with
+a thin dispatcher: a call that involves no `LTPStateSpace` goes unchanged
+to python-control; a call that does is
+
+* routed to ltpcontrol's exact algorithm with the same arguments
+  (`ROUTES`), or
+* routed to the same-named ltpcontrol function when it exists, and refused
+  naming it otherwise (`HOOKS`: adding ``ltp.zeros`` turns ``ct.zeros``
+  from an error into the exact answer with no change here), or
+* refused with a `control.exception.ControlArgument` that names the
+  ltpcontrol way to get the quantity (`REFUSED`).
+
+``ct.sample_system``/``ct.c2d``, ``ct.poles`` and ``ct.linearize`` need no
+wrapper: they call the system's own methods.
+"""
+
+import functools
+import inspect
+import sys as _sys
+
+import numpy as np
+import control as ct
+from control.config import _process_kwargs
+from control.exception import ControlArgument
+from control.timeresp import _timeresp_aliases
+
+from ._ltpsys import LTPStateSpace
+from ._periodic_matrix import PeriodicMatrix
+
+__all__ = []
+
+
+def _is_ltp(obj):
+    return isinstance(obj, LTPStateSpace) or (
+        isinstance(obj, (list, tuple)) and any(isinstance(o, LTPStateSpace) for o in obj))
+
+
+def _involves_ltp(args, kwargs):
+    return any(_is_ltp(a) for a in args) or any(_is_ltp(v) for v in kwargs.values())
+
+
+def _ltp_function(name):
+    import ltpcontrol
+    return getattr(ltpcontrol, name, None)
+
+
+#
+# Time responses: same arguments, exact LTP simulation
+#
+
+def _time_response(name):
+    def route(orig, *args, **kwargs):
+        _process_kwargs(kwargs, _timeresp_aliases)
+        bound = inspect.signature(orig).bind(*args, **kwargs)
+        arg = dict(bound.arguments)
+        arg.update(arg.pop('kwargs', {}))
+        sysdata = arg.pop('sysdata') if 'sysdata' in arg else arg.pop('sys')
+        if isinstance(sysdata, (list, tuple)):
+            return ct.TimeResponseList([_dispatch(name, orig, s, **arg) for s in sysdata])
+        return _simulate(name, sysdata, arg)
+    return route
+
+
+def _dispatch(name, orig, sys, **arg):
+    if isinstance(sys, LTPStateSpace):
+        return _simulate(name, sys, dict(arg))
+    return orig(sys, **arg)
+
+
+def _simulate(name, sys, arg):
+    if arg.pop('params', None):
+        raise ControlArgument(f"{name}: an LTPStateSpace has no parameters (params)")
+    if arg.pop('interpolate', False):
+        raise ControlArgument(f"{name}: interpolate=True is not supported for an "
+                              "LTPStateSpace; give the input on the output time grid")
+    num = arg.pop('timepts_num', None)
+    if num is not None:
+        if arg.get('timepts') is None or np.ndim(arg['timepts']) != 0:
+            raise ControlArgument(f"{name}: give timepts (a final time or a grid) with "
+                                  "timepts_num for an LTPStateSpace")
+        arg['timepts'] = np.linspace(0, arg['timepts'], int(num))
+    if name == 'input_output_response':
+        # exact simulation: solver settings do not apply
+        for key in ('ignore_errors', 'solve_ivp_kwargs', 'solve_ivp_method', 'method'):
+            arg.pop(key, None)
+        times = arg.pop('evaluation_times', 'T')
+        if not (isinstance(times, str) and times == 'T'):
+            raise ControlArgument("input_output_response: an LTPStateSpace is evaluated at "
+                                  "timepts (evaluation_times='T')")
+        name = 'forced_response'
+    ret = arg.get('return_states')
+    if ret is None:
+        arg['return_states'] = bool(ct.config.defaults.get(f'{name}.return_x', False))
+    return _ltp_function(name)(sys, **arg)
+
+
+#
+# Block diagrams: LTP results for LTP, LTI and static blocks
+#
+
+def _supported_block(obj):
+    return isinstance(obj, (LTPStateSpace, ct.StateSpace, ct.TransferFunction,
+                            PeriodicMatrix, int, float, np.number, np.ndarray, list))
+
+
+def _blocks(name):
+    def route(orig, *args, **kwargs):
+        systems = list(args[0]) if name == 'interconnect' else list(args)
+        if not all(_supported_block(s) for s in systems):
+            return orig(*args, **kwargs)        # a nonlinear block: python-control's system
+        return _ltp_function(name)(*args, **kwargs)
+    return route
+
+
+#: python-control name -> router ``route(original, *args, **kwargs)``
+ROUTES = {
+    'forced_response': _time_response('forced_response'),
+    'step_response': _time_response('step_response'),
+    'initial_response': _time_response('initial_response'),
+    'impulse_response': _time_response('impulse_response'),
+    'input_output_response': _time_response('input_output_response'),
+    'feedback': _blocks('feedback'),
+    'series': _blocks('series'),
+    'parallel': _blocks('parallel'),
+    'append': _blocks('append'),
+    'interconnect': _blocks('interconnect'),
+}
+
+#: python-control name -> ltpcontrol function with the same arguments (analysis,
+#: synthesis, reduction), reached when this version of ltpcontrol provides it
+HOOKS = {name: name for name in ('zeros', 'norm', 'lyap', 'dlyap', 'gram', 'lqr', 'dlqr',
+                                 'lqe', 'dlqe', 'place', 'h2syn', 'hinfsyn', 'minreal')}
+HOOKS.update(hankel_singular_values='hsvd', balanced_reduction='balred')
+
+_HTF = ("ltp.htf(sys, nharmonics) (or ltp.harmonic_ss) for the harmonic transfer function; "
+        "HTF.component(k, omega) or ltp.htf_response give its components")
+_LTI = ("sys.to_ss() for constant matrices, sys.average(), sys.linearize(t=...) or "
+        "ltp.lift(sys) for an LTI view")
+
+#: python-control names that have no LTP meaning as called -> what to use instead
+REFUSED = {
+    'frequency_response': _HTF,
+    'bode_plot': "ltp.bode_htf(ltp.htf(sys, nharmonics))",
+    'nyquist_plot': "ltp.bode_htf or ltp.htf_map_plot of ltp.htf(sys, nharmonics)",
+    'nyquist_response': _HTF,
+    'nichols_plot': "ltp.bode_htf(ltp.htf(sys, nharmonics))",
+    'singular_values_response': _HTF,
+    'singular_values_plot': "ltp.htf_map_plot(ltp.htf(sys, nharmonics), omega)",
+    'evalfr': "ltp.htf(sys, nharmonics)(s)",
+    'dcgain': "ltp.htf(sys, nharmonics)(0) (the harmonic DC gains)",
+    'margin': "ltp.floquet_multipliers or ltp.is_stable",
+    'stability_margins': "ltp.floquet_multipliers or ltp.is_stable",
+    'bandwidth': _HTF,
+    'damp': "ltp.floquet_exponents(sys)",
+    'pole_zero_map': "ltp.floquet_exponents(sys)",
+    'pole_zero_plot': "ltp.floquet_exponents(sys)",
+    'root_locus_map': "ltp.floquet_exponents of the closed loops",
+    'root_locus_plot': "ltp.floquet_exponents of the closed loops",
+    'step_info': "ct.step_info(ltp.step_response(sys, T).outputs, T)",
+    'similarity_transform': "ltp.floquet_transform or ltp.to_canonical",
+    'canonical_form': "ltp.to_canonical",
+    'ss': _LTI,
+    'tf': _LTI,
+    'ss2tf': _LTI,
+    'mixsyn': "ltpcontrol's synthesis functions",
+}
+
+
+def refusal(name):
+    """The error for python-control's `name` (function or method) on an LTP system."""
+    return _refusal(name, REFUSED[name])
+
+
+def _refusal(what, hint):
+    return ControlArgument(f"{what} does not apply to a linear time-periodic system "
+                           f"(LTPStateSpace): use {hint}")
+
+
+def _hook(name, target):
+    def route(orig, *args, **kwargs):
+        fn = _ltp_function(target)
+        if fn is None:
+            raise ControlArgument(
+                f"{name} does not apply to a linear time-periodic system "
+                f"(LTPStateSpace) and its periodic counterpart ltp.{target} is not "
+                "available in this version of ltpcontrol")
+        return fn(*args, **kwargs)
+    return route
+
+
+def _refuse(name, hint):
+    def route(orig, *args, **kwargs):
+        raise _refusal(name, hint)
+    return route
+
+
+def _routes():
+    table = dict(ROUTES)
+    table.update({name: _hook(name, target) for name, target in HOOKS.items()})
+    table.update({name: _refuse(name, hint) for name, hint in REFUSED.items()})
+    return table
+
+
+def _wrap(orig, route):
+    @functools.wraps(orig)
+    def dispatcher(*args, **kwargs):
+        if _involves_ltp(args, kwargs):
+            return route(orig, *args, **kwargs)
+        return orig(*args, **kwargs)
+    dispatcher._ltp_route = route
+    return dispatcher
+
+
+def install():
+    """Wrap python-control's entry points (idempotent).
+
+    Every module of the ``control`` package that holds a listed function
+    (including aliases such as ``bode`` for ``bode_plot``) gets the same
+    dispatcher, so internal calls between python-control modules see it too.
+    """
+    modules = [m for n, m in list(_sys.modules.items())
+               if m is not None and (n == 'control' or n.startswith('control.'))]
+    for name, route in _routes().items():
+        orig = getattr(ct, name, None)
+        if orig is None or hasattr(orig, '_ltp_route'):
+            continue
+        wrapped = _wrap(orig, route)
+        for mod in modules:
+            for attr, value in list(vars(mod).items()):
+                if value is orig:
+                    setattr(mod, attr, wrapped)
+
+
+def original(name):
+    """python-control's own function behind a wrapped entry point."""
+    fn = getattr(ct, name)
+    return getattr(fn, '__wrapped__', fn)
