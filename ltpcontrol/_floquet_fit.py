@@ -5,9 +5,12 @@ A continuous LTP in Floquet form (constant A, periodic ``B(t)``, ``C(t)``,
 ``R_m(Ω) = (j(Ω + mω_p) I - A)^{-1}``, the harmonic response to the input
 harmonic 0
 
-    G_n(jΩ) = Σ_{m=-K..K} C_{n-m} R_m(Ω) B_m + D_n,        n = -K..K,
+    G_n(jΩ) = Σ_{m=-H..H} C_{n-m} R_m(Ω) B_m + D_n,        n = -K..K,
 
-truncated to the input harmonics ``|m| <= K`` of a K-harmonic model.  It is
+truncated to the input harmonics ``|m| <= H`` of a model whose B has H >= K
+harmonics (C then has K + H, D has K; H = K by default).  A plant whose A(t)
+is periodic has B_m for all m in Floquet form: the terms ``|m| > K`` omitted
+by H = K bias the fitted exponents, H = K + 1 captures most of them.  It is
 linear in D, linear in B for fixed (A, C) and in C for fixed (A, B), and
 ``dR_m = R_m dA R_m``.  The parameters are real: ``Re P_0, Re P_h, Im P_h``
 (h > 0) of every coefficient series, so that ``P_{-h} = conj P_h`` and the
@@ -31,29 +34,34 @@ def _resolvents(A, omega, wp, K):
     return np.linalg.inv(s[..., None, None] * np.eye(n) - A)
 
 
-def _model_response(R, Bc, Cc, Dc, K):
+def _cnm(Cc, K, H):
+    """``C_{n-m}`` for n = -K..K, m = -H..H, shape (2K+1, 2H+1, ny, nx)."""
+    n, m = np.arange(-K, K + 1), np.arange(-H, H + 1)
+    return Cc[(n[:, None] - m[None, :]) + K + H]
+
+
+def _model_response(R, Bc, Cc, Dc, K, H):
     """``G_n = Σ_m C_{n-m} R_m B_m + D_n`` for n = -K..K, shape (2K+1, ny, M)."""
     X = np.einsum('wmij,mj->wmi', R, Bc[:, :, 0])                 # R_m B_m
-    idx = np.arange(-K, K + 1)
-    Cnm = Cc[(idx[:, None] - idx[None, :]) + 2 * K]               # (n, m, ny, nx)
-    return np.einsum('nmoi,wmi->now', Cnm, X) + Dc[:, :, 0, None]
+    return np.einsum('nmoi,wmi->now', _cnm(Cc, K, H), X) + Dc[:, :, 0, None]
 
 
 def _harmonic_response(sys, omega, K):
-    """Continuous harmonic response G_n(jΩ), n = -K..K, of a Floquet-form model."""
-    wp = 2 * np.pi / sys.period
-    R = _resolvents(sys.A(0.0), omega, wp, K)
-    Bc, Cc, Dc = _coefficients(sys, K)
-    return _model_response(R, Bc, Cc, Dc, K)
+    """Continuous harmonic response G_n(jΩ), n = -K..K, of a Floquet-form model
+    (all harmonics of its B, at least K)."""
+    H = max(K, sys.B.nharmonics or 0)
+    R = _resolvents(sys.A(0.0), omega, 2 * np.pi / sys.period, H)
+    Bc, Cc, Dc = _coefficients(sys, K, H)
+    return _model_response(R, Bc, Cc, Dc, K, H)
 
 
-def _coefficients(sys, K):
-    """Fourier coefficients B_m (|m| <= K), C_l (|l| <= 2K), D_n (|n| <= K)."""
-    def central(P, H):
-        c = P.fourier(max(H, P.nharmonics or 0, 1))
+def _coefficients(sys, K, H):
+    """Fourier coefficients B_m (|m| <= H), C_l (|l| <= K+H), D_n (|n| <= K)."""
+    def central(P, h):
+        c = P.fourier(max(h, P.nharmonics or 0, 1))
         J = c.shape[0] // 2
-        return c[J - H:J + H + 1]
-    return central(sys.B, K), central(sys.C, 2 * K), central(sys.D, K)
+        return c[J - h:J + h + 1]
+    return central(sys.B, H), central(sys.C, K + H), central(sys.D, K)
 
 
 def _conj_map(H, size):
@@ -72,12 +80,13 @@ def _conj_map(H, size):
 
 
 class _FloquetFit:
-    """Real parameter vector θ = (B, C, D coefficients[, A]) of a K-harmonic model."""
+    """Real parameter vector θ = (B, C, D coefficients[, A]) of a model with H
+    harmonics in B fitted to K data harmonics."""
 
-    def __init__(self, nx, ny, K, period, estimate_d, fit_a):
-        self.nx, self.ny, self.K, self.wp = nx, ny, K, 2 * np.pi / period
+    def __init__(self, nx, ny, K, H, period, estimate_d, fit_a):
+        self.nx, self.ny, self.K, self.H, self.wp = nx, ny, K, H, 2 * np.pi / period
         self.fit_a = fit_a
-        Tb, Tc, Td = _conj_map(K, nx), _conj_map(2 * K, ny * nx), _conj_map(K, ny)
+        Tb, Tc, Td = _conj_map(H, nx), _conj_map(K + H, ny * nx), _conj_map(K, ny)
         self.nb, self.nc, self.nd = Tb.shape[0], Tc.shape[0], Td.shape[0]
         T = np.zeros((self.nb + self.nc + self.nd,) * 2, complex)
         nb, nc = self.nb, self.nc
@@ -86,35 +95,35 @@ class _FloquetFit:
         self.ncoef = self.T.shape[1]
 
     def pack(self, sys):
-        Bc, Cc, Dc = _coefficients(sys, self.K)
+        Bc, Cc, Dc = _coefficients(sys, self.K, self.H)
         c = np.concatenate([Bc.ravel(), Cc.ravel(), Dc.ravel()])
         theta = np.linalg.lstsq(self.T, c, rcond=None)[0].real
         return np.concatenate([theta, sys.A(0.0).ravel()]) if self.fit_a else theta
 
     def unpack(self, theta, A=None):
-        K, nx, ny, nb, nc = self.K, self.nx, self.ny, self.nb, self.nc
+        K, H, nx, ny, nb, nc = self.K, self.H, self.nx, self.ny, self.nb, self.nc
         c = self.T @ theta[:self.ncoef]
         if self.fit_a:
             A = theta[self.ncoef:].reshape(nx, nx)
-        return (A, c[:nb].reshape(2 * K + 1, nx, 1), c[nb:nb + nc].reshape(4 * K + 1, ny, nx),
+        return (A, c[:nb].reshape(2 * H + 1, nx, 1),
+                c[nb:nb + nc].reshape(2 * (K + H) + 1, ny, nx),
                 c[nb + nc:].reshape(2 * K + 1, ny, 1))
 
     def response_and_jacobian(self, theta, omega, A=None, jac=True):
         """Harmonic response (2K+1, ny, M) and its Jacobian ((2K+1) ny M, len θ)."""
-        K, nx, ny, nb, nc = self.K, self.nx, self.ny, self.nb, self.nc
+        K, H, nx, ny, nb, nc = self.K, self.H, self.nx, self.ny, self.nb, self.nc
         A, Bc, Cc, Dc = self.unpack(theta, A)
-        R = _resolvents(A, omega, self.wp, K)
-        G = _model_response(R, Bc, Cc, Dc, K)
+        R = _resolvents(A, omega, self.wp, H)
+        G = _model_response(R, Bc, Cc, Dc, K, H)
         if not jac:
             return G, None
-        M, idx = omega.size, np.arange(-K, K + 1)
-        Cnm = Cc[(idx[:, None] - idx[None, :]) + 2 * K]            # (n, m, o, i)
-        CR = np.einsum('nmoi,wmij->nowmj', Cnm, R)                 # C_{n-m} R_m
+        M, m = omega.size, np.arange(-H, H + 1)
+        CR = np.einsum('nmoi,wmij->nowmj', _cnm(Cc, K, H), R)     # C_{n-m} R_m
         X = np.einsum('wmij,mj->wmi', R, Bc[:, :, 0])              # R_m B_m, (w, m, i)
-        # dG_n = Σ_l dC_l X_{n-l}, |n-l| <= K
-        Xsel = np.zeros((2 * K + 1, 4 * K + 1, M, nx), complex)
-        for a, n in enumerate(idx):
-            Xsel[a, n - idx + 2 * K] = X.transpose(1, 0, 2)
+        # dG_n = Σ_l dC_l X_{n-l}, |n-l| <= H
+        Xsel = np.zeros((2 * K + 1, 2 * (K + H) + 1, M, nx), complex)
+        for a, n in enumerate(range(-K, K + 1)):
+            Xsel[a, n - m + K + H] = X.transpose(1, 0, 2)
         eye = np.eye(ny)
         JC = np.einsum('oq,nlwi->nowlqi', eye, Xsel).reshape(-1, nc)
         JD = np.einsum('na,oq,w->nowaq', np.eye(2 * K + 1), eye,
@@ -126,9 +135,10 @@ class _FloquetFit:
         return G, J
 
 
-def fit_floquet(sys, Gc, omega, K, *, estimate_d=True, fit_a=True, maxiter=50, rtol=1e-8,
-                **labels):
-    """Least-squares Floquet-form model of K harmonics fitted to ``G_n(jΩ)``.
+def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=True,
+                maxiter=50, rtol=1e-8, **labels):
+    """Least-squares Floquet-form model fitted to ``G_n(jΩ)``, n = -K..K, with
+    `harmonics` H >= K harmonics in B (default K), K + H in C, K in D.
 
     Starts from the Floquet-form LTPStateSpace `sys` and minimises
     ``Σ |G_n(jΩ) - Ĝ_n|²`` over the lines Ω (rad/s) and n = -K..K (module
@@ -137,7 +147,8 @@ def fit_floquet(sys, Gc, omega, K, *, estimate_d=True, fit_a=True, maxiter=50, r
     Returns ``(model, relative residual, converged)``.
     """
     nx, ny = sys.nstates, Gc.shape[1]
-    fit = _FloquetFit(nx, ny, K, sys.period, estimate_d, fit_a)
+    H = K if harmonics is None else harmonics
+    fit = _FloquetFit(nx, ny, K, H, sys.period, estimate_d, fit_a)
     A0 = sys.A(0.0)
     scale = max(np.linalg.norm(Gc), np.finfo(float).tiny)
 

@@ -288,7 +288,7 @@ class LTPSubspaceInfo:
 
 def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
                  realization='direct', realization_options=None, refit_a=True,
-                 refine=None, refine_options=None,
+                 refit_harmonics=None, refine=None, refine_options=None,
                  estimate_d=True,
                  seed=None, progress=False,
                  return_info=False, name=None, **kwargs):
@@ -344,6 +344,13 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         ``B``, ``C``, ``D`` (default True, which makes the result independent
         of `q`); False keeps the 'log' ``A`` and refits ``B``, ``C``, ``D``
         given ``A`` only.
+    refit_harmonics : int, optional
+        With ``conversion='refit'``, number H >= K of harmonics of ``B(t)``
+        in the refitted model (``C(t)`` gets K + H, ``D(t)`` K); default K.
+        A plant whose A(t) is periodic has infinitely many harmonics in
+        Floquet form; H = K + 1 lets the model carry the input harmonics
+        just beyond the data's, which removes most of the truncation bias
+        of the Floquet exponents (see the identification guide).
     refine : {None, 'ml'}, optional
         'ml': finish with `ltpcontrol.refine_ltp` on the lifted data (the
         maximum-likelihood fit of the Floquet-form model, equal weights
@@ -447,6 +454,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
     if conversion not in _CONVERSIONS:
         raise ValueError(f"conversion must be one of {_CONVERSIONS}, got {conversion!r}")
+    H = K if refit_harmonics is None else check_positive_int(
+        refit_harmonics, 'refit_harmonics', minimum=K)
     if refine not in (None, 'ml'):
         raise ValueError(f"refine must be None or 'ml', got {refine!r}")
     # 1. lifted frequency response
@@ -462,8 +471,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         realization_options, conversion, labels)
     # 5. structured refinement: the Floquet-form model fitted to the harmonic data
     if conversion == 'refit':
-        sysc, _, converged = fit_floquet(sysc, Gc, G.omega, K, estimate_d=estimate_d,
-                                         fit_a=refit_a, **labels)
+        sysc, _, converged = fit_floquet(sysc, Gc, G.omega, K, harmonics=H,
+                                         estimate_d=estimate_d, fit_a=refit_a, **labels)
         if not converged:
             warnings.warn("the least-squares refit did not converge", UserWarning,
                           stacklevel=2)

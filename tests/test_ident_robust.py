@@ -163,3 +163,25 @@ def test_unusable_lines_dropped_and_skipped():
     assert np.isclose(model.A(0.0)[0, 0], -2.0, atol=1e-3)
     with pytest.raises(ValueError, match='multiples'):
         ltp.lifted_frequency_response(resp, 0.5, 1, transient=6.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize('seed, n, ny', [(4, 2, 1), (5, 4, 1), (7, 3, 2), (8, 4, 1), (9, 4, 1)])
+def test_refit_harmonics_remove_exponent_bias(seed, n, ny):
+    """The five of the 30 plants whose K = 3 exponents miss by more than 1e-3
+    (weakly observable modes; measured 1.1e-3 to 4.9e-3): a refit whose B(t)
+    has K + 1 harmonics brings them within 1e-3 (measured <= 4.9e-6 on all 30)
+    and lowers the HTF error (measured <= 1.7e-6)."""
+    plant = random_ltp(seed, n, ny)
+    base = ltp.compare_ltp(_identify(plant, 3)[0], plant, UNSEEN)
+    model, _ = _identify(plant, 3, refit_harmonics=4)
+    assert model.B.nharmonics == 4 and model.C.nharmonics <= 7
+    wide = ltp.compare_ltp(model, plant, UNSEEN)
+    assert base.exponent_error > 1e-3 and wide.exponent_error <= 1e-5
+    assert wide.htf_error <= 1e-5 and wide.htf_error < base.htf_error
+
+
+def test_refit_harmonics_checked():
+    plant = random_ltp(0, 2, 1)
+    with pytest.raises(ValueError, match='refit_harmonics'):
+        ltp.identify_ltp(lifted_data(plant, 2, LINES, DT), T, 2, 2, refit_harmonics=1)
