@@ -713,7 +713,7 @@ def _to_ltp(obj, period, dt):
     if isinstance(obj, ct.TransferFunction):
         obj = ct.ss(obj)
     if isinstance(obj, ct.StateSpace):
-        if ct.common_timebase(obj.dt, dt) != dt and not (obj.dt in (None, True)):
+        if ct.common_timebase(obj.dt, dt) != dt and not _unspecified(obj.dt):
             raise ValueError(f"systems have incompatible timebases (dt={obj.dt} and dt={dt})")
         return LTPStateSpace(obj.A, obj.B, obj.C, obj.D, period, dt=dt,
                              inputs=obj.input_labels, outputs=obj.output_labels,
@@ -753,10 +753,18 @@ def _period_and_dt(systems, where):
         period = _merge_period(period, s.period)
     # static operands (no states) fit any timebase
     dts = {s.dt for s in systems if isinstance(s, ct.InputOutputSystem)
-           and s.dt not in (None, True) and s.nstates}
+           and not _unspecified(s.dt) and s.nstates}
     if len(dts) > 1:
         raise ValueError(f"{where}: systems have incompatible timebases {sorted(dts)}")
     return period, (dts.pop() if dts else 0.0)
+
+
+def _unspecified(dt):
+    """python-control's unspecified timebases: None, or True (discrete, any step).
+
+    By identity: ``dt in (None, True)`` would also match a sampling time of 1.0.
+    """
+    return dt is None or dt is True
 
 
 def _common(sys1, sys2):

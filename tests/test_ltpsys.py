@@ -147,3 +147,15 @@ def test_periods_combine_or_fail():
 def test_bad_input(call, exc, match):
     with pytest.raises(exc, match=match):
         call()
+
+
+def test_feedback_of_a_system_sampled_at_one_second_with_a_periodic_gain():
+    # dt = 1.0 equals True in Python: the timebase must still be taken as 1.0
+    A = np.array([[[1.2, 0.3], [0.0, 0.5]], [[0.8, 0.0], [0.4, 1.1]]])
+    B = np.array([[[0.0], [1.0]], [[1.0], [0.0]]])
+    sysd = ltp.ltpss(A, B, np.eye(2), 0, period=2.0, dt=1.0)
+    K = ltp.place(sysd, [0.5, -0.2])
+    loop = ltp.feedback(sysd, K)
+    assert loop.dt == 1.0
+    np.testing.assert_allclose(np.sort_complex(ltp.floquet_multipliers(loop)),
+                               np.sort_complex(np.array([-0.2, 0.5], complex)), atol=1e-10)
