@@ -37,7 +37,7 @@ from control.exception import ControlArgument, ControlDimension
 from ._hybrid import (HybridMode, HybridPlant, _central_jacobian, _Flow, _input_function,
                       _solver_options)
 from ._ltpsys import LTPStateSpace
-from ._orbits import PeriodicOrbit, _as_hybrid, periodic_orbit
+from ._orbits import PeriodicOrbit, _as_hybrid, _check_orbit_of, periodic_orbit
 from ._validation import check_kwargs, check_positive_int, real_array, steps_per_period
 
 __all__ = ['ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit']
@@ -48,12 +48,7 @@ class _Loop:
 
     def __init__(self, plant, controller, orbit, saturation):
         plant = _as_hybrid(plant, None)
-        if not isinstance(orbit, PeriodicOrbit):
-            raise ControlArgument(f"orbit must be a PeriodicOrbit, got {type(orbit).__name__}")
-        if orbit.plant.nstates != plant.nstates or orbit.plant.mode_names != plant.mode_names:
-            raise ValueError("orbit was computed for a plant with different states or modes")
-        if plant.ninputs == 0:
-            raise ValueError("plant has no inputs: a controller cannot act on it")
+        _check_orbit_of(orbit, plant, "a controller cannot act on it")
         self.plant, self.orbit, self.T = plant, orbit, orbit.period
         self.params, self.u0 = orbit.params, orbit.u0
         self.n, self.m, self.p = plant.nstates, plant.ninputs, plant.noutputs

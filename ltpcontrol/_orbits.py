@@ -483,6 +483,16 @@ def _segment_average(func, a, b):
     return np.einsum('k,kij->ij', weights, func(t)) / 2
 
 
+def _check_orbit_of(orbit, plant, why_inputs):
+    """`orbit` is a `PeriodicOrbit` of `plant` (a `HybridPlant` with inputs)."""
+    if not isinstance(orbit, PeriodicOrbit):
+        raise ControlArgument(f"orbit must be a PeriodicOrbit, got {type(orbit).__name__}")
+    if orbit.plant.nstates != plant.nstates or orbit.plant.mode_names != plant.mode_names:
+        raise ValueError("orbit was computed for a plant with different states or modes")
+    if plant.ninputs == 0:
+        raise ValueError(f"plant has no inputs: {why_inputs}")
+
+
 def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, name=None):
     """LTP model of a plant linearised about its periodic orbit.
 
@@ -532,12 +542,7 @@ def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, na
     from ._ltpsys import ltpss
 
     hp = _as_hybrid(plant, jacobian)
-    if not isinstance(orbit, PeriodicOrbit):
-        raise ControlArgument(f"orbit must be a PeriodicOrbit, got {type(orbit).__name__}")
-    if orbit.plant.nstates != hp.nstates or orbit.plant.mode_names != hp.mode_names:
-        raise ValueError("orbit was computed for a plant with different states or modes")
-    if hp.ninputs == 0:
-        raise ValueError("plant has no inputs: an LTP model needs at least one input")
+    _check_orbit_of(orbit, hp, "an LTP model needs at least one input")
     if not isinstance(piecewise_constant, (bool, np.bool_)):
         raise ControlArgument(f"piecewise_constant must be True or False, "
                               f"got {piecewise_constant!r}")
