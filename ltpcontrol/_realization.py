@@ -63,7 +63,7 @@ from scipy.optimize import linear_sum_assignment, minimize
 
 from ._lifting import _real_basis, lift
 from ._ltpsys import LTPStateSpace, ltpss
-from ._validation import check_kwargs, check_period, check_positive_int
+from ._validation import check_kwargs, check_period, check_positive, check_positive_int
 
 __all__ = ['floquet_realization', 'FloquetRealization']
 
@@ -133,7 +133,7 @@ class FloquetRealization:
 
 def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct',
                         input_harmonics='all', distance='corrected', tol=1e-4,
-                        fit_tol=0.05, ladder_tol=0.1, seed=None, progress=True, pso_options=None,
+                        fit_tol=0.05, ladder_tol=0.1, seed=None, progress=False, pso_options=None,
                         minimize_options=None, name=None, **kwargs):
     """Floquet-form LTP realization of an identified lifted LTI model.
 
@@ -185,7 +185,7 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
         Seed of the swarm ('pso'); the global NumPy random state used by
         pyswarms is restored afterwards.
     progress : bool
-        Show tqdm progress bars during the search ('pso'; default True).
+        Show tqdm progress bars during the search ('pso'; default False).
     pso_options : dict, optional
         'pso' settings: ``iters`` (default 500), ``particles`` (default
         ``n^2``), ``c1`` (0.5), ``c2`` (0.3), ``w`` (0.9) and ``bound``
@@ -251,9 +251,9 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
         raise ValueError(f"method must be 'direct' or 'pso', got {method!r}")
     if distance not in ('corrected', 'literal'):
         raise ValueError(f"distance must be 'corrected' or 'literal', got {distance!r}")
-    tol = _positive(tol, 'tol')
-    fit_tol = _positive(fit_tol, 'fit_tol')
-    ladder_tol = _positive(ladder_tol, 'ladder_tol')
+    tol = check_positive(tol, 'tol')
+    fit_tol = check_positive(fit_tol, 'fit_tol')
+    ladder_tol = check_positive(ladder_tol, 'ladder_tol')
     if not isinstance(progress, (bool, np.bool_)):
         raise ControlArgument(f"progress must be True or False, got {progress!r}")
     if seed is not None and (isinstance(seed, (bool, np.bool_))
@@ -737,12 +737,3 @@ def _pso_transform(problem, literal, seed, progress, pso, nm):
         res = minimize(scalar, x, method='Nelder-Mead', options=nm)
     x = res.x if res.fun <= best else x
     return x.reshape(n, n), nfev
-
-
-def _positive(value, name):
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.number)):
-        raise ControlArgument(f"{name} must be a real number, got {value!r}")
-    value = float(value)
-    if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"{name} must be positive and finite, got {value}")
-    return value
