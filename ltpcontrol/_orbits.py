@@ -20,6 +20,7 @@ from control.exception import ControlArgument, ControlDimension
 
 from ._hybrid import (HybridMode, HybridPlant, _central_jacobian, _constant_input,
                       _Flow, _params, _solver_settings)
+from ._ltpsys import ltpss
 from ._periodic_matrix import PeriodicMatrix
 from ._validation import check_period, check_positive_int, real_array
 
@@ -538,8 +539,6 @@ def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, na
     ...                  np.sort(np.abs(orbit.multipliers)), rtol=1e-6))
     True
     """
-    from ._ltpsys import ltpss
-
     hp = _as_hybrid(plant, jacobian)
     _check_orbit_of(orbit, hp, "an LTP model needs at least one input")
     if not isinstance(piecewise_constant, (bool, np.bool_)):

@@ -52,7 +52,7 @@ def as_ltp(sys, name="sys", *, period=None, discrete=None, lti_hint=None):
     >>> as_ltp(ct.ss(-1, 1, 1, 0), lti_hint='control.forced_response')
     Traceback (most recent call last):
     ...
-    control.exception.ControlArgument: sys is an LTI system: use control.forced_response, or convert it with ltpss(sys, period)
+    control.exception.ControlArgument: sys must be an LTPStateSpace; it is an LTI system: use control.forced_response, or convert it with ltpss(sys, period)
     """
     # _ltpsys imports this module: the system class is looked up at call time
     from ._ltpsys import LTPStateSpace, ltpss
@@ -63,8 +63,8 @@ def as_ltp(sys, name="sys", *, period=None, discrete=None, lti_hint=None):
     elif isinstance(sys, (ct.StateSpace, ct.TransferFunction)):
         if period is None:
             use = f"use {lti_hint}, or " if lti_hint else ""
-            raise ControlArgument(f"{name} is an LTI system: {use}convert it with "
-                                  "ltpss(sys, period)")
+            raise ControlArgument(f"{name} must be an LTPStateSpace; it is an LTI system: "
+                                  f"{use}convert it with ltpss(sys, period)")
         sys = ltpss(sys, check_period(period))
     else:
         raise ControlArgument(f"{name} must be an LTPStateSpace, got {type(sys).__name__}")

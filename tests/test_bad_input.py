@@ -259,7 +259,7 @@ CATALOGUE = [
     ('append-no-ltp', _call(ltp.append, ct.tf([1], [1, 1])), CA, 'LTPStateSpace'),
     ('append-incommensurate', _call(ltp.append, SYS, SYS_OTHER_PERIOD), VE,
      'incommensurate'),
-    ('negate-lti', _call(ltp.negate, ct.rss(1, 1, 1)), CA, 'sys is an LTI system'),
+    ('negate-lti', _call(ltp.negate, ct.rss(1, 1, 1)), CA, 'sys must be an LTPStateSpace'),
     ('negate-unknown-keyword', _call(ltp.negate, SYS, bogus=1), TE, 'bogus'),
 
     # -- time responses -------------------------------------------------------
