@@ -14,10 +14,13 @@ that names the offending argument.  There is one helper per concept:
 """
 
 import numbers
+from fractions import Fraction
 
 import control as ct
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
+
+from .config import _get
 
 __all__ = []
 
@@ -213,8 +216,6 @@ def commensurate(a, b, rtol=None, max_multiple=None):
     >>> commensurate(1.0, 1.5)
     3.0
     """
-    from fractions import Fraction
-    from .config import _get
     rtol, qmax = _get('period.rtol', rtol), _get('period.max_multiple', max_multiple)
     ratio = a / b
     frac = Fraction(ratio).limit_denominator(int(qmax))
