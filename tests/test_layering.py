@@ -153,14 +153,17 @@ def test_package_respects_layers():
     assert not errors, "\n".join(errors)
 
 
+def modules(pending, reason):
+    """The package's modules; those in `pending` must fail (strict xfail) until mended."""
+    return [pytest.param(path.stem, marks=pytest.mark.xfail(strict=True, reason=reason))
+            if path.stem in pending else path.stem for path in sorted(PACKAGE.glob('*.py'))]
+
+
 # modules whose lazy imports are not yet at module level
 PENDING_LAZY = {'_htf', '_harmonic_ss'}
 
 
-@pytest.mark.parametrize('module', [
-    pytest.param(path.stem, marks=pytest.mark.xfail(
-        strict=True, reason="lazy imports without a cycle")) if path.stem in PENDING_LAZY
-    else path.stem for path in sorted(PACKAGE.glob('*.py'))])
+@pytest.mark.parametrize('module', modules(PENDING_LAZY, "lazy imports without a cycle"))
 def test_lazy_imports_only_where_a_cycle_forces_them(module):
     found = [dep for mod, dep in package_unforced() if mod == module]
     assert not found, f"{module} imports {found} inside functions; import at module top"
@@ -216,10 +219,8 @@ def hidden_options(source):
 PENDING_OPTIONS = {'_htf', '_closed_loop'}
 
 
-@pytest.mark.parametrize('module', [
-    pytest.param(path.stem, marks=pytest.mark.xfail(
-        strict=True, reason="documented option in **kwargs")) if path.stem in PENDING_OPTIONS
-    else path.stem for path in sorted(PACKAGE.glob('*.py'))])
+@pytest.mark.parametrize('module', modules(PENDING_OPTIONS,
+                                              "documented option in **kwargs"))
 def test_documented_options_are_parameters(module):
     found = hidden_options((PACKAGE / f'{module}.py').read_text())
     assert not found, f"{module}: make these keyword-only parameters: {found}"
