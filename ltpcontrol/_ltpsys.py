@@ -19,6 +19,7 @@ from control.exception import ControlArgument, ControlDimension
 from control.iosys import _process_iosys_keywords
 from control.nlsys import NonlinearIOSystem
 
+from ._htf import htf
 from ._periodic_matrix import PeriodicMatrix, as_periodic
 from ._validation import check_period, commensurate, real_array, steps_per_period
 
@@ -294,7 +295,6 @@ class LTPStateSpace(NonlinearIOSystem):
 
     def htf(self, nharmonics, **kwargs):
         """Harmonic transfer function truncated to K harmonics; see `ltpcontrol.htf`."""
-        from ._htf import htf
         return htf(self, nharmonics, **kwargs)
 
     def sample(self, Ts, method='zoh', alpha=None, prewarp_frequency=None,

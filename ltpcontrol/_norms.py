@@ -29,6 +29,7 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
+from ._harmonic_ss import _HarmonicStateSpace, _internal_order
 from ._lyapunov import cyclic_lyap, periodic_solution
 from ._periodic_matrix import PeriodicMatrix
 from ._steps import gram_weight, step_grid, step_integrals
@@ -274,7 +275,6 @@ def _linf_continuous(sys, tol, nsteps):
 def _htf_peak(sys):
     """Largest σ_max of the HTF (4 harmonics) over ω ∈ [0, ω_p/2] and its ω."""
     from scipy.optimize import minimize_scalar
-    from ._htf import _HarmonicStateSpace, _internal_order
     w = sys.omega_p
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')

@@ -20,6 +20,7 @@ import numpy as np
 import scipy.linalg as la
 from control.exception import ControlArgument, ControlDimension
 
+from ._harmonic_ss import _toeplitz
 from ._validation import check_positive_int
 
 __all__ = ['zeros']
@@ -101,7 +102,6 @@ def _bandwidth(M):
 
 def _harmonic_zeros(sys, K):
     """Finite pencil eigenvalues of truncation K in the central strip."""
-    from ._htf import _toeplitz
     n, m = sys.nstates, sys.ninputs
     w = sys.omega_p
     T = [_toeplitz(M.fourier(2 * K), K) for M in (sys.A, sys.B, sys.C, sys.D)]
