@@ -196,3 +196,44 @@ def test_data_htf_marks_unidentified_components_with_nan():
         data.predict(t, high)
     with pytest.raises(ValueError, match="inf"):
         ltp.HTFData(np.where(np.isnan(G), np.inf, G), w, 1.0)
+
+
+def test_models_and_data_are_two_classes_behind_one_interface():
+    sys = mathieu()
+    H = ltp.htf(sys, 2)
+    assert type(H) is ltp.HTFModel and isinstance(H, ltp.HTF)
+    w = np.linspace(0.5, 5, 10)
+    direct = ltp.HTFModel(sys, 2)
+    np.testing.assert_array_equal(direct(1j * w), H(1j * w))
+    data = ltp.HTFData(H.components(w)[1], w, sys.period)
+    assert isinstance(data, ltp.HTF) and not isinstance(data, ltp.HTFModel)
+    np.testing.assert_allclose(data.to_frd().frdata, H.to_frd(w).frdata, rtol=1e-14)
+    # the period of an LTI system is an explicit keyword, refused for an LTP system
+    G = ct.rss(2, 1, 1)
+    np.testing.assert_allclose(ltp.htf(G, 1, period=2.0)(0.3j),
+                               ltp.htf(ltp.ltpss(G, 2.0), 1)(0.3j), rtol=1e-14)
+    with pytest.raises(TypeError, match="period"):
+        ltp.htf(sys, 1, period=2.0)
+
+
+def test_default_grid_is_one_setting():
+    H = ltp.htf(mathieu(), 1)
+    with ltp.config.defaults_context({'htf.omega_num': 37}):
+        w, G = H.components()
+        resp = ltp.htf_response(H)[0][0]
+    assert w.size == G.shape[-1] == 37
+    np.testing.assert_array_equal(resp.omega, w)
+    assert w[0] == pytest.approx(H.omega_p / 100) and w[-1] == pytest.approx(10 * H.omega_p)
+    # discrete time: the same grid, below the Nyquist frequency
+    Hd = ltp.htf(ltp.sample_system(mathieu(), 0.05), 1)
+    wd, _ = Hd.components()
+    assert wd.size == ltp.config.defaults['htf.omega_num'] and wd[-1] < np.pi / 0.05
+
+
+def test_predict_in_the_old_order_is_refused():
+    H = ltp.htf(mathieu(), 1)
+    t = np.arange(200) * 0.01
+    u = np.cos(2 * np.pi * t)
+    with pytest.raises(ValueError, match="order"):
+        H.predict(u, t)
+    np.testing.assert_array_equal(H.predict(timepts=t, inputs=u), H.predict(t, u))
