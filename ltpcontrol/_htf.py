@@ -31,8 +31,9 @@ __all__ = ['HTF', 'HTFModel', 'HTFData', 'htf']
 class HTF(abc.ABC):
     """Harmonic transfer function: the interface of `HTFModel` and `HTFData`.
 
-    Not instantiated itself: `htf` builds the HTF of a system
-    (`HTFModel`), `HTFData` holds components sampled on a frequency grid.
+    An abstract class, not instantiated itself: `htf` builds the HTF of a
+    system (`HTFModel`), `HTFData` holds components sampled on a frequency
+    grid.
     Both are evaluated, plotted and converted through the methods below.
 
     Attributes
@@ -60,14 +61,9 @@ class HTF(abc.ABC):
     (True, True, 'HTFData')
     """
 
-    def __new__(cls, *args, **kwargs):
-        if cls is HTF:
-            raise TypeError("HTF is the common interface of harmonic transfer functions: "
-                            "build a model with ltp.htf(sys, nharmonics) and frequency "
-                            "data with ltp.HTFData(components, omega, period)")
-        return super().__new__(cls)
-
-    def __init__(self, period, nharmonics, noutputs, ninputs, dt, name, inputs, outputs):
+    def _set_signals(self, period, nharmonics, noutputs, ninputs, dt, name, inputs,
+                     outputs):
+        """The attributes every HTF has (called by the constructors)."""
         self.period = check_period(period)
         self.nharmonics = nharmonics
         self.noutputs, self.ninputs = noutputs, ninputs
@@ -364,7 +360,7 @@ class HTFModel(HTF):
                  period=None):
         sys = as_ltp(sys, 'sys', period=period)
         K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
-        super().__init__(sys.period, K, sys.noutputs, sys.ninputs, sys.dt, sys.name,
+        self._set_signals(sys.period, K, sys.noutputs, sys.ninputs, sys.dt, sys.name,
                          sys.input_labels, sys.output_labels)
         self._states = list(sys.state_labels)
         # user -> htf -> HTFModel -> build
@@ -462,7 +458,7 @@ class HTFData(HTF):
             std = _data_array(std, 'std')
             if std.shape != comps.shape:
                 raise ControlDimension(f"std must have shape {comps.shape}, got {std.shape}")
-        super().__init__(period, comps.shape[0] // 2, comps.shape[1], comps.shape[2], 0.0,
+        self._set_signals(period, comps.shape[0] // 2, comps.shape[1], comps.shape[2], 0.0,
                          name, inputs, outputs)
         self._components = comps.astype(complex)
         self.omega = omega

@@ -214,6 +214,7 @@ _RESULT_CLASSES |= {'ClosedLoopOrbit'}
 _RESULT_CLASSES |= {'OrbitBranch', 'Bifurcation'}
 _RESULT_CLASSES |= {'LMIDesign'}
 _RESULT_CLASSES |= {'RefineInfo', 'MonteCarloResult'}
+_RESULT_CLASSES |= {'HTFEstimateInfo'}
 
 DOC_DEFECTS = {}
 

@@ -345,7 +345,7 @@ CATALOGUE = [
     ('htf-predict-old-order', lambda: H.predict(np.sin(np.arange(100) * 0.01),
                                                 np.arange(100) * 0.01), VE, 'order'),
     ('HTF-is-an-interface', _call(ltp.HTF, np.ones((3, 1, 1, 3)), [1.0, 2.0, 3.0], T), TE,
-     'HTFData'),
+     'HTF'),
     ('HTF-components-3d', _call(ltp.HTFData, np.ones((3, 1, 4)), np.arange(1, 5.0), T), CD,
      'components'),
     ('HTF-even-harmonics', _call(ltp.HTFData, np.ones((2, 1, 1, 4)), np.arange(1, 5.0), T), CD,
