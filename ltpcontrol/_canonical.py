@@ -297,8 +297,8 @@ def compare_ltp(est, true, omega, nharmonics=1, **kwargs):
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
     s = np.exp(1j * omega * true.dt) if true.isdtime(strict=True) else 1j * omega
     Ht, He = htf(true, K)(s), htf(est, K)(s)
-    scale = max(np.linalg.norm(Ht, axis=(1, 2)).max(), np.finfo(float).tiny)
-    htf_error = float(np.linalg.norm(He - Ht, axis=(1, 2)).max() / scale)
+    scale = max(np.linalg.norm(Ht, axis=(0, 1)).max(), np.finfo(float).tiny)
+    htf_error = float(np.linalg.norm(He - Ht, axis=(0, 1)).max() / scale)
     lt, le = floquet_exponents(true), floquet_exponents(est)
     if true.isdtime(strict=True):
         # per-step exponents ρ are defined up to e^{j2πk/N}

@@ -22,6 +22,7 @@ from control.iosys import _process_iosys_keywords
 from control.nlsys import NonlinearIOSystem
 
 from ._display import html, text
+from ._htf import htf
 from ._periodic_matrix import PeriodicMatrix, as_periodic
 from ._validation import (as_ltp, check_period, check_positive, commensurate, real_array,
                           steps_per_period)
@@ -292,7 +293,6 @@ class LTPStateSpace(NonlinearIOSystem):
 
     def htf(self, nharmonics, **kwargs):
         """Harmonic transfer function truncated to K harmonics; see `ltpcontrol.htf`."""
-        from ._htf import htf
         return htf(self, nharmonics, **kwargs)
 
     def sample(self, Ts, method='zoh', alpha=None, prewarp_frequency=None,

@@ -30,7 +30,7 @@ import control as ct
 from scipy.optimize import minimize_scalar
 
 from ._floquet import _log_multipliers
-from ._htf import _HarmonicStateSpace, _internal_order
+from ._harmonic_ss import _HarmonicStateSpace, _internal_order
 from ._lifting import lift
 from ._lyapunov import cyclic_lyap, periodic_solution
 from ._periodic_matrix import PeriodicMatrix

@@ -20,7 +20,7 @@ import numpy as np
 import scipy.linalg as la
 from control.exception import ControlDimension
 
-from ._htf import _toeplitz
+from ._harmonic_ss import _toeplitz
 from ._lifting import lift
 from ._validation import as_ltp, check_positive_int
 
