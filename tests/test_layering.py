@@ -41,7 +41,7 @@ LAYERS = {
 #: Method aliases: methods of a class that call a public function of a higher
 #: layer (python-control's ``lti.py`` does the same), e.g. ``sys.zeros()``
 #: for ``ltp.zeros(sys)``, so that python-control's own function dispatches.
-METHOD_ALIASES = {'_ltpsys': {'_zeros', '_htf', '_floquet', '_discretize', '_interop'}}
+METHOD_ALIASES = {'_ltpsys': {'_zeros', '_floquet', '_discretize', '_interop'}}
 # end of layer map
 
 #: Modules exempt from the layering: the public namespace imports everything.
@@ -160,7 +160,7 @@ def modules(pending, reason):
 
 
 # modules whose lazy imports are not yet at module level
-PENDING_LAZY = {'_htf', '_harmonic_ss'}
+PENDING_LAZY = set()
 
 
 @pytest.mark.parametrize('module', modules(PENDING_LAZY, "lazy imports without a cycle"))
@@ -216,7 +216,7 @@ def hidden_options(source):
 
 
 # modules that still take documented options out of **kwargs
-PENDING_OPTIONS = {'_htf', '_closed_loop'}
+PENDING_OPTIONS = {'_closed_loop'}
 
 
 @pytest.mark.parametrize('module', modules(PENDING_OPTIONS,
