@@ -517,12 +517,6 @@ def _solver_settings(where, rtol=1e-10, atol=1e-12, method='DOP853', max_events=
                 max_events=check_positive_int(max_events, 'max_events'))
 
 
-def _solver_options(kwargs, where):
-    """`_solver_settings` of the solver keywords in `kwargs` (removed from it)."""
-    keys = ('rtol', 'atol', 'method', 'max_events')
-    return _solver_settings(where, **{key: kwargs.pop(key) for key in keys if key in kwargs})
-
-
 def simulate_hybrid(plant, timepts, initial_state, mode0=0, inputs=0.0, params=None, *,
                     rtol=1e-10, atol=1e-12, method='DOP853', max_events=10000):
     """Simulate a `HybridPlant` with event detection.

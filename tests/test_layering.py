@@ -216,7 +216,7 @@ def hidden_options(source):
 
 
 # modules that still take documented options out of **kwargs
-PENDING_OPTIONS = {'_closed_loop'}
+PENDING_OPTIONS = set()
 
 
 @pytest.mark.parametrize('module', modules(PENDING_OPTIONS,
