@@ -5,6 +5,7 @@ import runpy
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 EXAMPLES = Path(__file__).resolve().parents[1] / 'examples'
@@ -27,3 +28,25 @@ def test_hopper_control_chain(tmp_path, monkeypatch, capsys):
     assert out['strides closed'] < out['strides open']
     assert out['effort'] <= example['EFFORT_BOUND']
     assert os.environ.get('LTP_EXAMPLES_QUICK') == '1'
+
+
+@pytest.mark.slow
+def test_vhop_control_chain(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, 'path', [str(EXAMPLES)] + sys.path)
+    monkeypatch.setenv('LTP_EXAMPLES_QUICK', '1')
+    example = runpy.run_path(str(EXAMPLES / 'plot_vhop_control.py'))
+    out, *_ = example['run']()
+    # open loop: the exact return map of the hybrid limit cycle
+    assert out['open'] == pytest.approx(0.848, abs=1e-3)
+    # the model identified from data has the plant's open-loop multipliers
+    np.testing.assert_allclose(np.sort_complex(out['identified model']),
+                               np.sort_complex(out['open multipliers']), atol=0.01)
+    # the design on it, verified on the hybrid plant, meets the target and
+    # reaches at least 80 % of the true-linearization design's reduction
+    assert out['identified'] <= 0.3
+    assert out['open'] - out['identified'] >= 0.8 * (out['open'] - out['true linearization'])
+    # push recovery is faster in closed loop, with the stated effort bound
+    assert out['strides closed'] is not None and out['strides open'] is not None
+    assert out['strides closed'] < out['strides open']
+    assert out['effort'] <= example['EFFORT_BOUND']
