@@ -47,7 +47,16 @@ saltation matrices included).
    push on the body velocity mid-flight (`ltpcontrol.closed_loop_response`),
    with the actuator effort.
 
-Set ``LTP_EXAMPLES_QUICK=1`` for shorter records.
+With noise on the recorded input and output at SNR 12.5 the identified
+multipliers stay right (within 0.005) but the model misses its data by
+about 16 % (the noise), and the same design on it only moves the closed
+loop's multiplier from 0.848 to about 0.66 on the hybrid plant; with other
+noise draws it can even destabilise the loop.  These weights are aggressive
+(Bryson's 1 mm against 3 N); a design for noisy models needs robustness
+margins that LQG does not give.
+
+Set ``LTP_EXAMPLES_QUICK=1`` for a shorter push simulation (the records
+are the same: shorter ones identify a model whose design is much worse).
 """
 
 import os
@@ -73,16 +82,16 @@ NSAMPLES = 33
 #: Multisine bands [b ω_p/2, (b+1) ω_p/2], b = 0 .. NBANDS-1.
 NBANDS = 4
 #: Multisine design: analysis periods, settling periods, amplitude per line (N).
-MULTISINE = {'nperiods': 20 if QUICK else 30, 'settle': 30, 'amplitude': 0.05}
+MULTISINE = {'nperiods': 30, 'settle': 30, 'amplitude': 0.05}
 #: Model structure: states and harmonics of the lifting.
 NSTATES, NHARMONICS = 2, 6
 #: Bryson's rule: output and input scales (m, N) and the sensor noise (m per N).
 Y_MAX, U_MAX, SENSOR = 1e-3, 3.0, 1e-4
 R_WEIGHT, RN = (Y_MAX / U_MAX) ** 2, SENSOR ** 2
 #: Push: body velocity change (m/s) in the middle of the flight phase.
-PUSH, NSTRIDES = 0.1, 25
-#: Actuator effort bound (N) that the closed loop must respect.
-EFFORT_BOUND = U_MAX
+PUSH, NSTRIDES = 0.05, 15 if QUICK else 25
+#: Actuator effort bound (N) for the push: a quarter of the pumping amplitude a = 75 N.
+EFFORT_BOUND = 20.0
 #: Signal-to-noise ratio of the noisy data set.
 SNR = 12.5
 
@@ -169,7 +178,7 @@ def main():
     axes[0].set_ylabel('h − h_lc (mm)')
     axes[0].legend()
     axes[0].set_title('VHOP: recovery from a push mid-flight')
-    axes[1].plot(closed.time, closed.inputs[0], drawstyle='steps-post', color='C1')
+    axes[1].plot(closed.time, np.atleast_2d(closed.inputs)[0], drawstyle='steps-post', color='C1')
     axes[1].set_ylabel('u_c (N)')
     axes[1].set_xlabel('time (s)')
     fig.tight_layout()

@@ -1,4 +1,4 @@
-"""The data-to-controller example on the simplified hopper, in quick mode."""
+"""The data-to-controller examples (simplified hopper, VHOP), in quick mode."""
 
 import os
 import runpy
@@ -11,13 +11,18 @@ import pytest
 EXAMPLES = Path(__file__).resolve().parents[1] / 'examples'
 
 
-@pytest.mark.slow
-def test_hopper_control_chain(tmp_path, monkeypatch, capsys):
+def _quick_run(script, tmp_path, monkeypatch):
+    """The example's module namespace and the figures of its quick `run`."""
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(sys, 'path', [str(EXAMPLES)] + sys.path)
     monkeypatch.setenv('LTP_EXAMPLES_QUICK', '1')
-    example = runpy.run_path(str(EXAMPLES / 'plot_hopper_control.py'))
-    out, *_ = example['run']()
+    example = runpy.run_path(str(EXAMPLES / script))
+    return example, example['run']()[0]
+
+
+@pytest.mark.slow
+def test_hopper_control_chain(tmp_path, monkeypatch, capsys):
+    example, out = _quick_run('plot_hopper_control.py', tmp_path, monkeypatch)
     # the identified design verified on the hybrid plant
     assert out['open'] == pytest.approx(0.599, abs=1e-3)
     assert out['identified'] <= 0.3
@@ -32,11 +37,7 @@ def test_hopper_control_chain(tmp_path, monkeypatch, capsys):
 
 @pytest.mark.slow
 def test_vhop_control_chain(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(sys, 'path', [str(EXAMPLES)] + sys.path)
-    monkeypatch.setenv('LTP_EXAMPLES_QUICK', '1')
-    example = runpy.run_path(str(EXAMPLES / 'plot_vhop_control.py'))
-    out, *_ = example['run']()
+    example, out = _quick_run('plot_vhop_control.py', tmp_path, monkeypatch)
     # open loop: the exact return map of the hybrid limit cycle
     assert out['open'] == pytest.approx(0.848, abs=1e-3)
     # the model identified from data has the plant's open-loop multipliers
