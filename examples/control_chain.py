@@ -8,6 +8,8 @@
    output: ``Σ y² + r u²``, process noise on the input, sensor noise ``rn``.
 3. `push_recovery`: response to a velocity push, open and closed loop, and
    the strides taken to return within 1 % of the orbit.
+4. `record_experiments`: records of multi-experiment designs (one row per
+   experiment, e.g. multisines in several bands), each started on the orbit.
 """
 
 import numpy as np
@@ -107,7 +109,8 @@ def record_experiments(plant, orbit, excitations, *, snr=None, seed=0, solver=No
     """
     from tqdm.auto import tqdm
     solver = solver or {'rtol': 1e-8, 'atol': 1e-11}
-    jobs = [(exc, row) for exc in excitations for row in range(np.atleast_2d(exc.inputs).shape[0])]
+    jobs = [(exc, row) for exc in excitations
+            for row in range(np.atleast_2d(exc.inputs).shape[0])]
     ys = Parallel(n_jobs=n_jobs)(delayed(_simulate_experiment)(plant, orbit, exc, row, solver)
                                  for exc, row in tqdm(jobs, desc='experiments',
                                                       disable=not progress, leave=False))
