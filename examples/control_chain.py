@@ -95,17 +95,17 @@ def _simulate_experiment(plant, orbit, exc, row, solver):
     resp = ltp.simulate_hybrid(plant, exc.time, orbit.x0, orbit.mode0,
                                inputs=lambda s: np.atleast_1d(signal(np.atleast_1d(s))[row]),
                                **solver)
-    return np.atleast_2d(resp.outputs)[0] - np.array([plant.outfcn(tk, xk, orbit.u0, orbit.params)[0]
-                                       for tk, xk in zip(exc.time, orbit(exc.time).T)])
+    ybar = [plant.outfcn(tk, xk, orbit.u0, orbit.params)[0]
+            for tk, xk in zip(exc.time, orbit(exc.time).T)]
+    return np.atleast_2d(resp.outputs)[0] - np.array(ybar)
 
 
-def record_experiments(plant, orbit, excitations, *, snr=None, seed=0, solver=None,
-                       n_jobs=2, progress=False):
+def record_experiments(plant, orbit, excitations, *, solver=None, n_jobs=2, progress=False):
     """Records ``(t, u, y)`` of multi-experiment designs, each row started on the orbit at t = 0.
 
     `excitations` is a list of `ltpcontrol.Excitation` with rows of equal
     length (e.g. `ltpcontrol.multisine` in several bands); ``u`` and ``y``
-    have one row per experiment.  `snr` adds white noise as in `record`.
+    have one row per experiment (noise-free).
     """
     from tqdm.auto import tqdm
     solver = solver or {'rtol': 1e-8, 'atol': 1e-11}
@@ -115,9 +115,4 @@ def record_experiments(plant, orbit, excitations, *, snr=None, seed=0, solver=No
                                  for exc, row in tqdm(jobs, desc='experiments',
                                                       disable=not progress, leave=False))
     u = np.vstack([np.atleast_2d(exc.inputs) for exc in excitations])
-    y = np.array(ys)
-    if snr is not None:
-        rng = np.random.default_rng(seed)
-        u = u + rng.standard_normal(u.shape) * np.sqrt(np.mean(u ** 2) / snr)
-        y = y + rng.standard_normal(y.shape) * np.sqrt(np.mean(y ** 2) / snr)
-    return excitations[0].time, u, y
+    return excitations[0].time, u, np.array(ys)
