@@ -1,22 +1,28 @@
-"""The data-to-controller example on the simplified hopper, in quick mode."""
+"""The data-to-controller examples (simplified hopper, VHOP), in quick mode."""
 
 import os
 import runpy
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 EXAMPLES = Path(__file__).resolve().parents[1] / 'examples'
 
 
-@pytest.mark.slow
-def test_hopper_control_chain(tmp_path, monkeypatch, capsys):
+def _quick_run(script, tmp_path, monkeypatch):
+    """The example's module namespace and the figures of its quick `run`."""
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(sys, 'path', [str(EXAMPLES)] + sys.path)
     monkeypatch.setenv('LTP_EXAMPLES_QUICK', '1')
-    example = runpy.run_path(str(EXAMPLES / 'plot_hopper_control.py'))
-    out, *_ = example['run']()
+    example = runpy.run_path(str(EXAMPLES / script))
+    return example, example['run']()[0]
+
+
+@pytest.mark.slow
+def test_hopper_control_chain(tmp_path, monkeypatch, capsys):
+    example, out = _quick_run('plot_hopper_control.py', tmp_path, monkeypatch)
     # the identified design verified on the hybrid plant
     assert out['open'] == pytest.approx(0.599, abs=1e-3)
     assert out['identified'] <= 0.3
@@ -27,3 +33,21 @@ def test_hopper_control_chain(tmp_path, monkeypatch, capsys):
     assert out['strides closed'] < out['strides open']
     assert out['effort'] <= example['EFFORT_BOUND']
     assert os.environ.get('LTP_EXAMPLES_QUICK') == '1'
+
+
+@pytest.mark.slow
+def test_vhop_control_chain(tmp_path, monkeypatch):
+    example, out = _quick_run('plot_vhop_control.py', tmp_path, monkeypatch)
+    # open loop: the exact return map of the hybrid limit cycle
+    assert out['open'] == pytest.approx(0.848, abs=1e-3)
+    # the model identified from data has the plant's open-loop multipliers
+    np.testing.assert_allclose(np.sort_complex(out['identified model']),
+                               np.sort_complex(out['open multipliers']), atol=0.01)
+    # the design on it, verified on the hybrid plant, meets the target and
+    # reaches at least 80 % of the true-linearization design's reduction
+    assert out['identified'] <= 0.3
+    assert out['open'] - out['identified'] >= 0.8 * (out['open'] - out['true linearization'])
+    # push recovery is faster in closed loop, with the stated effort bound
+    assert out['strides closed'] is not None and out['strides open'] is not None
+    assert out['strides closed'] < out['strides open']
+    assert out['effort'] <= example['EFFORT_BOUND']
