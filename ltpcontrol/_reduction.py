@@ -16,7 +16,12 @@ bound ``‖G - Ĝ‖∞ <= 2 Σ_{j>r} max_k σ_j(k)`` on the ℓ2 gain of the er
 
 A continuous-time system with constant matrices is reduced with its
 constant gramians (the same formulas with ``Â = WAV``), which is
-`control.balred`'s balanced truncation.
+`control.balred`'s balanced truncation.  A continuous-time system with
+periodic matrices is reduced by time-varying balanced truncation
+(`_periodic_balancing`) when the gap ``σ_r(t) > σ_{r+1}(t)`` holds for all
+t, with the bound of Sandberg and Rantzer (IEEE TAC 49(2), 2004)
+``‖G - Ĝ‖ <= 2 Σ_{j>r} sup_t σ_j(t)`` on the L2 gain of the error, the
+supremum taken along each branch of the discarded values.
 """
 
 import warnings
@@ -27,26 +32,34 @@ from control.exception import ControlArgument
 
 from ._ltpsys import LTPStateSpace
 from ._lyapunov import dlyap
-from ._validation import check_positive_int
+from ._periodic_balancing import gramians, hankel_svd, truncate
+from ._validation import check_positive_int, real_array
 
 __all__ = ['hsvd', 'balred', 'minreal']
 
 
-def hsvd(sys):
-    """Hankel singular values of a stable periodic system at every step.
+def hsvd(sys, t=None, *, nsteps=None):
+    """Hankel singular values of a stable periodic system (Conventions page).
+
+    ``σ_j = sqrt(λ_j(P Q))`` of the periodic gramians (`gram`), at every
+    step of a discrete-time system and at the instants `t` of a
+    continuous-time one.
 
     Parameters
     ----------
     sys : LTPStateSpace
-        Stable discrete-time system, or a continuous-time system with
-        constant matrices.
+        Stable continuous- or discrete-time system.
+    t : array_like, optional
+        Continuous time only: instants of evaluation (default 64 uniform
+        instants ``kT/64``; one row for a system with constant matrices).
+    nsteps : int, optional
+        Continuous time only: uniform steps of the gramians' grid (`lyap`).
 
     Returns
     -------
-    ndarray, shape (N, n)
-        ``σ_j(k)``, decreasing in j, for the N steps of the period (N = 1
-        for a continuous-time LTI system, whose values equal
-        `control.hankel_singular_values`).
+    ndarray, shape (N, n) or (len(t), n)
+        ``σ_j(k)`` or ``σ_j(t)``, decreasing in j.  A continuous-time system
+        with constant matrices gives `control.hankel_singular_values`.
 
     Examples
     --------
@@ -54,24 +67,52 @@ def hsvd(sys):
     >>> hsv = ltp.hsvd(ltp.ltpss(G, period=1.0))
     >>> np.allclose(hsv[0], np.sort(ct.hankel_singular_values(G))[::-1])
     True
+
+    A periodic gain on the input makes the values vary over the period:
+
+    >>> sys = ltp.ltpss([[-1.0, 0.0], [1.0, -2.0]],
+    ...                 lambda t: np.array([[1.0 + 0.5 * np.cos(t)], [0.0]]),
+    ...                 [[0.0, 1.0]], 0, period=2 * np.pi)
+    >>> hsv = ltp.hsvd(sys, t=[0.0, np.pi])
+    >>> hsv.shape, bool(hsv[0, 0] > hsv[1, 0])
+    ((2, 2), True)
     """
-    return _balance(sys)[0]
+    _check(sys)
+    if sys.isdtime(strict=True) or (sys.is_lti and t is None):
+        if t is not None:
+            raise ControlArgument("t applies to continuous-time systems only; a "
+                                  "discrete-time system has one row per step")
+        return _balance(sys)[0]
+    _require_stable(sys)
+    if t is None:
+        t = np.arange(64) * sys.period / 64
+    t = real_array(t, 't', ndim=(0, 1)).reshape(-1)
+    P, Q = gramians(sys, nsteps)
+    return hankel_svd(P(t), Q(t))[3]
 
 
-def balred(sys, orders, method='truncate', return_bound=False):
+def balred(sys, orders, method='truncate', return_bound=False, *, nsteps=None):
     """Periodic balanced truncation, as `control.balred`.
+
+    Discrete time: per-step balancing projections of the periodic gramians.
+    Continuous time: time-varying balanced truncation with a smooth periodic
+    projection (see the Notes), which needs the order-r gap
+    ``σ_r(t) > σ_{r+1}(t)`` at every t.
 
     Parameters
     ----------
     sys : LTPStateSpace
-        Stable discrete-time system, or a continuous-time system with
-        constant matrices (the reduced order is constant over the period).
+        Stable continuous- or discrete-time system.
     orders : int
         Order r of the reduced system, 1 <= r <= n.
     method : {'truncate'}
         Balanced truncation (the only method).
     return_bound : bool
-        Also return the a-priori bound ``2 Σ_{j>r} max_k σ_j(k)``.
+        Also return the a-priori bound ``2 Σ_{j>r} sup σ_j`` on the L2
+        (ℓ2) gain of the error.
+    nsteps : int, optional
+        Continuous time only: uniform steps of the period grid (`lyap`);
+        the reduced matrices are interpolated on it.
 
     Returns
     -------
@@ -83,12 +124,24 @@ def balred(sys, orders, method='truncate', return_bound=False):
     Raises
     ------
     ValueError
-        If the system is unstable, `orders` is out of range, or the order-r
-        Hankel singular value vanishes at some step (no constant-order
-        balanced truncation exists there).
-    ControlArgument
-        For a continuous-time system with time-varying matrices (sample it
-        with `ltpcontrol.sample_system`).
+        If the system is unstable, `orders` is out of range, the order-r
+        Hankel singular value vanishes at some step, or (continuous time)
+        ``σ_r(t)`` and ``σ_{r+1}(t)`` meet: no balanced truncation of constant
+        order r exists then.
+
+    Notes
+    -----
+    Continuous time, with ``P = SSᵀ``, ``Q = RRᵀ``, ``RᵀS = UΣVᵀ`` at every
+    t, the state is projected on the span of ``V_b = S V_r Σ_r^{-1/2}``
+    along the kernel of ``W_b = Σ_r^{-1/2} U_rᵀ Rᵀ`` (the dominant
+    invariant subspace of ``P(t)Q(t)``).  In a smooth periodic basis
+    ``V(t)`` of that span, with ``W V = I``, the reduced model is
+    ``(W A V − W V̇, W B, C V, D)``; the derivative of the projector is
+    computed exactly from the Lyapunov equations.  The bound is that of
+    Sandberg and Rantzer (IEEE TAC 49(2), 2004) for balanced truncation of
+    time-varying systems, ``2 Σ_{j>r} sup_t σ_j(t)``, with the supremum
+    along each branch of the discarded values where two of them cross
+    (discrete time: ``2 Σ_{j>r} max_k σ_j(k)``).
 
     Examples
     --------
@@ -99,16 +152,30 @@ def balred(sys, orders, method='truncate', return_bound=False):
     >>> rsys, bound = ltp.balred(sysd, 2, return_bound=True)
     >>> rsys.nstates, bool(bound < 0.1)
     (2, True)
+
+    A continuous-time plant with a periodic input gain:
+
+    >>> sys = ltp.ltpss([[-1.0, 0.0], [1.0, -4.0]],
+    ...                 lambda t: np.array([[1.0 + 0.5 * np.cos(t)], [0.2]]),
+    ...                 [[0.0, 1.0]], 0, period=2 * np.pi)
+    >>> rsys, bound = ltp.balred(sys, 1, return_bound=True)
+    >>> rsys.nstates, round(bound, 3)
+    (1, 0.03)
     """
     if method != 'truncate':
         raise ValueError(f"method must be 'truncate', got {method!r}")
     if not isinstance(return_bound, (bool, np.bool_)):
         raise ControlArgument(f"return_bound must be True or False, got {return_bound!r}")
-    hsv, W, V = _balance(sys)
+    _check(sys)
     r = check_positive_int(orders, 'orders')
-    n = hsv.shape[1]
+    n = sys.nstates
     if r > n:
         raise ValueError(f"orders must be at most the number of states {n}, got {r}")
+    if not sys.isdtime(strict=True) and not sys.is_lti:
+        _require_stable(sys)
+        rsys, bound = _truncate_periodic(sys, r, nsteps, '$reduced')
+        return (rsys, bound) if return_bound else rsys
+    hsv, W, V = _balance(sys)
     if np.min(hsv[:, r - 1]) <= 1e-13 * max(1.0, hsv.max()):
         raise ValueError(f"the Hankel singular value {r} vanishes at some step of the "
                          "period: no balanced truncation of constant order "
@@ -121,24 +188,27 @@ def balred(sys, orders, method='truncate', return_bound=False):
     return (rsys, bound) if return_bound else rsys
 
 
-def minreal(sys, tol=None):
+def minreal(sys, tol=None, *, nsteps=None):
     """Remove the uncontrollable and unobservable periodic modes, as `control.minreal`.
 
-    Discrete time: balanced truncation of the states whose Hankel singular
-    values stay below ``tol`` (relative to the largest) at every step, which
-    removes exactly the modes that are unreachable or unobservable over the
-    period; the input-output map is unchanged to within ``2 Σ`` of the
-    removed values.  A continuous-time system with constant matrices is
-    passed to `control.minreal`.
+    Balanced truncation of the states whose Hankel singular values stay
+    below ``tol`` (relative to the largest) over the whole period, which
+    removes exactly the modes that are unreachable or unobservable; the
+    input-output map is unchanged to within ``2 Σ`` of the removed values.
+    A continuous-time system with constant matrices is passed to
+    `control.minreal`.
 
     Parameters
     ----------
     sys : LTPStateSpace
-        Stable discrete-time system, or a continuous-time system with
-        constant matrices.
+        Stable system (discrete time, or continuous time with periodic
+        matrices), or a continuous-time system with constant matrices.
     tol : float, optional
         Relative tolerance on the Hankel singular values (default
-        ``sqrt(eps)``, about 1.5e-8).
+        ``sqrt(eps)``, about 1.5e-8, in discrete time; 1e-6 for continuous
+        periodic matrices, whose gramians are integrated to about 1e-12).
+    nsteps : int, optional
+        Continuous time only: uniform steps of the period grid (`lyap`).
 
     Returns
     -------
@@ -147,7 +217,8 @@ def minreal(sys, tol=None):
     Raises
     ------
     ValueError
-        If a discrete-time system is unstable (its gramians do not exist).
+        If a system with periodic matrices is unstable (its gramians do not
+        exist).
 
     Examples
     --------
@@ -158,21 +229,28 @@ def minreal(sys, tol=None):
     >>> ltp.minreal(sysd).nstates
     1
     """
+    periodic_ct = not sys.isdtime(strict=True) and not sys.is_lti \
+        if isinstance(sys, LTPStateSpace) else False
     if tol is None:
-        tol = np.sqrt(np.finfo(float).eps)
+        tol = 1e-6 if periodic_ct else np.sqrt(np.finfo(float).eps)
     if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, (int, float, np.floating)) \
             or not 0 <= tol < 1:
         raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
     _check(sys)
-    if not sys.isdtime(strict=True):
+    if not sys.isdtime(strict=True) and sys.is_lti:
         red = ct.minreal(sys.to_ss(), tol=tol, verbose=False)
         return LTPStateSpace(red.A, red.B, red.C, red.D, sys.period,
                              inputs=sys.input_labels, outputs=sys.output_labels,
                              name=sys.name + '$minreal')
-    hsv, W, V = _balance(sys)
+    if periodic_ct:
+        hsv = hsvd(sys, nsteps=nsteps)
+    else:
+        hsv, W, V = _balance(sys)
     keep = int(np.count_nonzero(np.max(hsv, axis=0) > tol * max(hsv.max(), 1e-300)))
     if keep == hsv.shape[1]:
         return sys
+    if periodic_ct:
+        return _truncate_periodic(sys, keep, nsteps, '$minreal')[0]
     return _project(sys, W[:, :keep], V[:, :, :keep])
 
 
@@ -183,17 +261,26 @@ def minreal(sys, tol=None):
 def _check(sys):
     if not isinstance(sys, LTPStateSpace):
         raise ControlArgument(f"sys must be an LTPStateSpace, got {type(sys).__name__}")
-    if not sys.isdtime(strict=True) and not sys.is_lti:
-        raise ControlArgument("a continuous-time system with time-varying matrices is "
-                              "reduced after sampling (ltpcontrol.sample_system)")
+
+
+def _require_stable(sys):
+    if not sys.is_stable():
+        raise ValueError("sys must be stable: the gramians of an unstable system do "
+                         "not exist")
+
+
+def _truncate_periodic(sys, r, nsteps, suffix):
+    """Continuous-time periodic balanced truncation and its a-priori bound."""
+    (A, B, C), sup = truncate(sys, r, nsteps)
+    bound = 2 * float(np.sum(sup))
+    rsys = LTPStateSpace(A, B, C, sys.D, sys.period, inputs=sys.input_labels,
+                         outputs=sys.output_labels, name=sys.name + suffix)
+    return rsys, bound
 
 
 def _balance(sys):
     """Hankel singular values (N, n) and balancing projections W (N, n, n), V (N, n, n)."""
-    _check(sys)
-    if not sys.is_stable():
-        raise ValueError("sys must be stable: the gramians of an unstable system do "
-                         "not exist")
+    _require_stable(sys)
     if sys.isdtime(strict=True):
         N = sys.nsteps
         A, B, C = (M.sample(N) for M in (sys.A, sys.B, sys.C))
@@ -202,19 +289,12 @@ def _balance(sys):
     else:
         G = sys.to_ss()
         P, Q = ct.gram(G, 'c')[None], ct.gram(G, 'o')[None]
-    S, R = _sqrt_factor(P), _sqrt_factor(Q)
-    U, hsv, Vt = np.linalg.svd(np.swapaxes(R, 1, 2) @ S)
+    S, R, U, hsv, Vt = hankel_svd(P, Q)
     with np.errstate(divide='ignore'):
         scale = np.where(hsv > 0, 1 / np.sqrt(hsv), 0.0)
     W = scale[:, :, None] * (np.swapaxes(U, 1, 2) @ np.swapaxes(R, 1, 2))
     V = S @ np.swapaxes(Vt, 1, 2) * scale[:, None, :]
     return hsv, W, V
-
-
-def _sqrt_factor(X):
-    """``S`` with ``X = S Sᵀ`` for symmetric positive semidefinite X (stacked)."""
-    w, U = np.linalg.eigh(0.5 * (X + np.swapaxes(X, 1, 2)))
-    return U * np.sqrt(np.clip(w, 0, None))[:, None, :]
 
 
 def _project(sys, W, V):

@@ -29,7 +29,7 @@ LAYERS = {
              '_interop'],
     # analysis and synthesis on LTP models
     'analysis': ['_lyapunov', '_riccati', '_norms', '_zeros', '_design', '_place', '_lmi',
-                 '_reduction', '_interconnect'],
+                 '_reduction', '_periodic_balancing', '_interconnect'],
     # rhythmic (hybrid) plants, their periodic orbits and closed loops
     'orbits': ['_hybrid', '_orbits', '_autonomous', '_continuation', '_closed_loop'],
     # experiments and identification from data
