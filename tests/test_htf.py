@@ -57,7 +57,9 @@ def test_lti_limit_is_shifted_diagonal():
             # frequency last, as in python-control: G(s) is (ny, nu, len(s))
             blk = M[2 * a:2 * a + 2, 2 * b:2 * b + 2]
             expected = G(s + 1j * n * wp) if a == b else np.zeros_like(blk)
-            np.testing.assert_allclose(blk, expected, rtol=1e-12, atol=1e-12)
+            # random plants may have poles near s: scale the tolerance by |G|
+            scale = 1 + np.abs(G(s + 1j * n * wp)).max()
+            np.testing.assert_allclose(blk, expected, rtol=1e-12, atol=1e-12 * scale)
 
 
 def test_component_convention_and_shift_property():
