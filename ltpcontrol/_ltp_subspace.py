@@ -37,12 +37,12 @@ from tqdm.auto import tqdm
 
 from ._discretize import d2c
 from ._fdsubspace import fdsubspace, FDSubspaceInfo
-from ._floquet_fit import _harmonic_response, fit_floquet
+from ._floquet_fit import _harmonic_data, _harmonic_response, fit_floquet
 from ._lifting import _harmonic_labels, _real_basis
 from ._realization import FloquetRealization, floquet_realization
 from ._refine import refine_ltp
-from ._validation import (check_kwargs, check_period, check_positive_int,
-                          real_array, steps_per_period)
+from ._validation import (check_kwargs, check_period, check_positive, check_positive_int,
+                          real_array, steps_per_period, time_record)
 
 __all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
 
@@ -50,6 +50,11 @@ __all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
 _LINE_RTOL = 1e-3
 # Energy outside the detected lines (relative) above which leakage is reported.
 _LEAKAGE_RTOL = 1e-8
+# Smallest/largest eigenvalue of the normalised input Gram matrix of a line below
+# which the experiments cannot separate the inputs (error) or separate them poorly
+# (warning, condition number of the input phasors > 100).
+_SEPARATION_RTOL = 1e-10
+_SEPARATION_WARN = 1e-4
 _HOLDS = (None, 'foh', 'zoh')
 _CONVERSIONS = ('refit', 'log', 'tustin')
 
@@ -60,22 +65,26 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
                               **kwargs):
     r"""Lifted frequency response of an LTP system from sine experiments.
 
-    Each experiment applies one real sinusoid (single sine) or a sum of
-    sinusoids (multisine) to a single-input LTP system of known period T.
-    After discarding a transient, the last whole periods of every record
-    are Fourier analysed at the input lines ``Ω`` and at the output
+    Each experiment applies real sinusoids (single sines) or sums of
+    sinusoids (multisines) to the inputs of an LTP system of known period
+    T.  After discarding a transient, the last whole periods of every
+    record are Fourier analysed at the input lines ``Ω`` and at the output
     harmonics ``Ω + nω_p``, n = -K..K.  The result is the frequency
-    response of the real lifted LTI system (`ltpcontrol.lift`) from its
-    ``c0`` input, i.e. the data of thesis eqs. (4.78)-(4.79).
+    response of the real lifted LTI system (`ltpcontrol.lift`) from the
+    ``c0`` coordinate of every input, i.e. the data of thesis eqs.
+    (4.78)-(4.79).  With several inputs, every line must be excited in at
+    least as many experiments as there are inputs, with input phasors that
+    separate the inputs (`sine_experiments` and `multisine` with
+    ``ninputs``); the response is their least-squares solution per line.
 
     Parameters
     ----------
     response : control.TimeResponseData or tuple
         The experiments: a response of `ltpcontrol.forced_response` with
         several traces, or a tuple ``(timepts, inputs, outputs)`` with
-        ``inputs`` of shape ``(nexp, L)`` or ``(1, nexp, L)`` and
-        ``outputs`` of shape ``(nexp, L)`` (single output) or
-        ``(noutputs, nexp, L)``.  ``timepts`` (length L, uniform step
+        ``inputs`` of shape ``(nexp, L)`` (single input) or ``(ninputs,
+        nexp, L)`` and ``outputs`` of shape ``(nexp, L)`` (single output)
+        or ``(noutputs, nexp, L)``.  ``timepts`` (length L, uniform step
         ``Ts``) are absolute times: ``t = 0`` is the phase reference of the
         period.
     period : float
@@ -83,9 +92,10 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     nharmonics : int
         Number K of output harmonics kept (``2K+1 <= N``).
     frequencies : array_like, optional
-        Input lines in rad/s, shape ``(nexp,)`` (one sine per experiment)
+        Input lines in rad/s, shape ``(nexp,)`` (one line per experiment)
         or ``(nexp, nlines)``.  By default the lines are the DFT bins of
-        each input window whose magnitude exceeds ``1e-3`` of the largest.
+        each experiment's input window whose magnitude (largest over the
+        inputs) exceeds ``1e-3`` of the largest.
     transient : float, optional
         Time (s) discarded at the start of every record (default 0).  The
         analysis window is the largest integer number of periods at the
@@ -113,10 +123,10 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
         (the responses to ``±Ω`` share their output frequencies there):
         'raise' (default) a ValueError, or 'skip' them with a warning.
     batch_size : int, optional
-        Number of input lines (experiments, for single sines) analysed at
-        once; bounds the memory use (default 64).
+        Number of (experiment, line) pairs analysed at once; bounds the
+        memory use (default 64).
     progress : bool, optional
-        Show a progress bar over the batches.
+        Show a progress bar over the batches (default False).
     name : str, optional
         Name of the result.
 
@@ -124,8 +134,10 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     -------
     control.FrequencyResponseData
         Discrete-time (``dt = Ts``) response of shape ``((2K+1) noutputs,
-        1, M)`` on the M distinct lines ``Ω`` (increasing, rad/s).  Lines
-        excited in several experiments are averaged.
+        ninputs, M)`` on the M distinct lines ``Ω`` (increasing, rad/s);
+        input j is the ``c0`` (``h0``) coordinate of input j.  Lines
+        excited in several experiments are solved in the least-squares
+        sense (averaged, for one input).
 
     Raises
     ------
@@ -137,18 +149,22 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
         responses to ``±Ω`` then share their output frequencies), no
         usable line is left, two lines of one experiment produce
         overlapping harmonics, a line is not below the Nyquist frequency,
-        or an input has no line.
+        an experiment has no line, or the experiments cannot separate the
+        inputs at some line (fewer experiments than inputs, or dependent
+        input phasors).
     ControlDimension
         If inputs, outputs, time points or frequencies have inconsistent
         shapes (experiment counts or lengths).
     ControlArgument
-        For a response of the wrong type or more than one input.
+        For a response of the wrong type.
 
     Warns
     -----
     UserWarning
         If a given frequency is off the DFT grid of the window (leakage
-        biases the response), or when lines are skipped (``unusable='skip'``).
+        biases the response), when lines are skipped (``unusable='skip'``),
+        or when the experiments separate the inputs only poorly at some
+        line (condition number of the input phasors above 100).
 
     Notes
     -----
@@ -157,6 +173,10 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     coefficient of the output at ``Ω + nω_p`` (thesis-errata page).  The
     real form uses the unitary ``V`` with columns ``c_0 = e_0``, ``c_n =
     (e_n + e_{-n})/√2``, ``s_n = j(e_n - e_{-n})/√2`` (errata items 3-4).
+    With m inputs, experiment e gives ``Y_n^{(e)} = G_n U^{(e)}`` (``G_n``
+    of size ``ny x m``, ``U^{(e)}`` the m input coefficients at Ω); the
+    experiments exciting Ω give ``G_n`` by least squares, each weighted by
+    ``1/‖U^{(e)}‖²`` (Conventions page, multi-input identification).
 
     Examples
     --------
@@ -171,11 +191,25 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     array([0.5, 1. , 0.5])
     >>> G.output_labels[:2]
     ['y[0]_h-1', 'y[0]_h0']
+
+    Two inputs excited jointly, two experiments per line with phases
+    ``(0, 0)`` and ``(0, π)``:
+
+    >>> D = lambda t: np.array([[1 + np.cos(4 * np.pi * t), 2.0]])
+    >>> sys2 = ltp.ltpss(np.zeros((0, 0)), np.zeros((0, 2)), np.zeros((1, 0)), D, 0.5)
+    >>> exc = ltp.sine_experiments([1.0, 3.0], 0.5, dt=0.05, nperiods=8, ninputs=2)
+    >>> exc.inputs.shape                              # (inputs, experiments, samples)
+    (2, 4, 80)
+    >>> resp = ltp.forced_response(sys2, exc.time, exc.inputs)
+    >>> G = ltp.lifted_frequency_response(resp, 0.5, 1, real=False)
+    >>> np.round(G.frdata[:, :, 0].real, 6)           # rows G_{-1}, G_0, G_1
+    array([[0.5, 0. ],
+           [1. , 2. ],
+           [0.5, 0. ]])
     """
     check_kwargs(kwargs, 'lifted_frequency_response')
     period = check_period(period)
-    t, u, y, ylabels, ulabel = _parse_response(response)
-    dt = _uniform_step(t)
+    t, dt, u, y, ylabels, ulabels = _parse_response(response)
     N = steps_per_period(period, dt, 'the time step of timepts')
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
     if 2 * K + 1 > N:
@@ -184,7 +218,7 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
         raise ValueError(f"input_hold must be None, 'foh' or 'zoh', got {input_hold!r}")
     if not isinstance(real, (bool, np.bool_)):
         raise ControlArgument(f"real must be True or False, got {real!r}")
-    hold_step = dt if hold_step is None else check_period(hold_step, 'hold_step')
+    hold_step = dt if hold_step is None else check_positive(hold_step, 'hold_step')
     batch_size = check_positive_int(batch_size, 'batch_size')
     if unusable not in ('raise', 'skip'):
         raise ValueError(f"unusable must be 'raise' or 'skip', got {unusable!r}")
@@ -192,65 +226,159 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     if transient < 0:
         raise ValueError(f"transient must be >= 0, got {transient}")
 
-    # Window: the last P whole periods after the transient.
-    nexp, L = u.shape
+    tw, uw, yw = _analysis_window(t, u, y, dt, N, transient)
+    window = tw.size * dt
+    lines = _lines(uw, frequencies, window, dt, period, unusable == 'skip')
+    omega, U, Y = _line_spectra(tw, uw, yw, lines, N, K, period, batch_size, progress)
+    U = U * _hold_factor(omega, hold_step, input_hold)[:, None]
+    omega, G = _solve_lines(omega, U, Y, window)
+    return _lifted_frd(G, omega, dt, K, N, real, ylabels, ulabels, name)
+
+
+def _parse_response(response):
+    """``(t, Ts, u (nu, nexp, L), y (ny, nexp, L), output labels, input labels)``."""
+    if isinstance(response, ct.TimeResponseData):
+        t, u, y = response.time, response.u, response.y
+        if u is None:
+            raise ControlArgument("response carries no inputs; pass (timepts, inputs, "
+                                  "outputs) instead")
+        ylabels = list(response.output_labels)
+        ulabels = list(response.input_labels) if response.ninputs else None
+        if u.ndim == 2:                          # single trace
+            u, y = u[:, None, :], y[:, None, :]
+    elif isinstance(response, tuple) and len(response) == 3:
+        t, u, y = response
+        u = real_array(u, 'inputs', ndim=(1, 2, 3))
+        y = real_array(y, 'outputs', ndim=(1, 2, 3))
+        u = u.reshape((1,) * (3 - u.ndim) + u.shape)
+        y = y.reshape((1,) * (3 - y.ndim) + y.shape)
+        ylabels, ulabels = [f'y[{i}]' for i in range(y.shape[0])], None
+    else:
+        raise ControlArgument("response must be a control.TimeResponseData or a tuple "
+                              f"(timepts, inputs, outputs), got {type(response).__name__}")
+    u = real_array(u, 'inputs', ndim=3)
+    y = real_array(y, 'outputs', ndim=3)
+    if u.shape[1:] != y.shape[1:]:
+        raise ControlDimension(
+            f"inputs (experiments, samples) = {u.shape[1:]} and outputs "
+            f"{y.shape[1:]} are inconsistent: every experiment needs input and "
+            "output records of the same length")
+    t, dt, (uf, yf) = time_record(t, {'the records': u.reshape(-1, u.shape[2]),
+                                      'outputs': y.reshape(-1, y.shape[2])},
+                                  tname='timepts')
+    ulabels = ulabels or [f'u[{j}]' for j in range(u.shape[0])]
+    return t, dt, uf.reshape(u.shape), yf.reshape(y.shape), ylabels, ulabels
+
+
+def _analysis_window(t, u, y, dt, N, transient):
+    """The last P whole periods (P N samples) of every record after the transient."""
+    L = t.size
     skip = int(np.ceil(transient / dt - 1e-9))
     P = (L - skip) // N
     if P < 1:
         raise ValueError(f"the records ({L} samples) hold no whole period ({N} samples) "
                          f"after the transient of {transient} s")
     start = L - P * N
-    tw, uw, yw = t[start:], u[:, start:], y[:, :, start:]
-    window = P * period
-    lines = _lines(uw, frequencies, nexp, window, dt, period, unusable == 'skip')
+    return t[start:], u[:, :, start:], y[:, :, start:]
 
-    # Output harmonics: Y_n = (1/L) Σ_k y[k] e^{-jΩt_k} e^{-jnω_p t_k}, where the
-    # second factor repeats every period (N samples).
+
+def _line_spectra(tw, uw, yw, lines, N, K, period, batch_size, progress):
+    """Input and output coefficients of every (experiment, line) pair.
+
+    Returns the pair's line Ω (rad/s), ``U (pairs, nu)`` with
+    ``U_j = (1/L) Σ_k u_j[k] e^{-jΩt_k}`` and ``Y (pairs, (2K+1) ny)`` with
+    ``Y_n = (1/L) Σ_k y[k] e^{-jΩt_k} e^{-jnω_p t_k}`` (harmonic-major rows);
+    the second factor of Y repeats every period (N samples).
+    """
     wp = 2 * np.pi / period
     harm = np.arange(-K, K + 1)
-    tper = tw[:N]
-    Eh = np.exp(-1j * wp * harm[:, None] * tper[None, :])          # (2K+1, N)
-    ny = y.shape[0]
-    # one (experiment, line) pair per data point
+    Eh = np.exp(-1j * wp * harm[:, None] * tw[None, :N])          # (2K+1, N)
+    ny, Lw = yw.shape[0], tw.size
+    P = Lw // N
     exp_index = np.concatenate([np.full(Om.size, e) for e, Om in enumerate(lines)])
-    line_omega = np.concatenate(lines)
-    values = []
-    npair, Lw = line_omega.size, uw.shape[1]
-    for b0 in tqdm(range(0, npair, batch_size), desc="lifted FR", leave=False,
+    omega = np.concatenate(lines)
+    U, Y = [], []
+    for b0 in tqdm(range(0, omega.size, batch_size), desc="lifted FR", leave=False,
                    disable=(not progress) or None):
-        Om, ex = line_omega[b0:b0 + batch_size], exp_index[b0:b0 + batch_size]
-        Ein = np.exp(-1j * Om[:, None] * tw[None, :])               # (b, Lw)
-        U = np.einsum('bk,bk->b', Ein, uw[ex]) / Lw
-        # Σ over periods of y e^{-jΩt}, then the periodic harmonic factor.
-        Z = (yw[:, ex] * Ein).reshape(ny, Om.size, P, N).sum(2)   # (ny, b, N)
-        Y = np.einsum('obk,hk->hob', Z, Eh) / Lw                   # (2K+1, ny, b)
-        values.append(Y / (U * _hold_factor(Om, hold_step, input_hold)))
-    omega = line_omega
-    G = np.concatenate(values, axis=2).reshape((2 * K + 1) * ny, -1)
-    # Average lines excited by several experiments; sort by frequency.
-    omega, inverse = np.unique(np.round(omega * window / (2 * np.pi), 6), return_inverse=True)
-    omega = omega * 2 * np.pi / window
-    counts = np.bincount(inverse)
-    Gm = np.zeros((G.shape[0], omega.size), complex)
-    np.add.at(Gm.T, inverse, G.T)
-    Gm /= counts
+        Om, ex = omega[b0:b0 + batch_size], exp_index[b0:b0 + batch_size]
+        Ein = np.exp(-1j * Om[:, None] * tw[None, :])              # (b, Lw)
+        U.append(np.einsum('bk,jbk->bj', Ein, uw[:, ex]) / Lw)
+        # Σ over periods of y e^{-jΩt}, then the periodic harmonic factor
+        Z = (yw[:, ex] * Ein).reshape(ny, Om.size, P, N).sum(2)  # (ny, b, N)
+        Y.append(np.einsum('obk,hk->bho', Z, Eh).reshape(Om.size, -1) / Lw)
+    return omega, np.concatenate(U), np.concatenate(Y)
+
+
+def _solve_lines(omega, U, Y, window):
+    """Lifted response ``G (M, (2K+1) ny, nu)`` on the M distinct lines (increasing).
+
+    Each pair e gives ``Y^{(e)} = G U^{(e)}``; the pairs of one line give G by
+    least squares with weights ``1/‖U^{(e)}‖²``:  ``G Σ_e U U^H/‖U‖² =
+    Σ_e Y U^H/‖U‖²`` (for one input the mean of ``Y/U``).
+    """
+    key, inverse = np.unique(np.round(omega * window / (2 * np.pi), 6), return_inverse=True)
+    Un = U / np.linalg.norm(U, axis=1, keepdims=True)
+    Yn = Y / np.linalg.norm(U, axis=1, keepdims=True)
+    nu = U.shape[1]
+    gram = np.zeros((key.size, nu, nu), complex)
+    rhs = np.zeros((key.size, Y.shape[1], nu), complex)
+    np.add.at(gram, inverse, Un[:, :, None] * Un[:, None, :].conj())
+    np.add.at(rhs, inverse, Yn[:, :, None] * Un[:, None, :].conj())
+    eig = np.linalg.eigvalsh(gram)                                   # ascending
+    ratio = eig[:, 0] / eig[:, -1]
+    lines = key * 2 * np.pi / window
+    if np.any(ratio < _SEPARATION_RTOL):
+        bad = lines[ratio < _SEPARATION_RTOL]
+        raise ValueError(
+            f"the experiments cannot separate the {nu} inputs at the lines "
+            f"{np.round(bad[:5], 6).tolist()}{' ...' if bad.size > 5 else ''} rad/s: every "
+            f"line needs at least {nu} experiments with independent input phasors (see "
+            "sine_experiments and multisine with ninputs)")
+    if np.any(ratio < _SEPARATION_WARN):
+        warnings.warn(f"the experiments separate the inputs poorly at {int(np.sum(ratio < _SEPARATION_WARN))} "
+                      f"lines (condition number of the input phasors up to "
+                      f"{np.sqrt(1 / ratio.min()):.3g}): noise is amplified there",
+                      UserWarning, stacklevel=3)
+    # G gram = rhs  <=>  gram^T G^T = rhs^T (gram Hermitian)
+    G = np.linalg.solve(gram.conj(), rhs.transpose(0, 2, 1)).transpose(0, 2, 1)
+    return lines, G
+
+
+def _lifted_frd(G, omega, dt, K, N, real, ylabels, ulabels, name):
+    """FrequencyResponseData of the lifted response G (M, (2K+1) ny, nu): real or complex."""
+    harm = np.arange(-K, K + 1)
+    ny = len(ylabels)
+    data = G.transpose(1, 2, 0)
     if real:
         V, tags = _real_basis(harm, N)
-        Gm = np.kron(V, np.eye(ny)).conj().T @ Gm
+        data = np.einsum('ba,bjw->ajw', np.kron(V, np.eye(ny)).conj(), data)
         outputs = _harmonic_labels(ylabels, tags)
-        inputs = [f'{ulabel}_c0']
+        inputs = [f'{lab}_c0' for lab in ulabels]
     else:
         outputs = _harmonic_labels(ylabels, [f'h{n}' for n in harm])
-        inputs = [f'{ulabel}_h0']
-    return ct.frd(Gm[:, None, :], omega, dt, name=name, inputs=inputs, outputs=outputs)
+        inputs = [f'{lab}_h0' for lab in ulabels]
+    return ct.frd(data, omega, dt, name=name, inputs=inputs, outputs=outputs)
 
 
 @dataclass(frozen=True)
 class LTPSubspaceInfo:
     """Diagnostics returned by `identify_ltp` with ``return_info=True``.
 
+    The first fields follow `scipy.optimize.OptimizeResult`.
+
     Attributes
     ----------
+    success : bool
+        The model is trustworthy: with 'refit', the least-squares refit
+        converged and its relative residual is at most the realization's
+        ``fit_tol`` (default 0.05); with 'log' or 'tustin', the Floquet
+        realization succeeded with all K harmonics; with ``refine='ml'``
+        also the refinement converged.
+    message : str
+        Description of the outcome.
+    nfev : int
+        Model evaluations of the refit and the refinement (0 for 'log' and
+        'tustin' without refinement).
     data : control.FrequencyResponseData
         Real lifted frequency response used for identification.
     lifted : control.StateSpace
@@ -265,18 +393,21 @@ class LTPSubspaceInfo:
         Continuous-time conversion used ('refit', 'log' or 'tustin').
     relative_residual : float
         ``‖G - Ĝ‖ / ‖G‖`` of the continuous-time model on the continuous
-        harmonic response ``G_n(jΩ)`` (all lines, harmonics -K..K; those of
-        the model for 'log' and 'tustin').
+        harmonic response ``G_n(jΩ)`` (all lines, inputs and harmonics
+        -K..K; those of the model for 'log' and 'tustin').
     realized_harmonics : int
         Harmonics of the realized lifted model: K, or fewer when the
         K-harmonic model had no eigenvalue ladders.
 
     Examples
     --------
-    >>> LTPSubspaceInfo.__dataclass_fields__.keys() >= {'lifted', 'realization'}
+    >>> LTPSubspaceInfo.__dataclass_fields__.keys() >= {'success', 'lifted', 'realization'}
     True
     """
 
+    success: bool
+    message: str
+    nfev: int
     data: ct.FrequencyResponseData
     lifted: ct.StateSpace
     subspace: FDSubspaceInfo
@@ -289,8 +420,8 @@ class LTPSubspaceInfo:
 def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
                  realization='direct', realization_options=None, refit_a=True,
                  refit_harmonics=None, refine=None, refine_options=None,
-                 estimate_d=True,
-                 seed=None, progress=False,
+                 estimate_d=True, frequencies=None, transient=None, input_hold=None,
+                 hold_step=None, batch_size=None, seed=None, progress=False,
                  return_info=False, name=None, **kwargs):
     r"""Identify a continuous-time LTP model from sine experiments (thesis §4.2).
 
@@ -303,10 +434,9 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     ----------
     data : control.FrequencyResponseData, control.TimeResponseData or tuple
         Either the real lifted response of `lifted_frequency_response`
-        (with ``2K+1`` harmonics per output) or the experiments themselves
-        (anything `lifted_frequency_response` accepts; its keywords
-        `frequencies`, `transient`, `input_hold`, `hold_step` and `batch_size` may be
-        given here).
+        (with ``2K+1`` harmonics per output, one column per input) or the
+        experiments themselves (anything `lifted_frequency_response`
+        accepts, single- or multi-input).
     period : float
         Period T of the system.
     nstates : int
@@ -360,20 +490,25 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         ``harmonics``, ...).
     estimate_d : bool, optional
         Estimate a feedthrough (default True); False forces ``D = 0``.
+    frequencies, transient, input_hold, hold_step, batch_size : optional
+        Time records only: passed to `lifted_frequency_response` (defaults
+        there: lines detected, no transient, no hold, ``Ts``, 64).  Lines at
+        multiples of ``ω_p/2`` are skipped with a warning.
     seed : int, optional
         Seed of the 'pso' realization search (reproducibility).
     progress : bool, optional
-        Show progress bars (experiment batches, realization).
+        Show progress bars (experiment batches, realization; default False).
     return_info : bool, optional
-        Also return an `LTPSubspaceInfo`.
+        Also return an `LTPSubspaceInfo` (``success``, ``message``,
+        ``nfev`` and the intermediate results).
     name : str, optional
         Name of the identified system (default ``'ltp_subspace'``).
 
     Returns
     -------
     sys : LTPStateSpace
-        Continuous-time model in Floquet form (constant A), one input and
-        the outputs of the data.
+        Continuous-time model in Floquet form (constant A) with the inputs
+        and outputs of the data.
     info : LTPSubspaceInfo
         Only with ``return_info=True``.
 
@@ -388,7 +523,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     ControlArgument
         If `data` has the wrong type or is not discrete-time.
     TypeError
-        For unknown keyword arguments.
+        For unknown keyword arguments, or the time-record options
+        (`frequencies`, `transient`, ...) given with frequency-response data.
 
     Warns
     -----
@@ -410,7 +546,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         G_n(jΩ) = \sum_{m=-K}^{K} C_{n-m} R_m(Ω) B_m + D_n,
         \qquad n = -K..K,
 
-    bilinear in (B, C) and linear in D.  'refit' minimises
+    (``ny x nu`` for ``nu`` inputs), bilinear in (B, C) and linear in D.  'refit' minimises
     ``Σ |G_n - Ĝ_n|²`` over all lines and harmonics by Levenberg-Marquardt
     steps (minimum-norm Gauss-Newton steps absorb the similarity freedom).
     The pipeline is robust to imperfect lifted models: the eigenvalue
@@ -446,8 +582,6 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     >>> round(float((B[2] / B[1]).real), 4)
     0.25
     """
-    lfr_keys = ('frequencies', 'transient', 'input_hold', 'hold_step', 'batch_size')
-    lfr_kwargs = {key: kwargs.pop(key) for key in lfr_keys if key in kwargs}
     check_kwargs(kwargs, 'identify_ltp')
     period = check_period(period)
     nstates = check_positive_int(nstates, 'nstates')
@@ -459,47 +593,55 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     if refine not in (None, 'ml'):
         raise ValueError(f"refine must be None or 'ml', got {refine!r}")
     # 1. lifted frequency response
-    G = _lifted_data(data, period, K, progress, lfr_kwargs)
+    record_options = dict(frequencies=frequencies, transient=transient,
+                          input_hold=input_hold, hold_step=hold_step, batch_size=batch_size)
+    G = _lifted_data(data, period, K, progress, record_options)
     ny, N = _check_lifted_data(G, period, K, nstates, q)
     name = 'ltp_subspace' if name is None else name
-    labels = dict(name=name, inputs=[G.input_labels[0].rsplit('_', 1)[0]],
+    labels = dict(name=name, inputs=[lab.rsplit('_', 1)[0] for lab in G.input_labels],
                   outputs=[lab.rsplit('_', 1)[0] for lab in G.output_labels[:ny]])
-    Gc = _harmonic_data(G, K, N, ny)
+    Gc = _harmonic_data(G.frdata, K, N, ny)
     # 2-4. subspace model, Floquet realization (fewer harmonics if better), continuous time
     lifted, sinfo, real, Kr, sysc = _realize(
         G, Gc, period, K, N, nstates, ny, q, estimate_d, realization, seed, progress,
         realization_options, conversion, labels)
     # 5. structured refinement: the Floquet-form model fitted to the harmonic data
+    nfev, converged = 0, True
     if conversion == 'refit':
-        sysc, _, converged = fit_floquet(sysc, Gc, G.omega, K, harmonics=H,
-                                         estimate_d=estimate_d, fit_a=refit_a, **labels)
+        sysc, _, converged, nfev = fit_floquet(sysc, Gc, G.omega, K, harmonics=H,
+                                               estimate_d=estimate_d, fit_a=refit_a, **labels)
         if not converged:
             warnings.warn("the least-squares refit did not converge", UserWarning,
                           stacklevel=2)
     # 6. optional maximum-likelihood refinement weighted by the data's uncertainty
+    ml = None
     if refine == 'ml':
-        sysc = _ml_refine(sysc, G, refine_options)
-    resid = _harmonic_response(sysc, G.omega, min(K, Kr) if conversion != 'refit' else K)
-    Gk = Gc if conversion == 'refit' else _harmonic_data(G, min(K, Kr), N, ny)
-    relres = float(np.linalg.norm(resid - Gk) / np.linalg.norm(Gk))
-    _warn_quality(real, Kr, K, conversion, relres, realization_options)
+        sysc, ml = refine_ltp(sysc, G, return_info=True, **(refine_options or {}))
+        nfev += ml.nfev
+    Kc = K if conversion == 'refit' else min(K, Kr)
+    Gk = Gc if Kc == K else _harmonic_data(G.frdata, Kc, N, ny)
+    relres = float(np.linalg.norm(_harmonic_response(sysc, G.omega, Kc) - Gk)
+                   / np.linalg.norm(Gk))
+    success, message = _quality(real, Kr, K, conversion, relres, converged, ml,
+                                realization_options)
     if not return_info:
         return sysc
-    info = LTPSubspaceInfo(data=G, lifted=lifted, subspace=sinfo, realization=real,
-                           conversion=conversion, relative_residual=relres,
-                           realized_harmonics=Kr)
-    return sysc, info
+    return sysc, LTPSubspaceInfo(
+        success=success, message=message, nfev=nfev, data=G, lifted=lifted, subspace=sinfo,
+        realization=real, conversion=conversion, relative_residual=relres,
+        realized_harmonics=Kr)
 
 
-def _lifted_data(data, period, K, progress, lfr_kwargs):
+def _lifted_data(data, period, K, progress, options):
     """Step 1: the real lifted response, given or computed from time records."""
+    given = {key: val for key, val in options.items() if val is not None}
     if isinstance(data, ct.FrequencyResponseData):
-        if lfr_kwargs:
-            raise TypeError(f"identify_ltp: {sorted(lfr_kwargs)} only apply to time "
+        if given:
+            raise TypeError(f"identify_ltp: {sorted(given)} only apply to time "
                             "records, not to frequency-response data")
         return data
     return lifted_frequency_response(data, period, K, progress=progress,
-                                     unusable='skip', **lfr_kwargs)
+                                     unusable='skip', **given)
 
 
 def _check_lifted_data(G, period, K, nstates, q):
@@ -509,9 +651,9 @@ def _check_lifted_data(G, period, K, nstates, q):
         raise ControlArgument("data must be discrete-time frequency-response data "
                               "with a numeric sampling time (from "
                               "lifted_frequency_response)")
-    if G.ninputs != 1 or G.noutputs % H:
-        raise ValueError(f"data must have one input and (2K+1) = {H} lifted outputs per "
-                         f"system output, got shape {G.frdata.shape[:2]}")
+    if G.noutputs % H:
+        raise ValueError(f"data must have (2K+1) = {H} lifted outputs per system output, "
+                         f"got shape {G.frdata.shape[:2]}")
     N = steps_per_period(period, float(G.dt), 'the sampling time of data')
     order, M = H * nstates, G.omega.size
     # fdsubspace needs 2M >= q + order with q > order: at least order + 1 lines.
@@ -560,99 +702,55 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
     return best[1:]
 
 
-def _harmonic_data(G, K, N, ny):
-    """Continuous harmonic data G_n(jΩ), n = -K..K (undo the real transform)."""
-    V, _ = _real_basis(np.arange(-K, K + 1), N)
-    H = 2 * K + 1
-    return (np.kron(V, np.eye(ny)) @ G.frdata[:H * ny, 0, :]).reshape(H, ny, -1)
-
-
-def _warn_quality(real, Kr, K, conversion, relres, options):
-    """Warn when the returned model is doubtful (see `identify_ltp`, Warns)."""
+def _quality(real, Kr, K, conversion, relres, converged, ml, options):
+    """``(success, message)`` of the returned model; warn when it is doubtful."""
     if Kr < K and conversion != 'refit':
         warnings.warn(f"the lifted model of {K} harmonics has no eigenvalue ladders; "
                       f"realized with {Kr} harmonics instead: the model has {Kr} "
                       "harmonics", UserWarning, stacklevel=3)
     fit_tol = (options or {}).get('fit_tol', 0.05)
     if conversion == 'refit':
+        success = converged and relres <= fit_tol
+        message = (f"refit {'converged' if converged else 'stopped before converging'}, "
+                   f"relative residual {relres:.3g} (fit_tol {fit_tol:g})")
         if relres > fit_tol:
             warnings.warn(f"the identified model misses the data: relative residual "
                           f"{relres:.3g} > {fit_tol:g} (realization: {real.message}); "
                           "try other nstates, nharmonics or q", UserWarning, stacklevel=3)
-    elif not real.success:
-        warnings.warn(f"{real.message}; the model is not trustworthy (try another "
-                      "realization method, seed or q)", UserWarning, stacklevel=3)
+    else:
+        success = real.success and Kr == K
+        message = f"{real.message}; relative residual {relres:.3g}"
+        if not real.success:
+            warnings.warn(f"{real.message}; the model is not trustworthy (try another "
+                          "realization method, seed or q)", UserWarning, stacklevel=3)
+    if ml is not None:
+        success = success and ml.success
+        message += f"; ML refinement: {ml.message}"
+    return bool(success), message
 
 
 #
 # Private helpers
 #
 
-def _parse_response(response):
-    """Return ``(t, u (nexp, L), y (ny, nexp, L), output labels, input label)``."""
-    if isinstance(response, ct.TimeResponseData):
-        t, u, y = response.time, response.u, response.y
-        ylabels = list(response.output_labels)
-        ulabel = response.input_labels[0] if response.ninputs else 'u[0]'
-        if u is None:
-            raise ControlArgument("response carries no inputs; pass (timepts, inputs, "
-                                  "outputs) instead")
-        if u.ndim == 2:                          # single trace
-            u, y = u[:, None, :], y[:, None, :]
-    elif isinstance(response, tuple) and len(response) == 3:
-        t, u, y = response
-        u = real_array(u, 'inputs', ndim=(1, 2, 3))
-        y = real_array(y, 'outputs', ndim=(1, 2, 3))
-        u = u.reshape((1,) * (3 - u.ndim) + u.shape)
-        y = y.reshape((1,) * (3 - y.ndim) + y.shape)
-        ylabels, ulabel = [f'y[{i}]' for i in range(y.shape[0])], 'u[0]'
-    else:
-        raise ControlArgument("response must be a control.TimeResponseData or a tuple "
-                              f"(timepts, inputs, outputs), got {type(response).__name__}")
-    t = real_array(t, 'timepts', ndim=1)
-    u = real_array(u, 'inputs', ndim=3)
-    y = real_array(y, 'outputs', ndim=3)
-    if u.shape[0] != 1:
-        raise ControlArgument(f"the experiments must have a single input, got {u.shape[0]}")
-    if u.shape[1:] != y.shape[1:]:
-        raise ControlDimension(
-            f"inputs (experiments, samples) = {u.shape[1:]} and outputs "
-            f"{y.shape[1:]} are inconsistent: every experiment needs one input and one "
-            "output record of the same length")
-    if u.shape[2] != t.size:
-        raise ControlDimension(f"the records have {u.shape[2]} samples but timepts has "
-                               f"{t.size}")
-    return t, u[0], y, ylabels, ulabel
-
-
-def _uniform_step(t):
-    """The step of uniformly spaced, increasing `t`."""
-    if t.size < 2:
-        raise ValueError("timepts must hold at least two samples")
-    d = np.diff(t)
-    dt = (t[-1] - t[0]) / (t.size - 1)
-    if dt <= 0 or np.max(np.abs(d - dt)) > 1e-9 * max(dt, np.abs(t).max()):
-        raise ValueError("timepts must be uniformly spaced and increasing")
-    return dt
-
-
-def _lines(uw, frequencies, nexp, window, dt, period, skip=False):
+def _lines(uw, frequencies, window, dt, period, skip=False):
     """Input lines (rad/s) of every experiment, validated (unusable ones skipped)."""
     bin_ = 2 * np.pi / window
-    Lw = uw.shape[1]
+    nexp, Lw = uw.shape[1:]
     if frequencies is None:
-        spec = np.abs(np.fft.rfft(uw, axis=1)) / Lw
-        spec[:, 0] = 0.0                                  # DC is no line
+        # a line: a bin where some input exceeds _LINE_RTOL of the experiment's peak
+        spec = np.abs(np.fft.rfft(uw, axis=-1)) / Lw
+        spec[..., 0] = 0.0                                # DC is no line
         if Lw % 2 == 0:
-            spec[:, -1] = 0.0                             # nor is Nyquist
-        peak = spec.max(axis=1)
+            spec[..., -1] = 0.0                           # nor is Nyquist
+        peak = spec.max(axis=(0, 2))
         if np.any(peak == 0):
             raise ValueError(f"the input of experiment {int(np.argmin(peak))} has no "
                              "spectral line in the analysis window")
-        on = spec >= _LINE_RTOL * peak[:, None]
+        on = spec.max(axis=0) >= _LINE_RTOL * peak[:, None]
         lines = [np.flatnonzero(row) * bin_ for row in on]
-        total = np.sum(uw ** 2, axis=1)
-        inline = 2 * Lw ** 2 * np.sum(np.where(on, spec, 0.0) ** 2, axis=1) / Lw
+        total = np.sum(uw ** 2, axis=(0, 2))
+        inline = 2 * Lw * np.sum(np.where(on, spec, 0.0) ** 2, axis=(0, 2))
         if np.any(total - inline > _LEAKAGE_RTOL * total):
             raise ValueError("an input window is not a sum of sinusoids on the DFT grid "
                              "of the window (leakage), so its lines cannot be detected; "
@@ -712,8 +810,3 @@ def _hold_factor(omega, dt, hold):
         return np.ones_like(omega)
     x = np.sinc(omega * dt / (2 * np.pi))                  # np.sinc(x) = sin(πx)/(πx)
     return x ** 2 if hold == 'foh' else x * np.exp(-0.5j * omega * dt)
-
-
-def _ml_refine(sys, data, options):
-    """``refine='ml'`` of `identify_ltp`: `refine_ltp` on the lifted data."""
-    return refine_ltp(sys, data, **(options or {}))
