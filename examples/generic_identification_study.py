@@ -2,8 +2,8 @@
 
 Thirty seeded random stable single-input plants (`random_ltp_plants.random_ltp`)
 with n_p = 2, 3, 4 states, one or two outputs and harmonics up to 2 in A(t),
-B(t) and C(t), and thirty with two inputs and two outputs, are identified by `ltpcontrol.identify_ltp` from their exact
-(noise-free) lifted frequency response on 120 lines in (0, 3 ω_p), for
+B(t) and C(t), and thirty with two inputs and two outputs, are identified by
+`ltpcontrol.identify_ltp` from their exact (noise-free) lifted frequency response on 120 lines in (0, 3 ω_p), for
 K = 1..4.  Each model is compared with its plant by `ltpcontrol.compare_ltp`
 (HTF blocks with harmonics -1..1 at 37 unseen frequencies in (0, 2 ω_p), and
 Floquet exponents modulo jω_p).  A plant whose A(t) is periodic has
