@@ -62,9 +62,9 @@ def lifted_data(sys, nharmonics, omega, dt):
     """Exact real lifted response (as `lifted_frequency_response` returns) on `omega`:
     the HTF columns of input harmonic 0, ``V^H H_{:,0}(jΩ)``."""
     K, ny, nu = nharmonics, sys.noutputs, sys.ninputs
-    G = ltp.htf(sys, K)(1j * np.asarray(omega))[:, :, K * nu:(K + 1) * nu]
+    G = ltp.htf(sys, K)(1j * np.asarray(omega))[:, K * nu:(K + 1) * nu]   # (.., nu, M)
     V, _ = _real_basis(np.arange(-K, K + 1), int(round(sys.period / dt)))
-    Gr = np.einsum('ba,wbj->ajw', np.kron(V, np.eye(ny)).conj(), G)
+    Gr = np.einsum('ba,bjw->ajw', np.kron(V, np.eye(ny)).conj(), G)
     return ct.frd(Gr, omega, dt)
 
 
