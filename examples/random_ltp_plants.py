@@ -9,8 +9,9 @@ from ltpcontrol._lifting import _real_basis
 
 
 def random_ltp(seed, nstates=2, noutputs=1, harmonics=2, period=1.0, depth=0.3,
-               allow_negative=False):
-    """Random stable continuous LTP plant with harmonics up to `harmonics` in A, B, C.
+               allow_negative=False, ninputs=1):
+    """Random stable continuous LTP plant with harmonics up to `harmonics` in A, B, C
+    (`ninputs` inputs, `noutputs` outputs).
 
     The mean A has exponents with real parts in [-3, -0.5] and imaginary
     parts below ω_p/4; every harmonic of A, B and C has a relative size of
@@ -45,7 +46,7 @@ def random_ltp(seed, nstates=2, noutputs=1, harmonics=2, period=1.0, depth=0.3,
             return c
 
         A = coeffs(A0, n, n, depth * scale / np.sqrt(n))
-        B = coeffs(rng.normal(size=(n, 1)), n, 1, depth)
+        B = coeffs(rng.normal(size=(n, ninputs)), n, ninputs, depth)
         C = coeffs(rng.normal(size=(noutputs, n)), noutputs, n, depth)
         sys = ltp.ltpss(ltp.PeriodicMatrix(A, period), ltp.PeriodicMatrix(B, period),
                         ltp.PeriodicMatrix(C, period), 0, period=period,
@@ -58,12 +59,13 @@ def random_ltp(seed, nstates=2, noutputs=1, harmonics=2, period=1.0, depth=0.3,
 
 
 def lifted_data(sys, nharmonics, omega, dt):
-    """Exact real lifted response (as `lifted_frequency_response` returns) on `omega`."""
-    K, ny = nharmonics, sys.noutputs
-    G = ltp.htf(sys, K)(1j * np.asarray(omega))[:, K]               # ((2K+1) ny, M)
+    """Exact real lifted response (as `lifted_frequency_response` returns) on `omega`:
+    the HTF columns of input harmonic 0, ``V^H H_{:,0}(jΩ)``."""
+    K, ny, nu = nharmonics, sys.noutputs, sys.ninputs
+    G = ltp.htf(sys, K)(1j * np.asarray(omega))[:, K * nu:(K + 1) * nu]   # (.., nu, M)
     V, _ = _real_basis(np.arange(-K, K + 1), int(round(sys.period / dt)))
-    Gr = np.kron(V, np.eye(ny)).conj().T @ G
-    return ct.frd(Gr[:, None, :], omega, dt)
+    Gr = np.einsum('ba,bjw->ajw', np.kron(V, np.eye(ny)).conj(), G)
+    return ct.frd(Gr, omega, dt)
 
 
 def design_lines(period, nlines, wmax_factor=3.0, offset=0.37):

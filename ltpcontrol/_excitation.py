@@ -12,6 +12,12 @@ Three experiment designs are provided:
 * `sine_experiments`: single sinusoids, one per experiment, for validation
   (thesis §3.7.4) or sine-by-sine identification.
 
+With ``ninputs = m`` the sinusoidal designs excite m inputs jointly: every
+line is applied in m experiments ``i = 0..m-1`` with input j phase-shifted by
+``2π i j / m``, so that the input phasors of a line form the unitary DFT
+matrix and `lifted_frequency_response` separates the inputs by least squares
+at every line (as in LTI MIMO frequency-response measurement).
+
 Every design returns the analysis windows (``segments``) of an integer number
 of periods that `estimate_htf` expects.  Frequencies at multiples of
 ``ω_p/2`` are flagged: there an input at ``ω`` and its mirror ``-ω`` produce
@@ -26,7 +32,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 from control.exception import ControlArgument
 
-from ._validation import (check_kwargs, check_period, check_positive_int,
+from ._validation import (check_kwargs, check_period, check_positive, check_positive_int,
                           real_array, steps_per_period)
 
 __all__ = ['chirp_replicas', 'multisine', 'sine_experiments', 'Excitation']
@@ -39,8 +45,10 @@ class Excitation(NamedTuple):
     ----------
     time : ndarray, shape (nt,)
         Sample times, starting at 0 (the phase reference of the period).
-    inputs : ndarray, shape (nt,) or (nexp, nt)
-        Input samples; one row per experiment for multi-experiment designs.
+    inputs : ndarray, shape (nt,), (nexp, nt) or (ninputs, nexp, nt)
+        Input samples; one row per experiment for multi-experiment designs,
+        and a leading input axis when several inputs are excited
+        (``ninputs`` given), as `ltpcontrol.forced_response` takes them.
     segments : ndarray of int, shape (nseg, 2)
         ``[start, stop)`` sample indices of the analysis windows, each an
         integer number of periods long.  Pass them to `estimate_htf`.
@@ -49,7 +57,8 @@ class Excitation(NamedTuple):
         `inputs` with the time axis replaced by ``t``); use it with
         variable-step simulators.
     frequencies : ndarray or None
-        Excited frequencies in rad/s for sinusoidal designs, else None.
+        Excited frequencies in rad/s for sinusoidal designs (for
+        `sine_experiments`, the line of every experiment), else None.
 
     Examples
     --------
@@ -66,7 +75,7 @@ class Excitation(NamedTuple):
 
 
 def _check_dt(dt, period):
-    dt = check_period(dt, "dt")
+    dt = check_positive(dt, "dt")
     return dt, steps_per_period(period, dt, "dt")
 
 
@@ -193,7 +202,7 @@ def chirp_replicas(period, nreplicas, duration, f0, f1, *, dt,
     check_kwargs(kwargs, "chirp_replicas")
     period = check_period(period)
     nrep = _replicas(nreplicas, nharmonics, plant_harmonics, "nreplicas")
-    duration = check_period(duration, "duration")
+    duration = check_positive(duration, "duration")
     dt, nper = _check_dt(dt, period)
     f0 = _check_frequency(f0, "f0")
     f1 = _check_frequency(f1, "f1", allow_zero=False)
@@ -245,8 +254,10 @@ def _grid_frequencies(frequencies, window, name):
     return bins * step, bins
 
 
-def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitude, what):
-    """Sum-of-cosines experiments; experiment r is delayed by r T / nexp."""
+def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitude, what,
+                     shifts=None):
+    """Sum-of-cosines experiments; experiment r is delayed by r T / nexp (jointly
+    on several inputs with `shifts`, see `_joint`)."""
     nper = steps_per_period(period, dt, "dt")
     if np.max(omega) >= np.pi / dt:
         raise ValueError(f"{what} reach the Nyquist frequency {np.pi / dt:.6g} rad/s "
@@ -254,16 +265,17 @@ def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitud
     _warn_half_multiples(omega, period, 1e-9 * np.max(omega), what)
     delays = np.arange(nexp) * period / nexp
 
-    def signal(t):
+    def single(t, shift=0.0):
         t = np.asarray(t, dtype=float)
-        # u_r(t) = Σ_l a cos(ω_l (t - τ_r) + φ_l), accumulated line by line so
-        # that memory stays (experiments x samples)
+        # u_r(t) = Σ_l a cos(ω_l (t - τ_r) + φ_l + shift), accumulated line by
+        # line so that memory stays (experiments x samples)
         shifted = t[None, :] - delays[:, None]
         out = np.zeros(shifted.shape)
         for w, phi in zip(omega, phases):
-            out += np.cos(w * shifted + phi)
+            out += np.cos(w * shifted + phi + shift)
         return amplitude * out
 
+    signal = single if shifts is None else _joint(single, shifts)
     nsamp = (settle + nperiods) * nper
     time = np.arange(nsamp) * dt
     segments = np.array([[settle * nper, nsamp]])
@@ -286,14 +298,38 @@ def _check_seed(seed, name="seed"):
 
 def _check_common(period, dt, nperiods, settle):
     period = check_period(period)
-    dt = check_period(dt, "dt")
+    dt = check_positive(dt, "dt")
     nperiods = check_positive_int(nperiods, "nperiods")
     settle = check_positive_int(settle, "settle", minimum=0)
     return period, dt, nperiods, settle
 
 
+def _input_phases(ninputs):
+    """Phase shifts ``2π i j / m`` (experiments i, inputs j), or None for one input."""
+    if ninputs is None:
+        return None
+    m = check_positive_int(ninputs, "ninputs")
+    return 2 * np.pi * np.outer(np.arange(m), np.arange(m)) / m
+
+
+def _joint(signal, shifts):
+    """Signal of m jointly excited inputs: experiment (e, i), input j gets the
+    experiment e of `signal` with its phases shifted by ``shifts[i, j]``.
+
+    `signal(t, phase)` returns (nexp, len(t)); the result has shape
+    (m, nexp m, len(t)), experiments ordered e-major.
+    """
+    def joint(t):
+        t = np.asarray(t, dtype=float)
+        m = shifts.shape[0]
+        out = np.stack([np.stack([signal(t, shifts[i, j]) for i in range(m)], axis=1)
+                        for j in range(m)])                     # (m, nexp, m, nt)
+        return out.reshape(m, -1, t.size)
+    return joint
+
+
 def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
-                     amplitude=1.0, unusable='warn', **kwargs):
+                     amplitude=1.0, unusable='warn', ninputs=None, **kwargs):
     """One sinusoid per experiment, on the DFT grid of the analysis window.
 
     Experiment ``e`` is ``amplitude · cos(ω_e t)`` for
@@ -321,12 +357,18 @@ def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
     unusable : {'warn', 'drop'}, optional
         Keep frequencies at multiples of ``ω_p/2`` with a UserWarning
         (default) or drop them (also with a warning).
+    ninputs : int, optional
+        Number m of inputs excited jointly: every frequency is applied in m
+        experiments, experiment i giving input j the phase ``2π i j / m``
+        (module notes).  Default: a single input.
 
     Returns
     -------
     Excitation
-        ``inputs`` has shape (nexp, nt); ``frequencies`` holds the rounded
-        frequencies (duplicates after rounding are removed).
+        ``inputs`` has shape (nexp, nt), or (m, m nexp, nt) with
+        `ninputs` (experiments frequency-major); ``frequencies`` holds the
+        rounded frequency of every experiment (duplicates after rounding
+        are removed).
 
     Examples
     --------
@@ -354,18 +396,21 @@ def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
             raise ValueError("no frequency is left after dropping the multiples of "
                              "omega_p/2")
 
-    def signal(t):
+    def single(t, shift=0.0):
         t = np.asarray(t, dtype=float)
-        return amplitude * np.cos(omega[:, None] * t[None, :])
+        return amplitude * np.cos(omega[:, None] * t[None, :] + shift)
 
+    shifts = _input_phases(ninputs)
+    signal = single if shifts is None else _joint(single, shifts)
+    lines = omega if shifts is None else np.repeat(omega, shifts.shape[0])
     time = np.arange((settle + nperiods) * nper) * dt
     segments = np.array([[settle * nper, time.size]])
-    return Excitation(time, signal(time), segments, signal, omega)
+    return Excitation(time, signal(time), segments, signal, lines)
 
 
 def multisine(frequencies, period, *, dt, nperiods, nexperiments=None, settle=0,
               amplitude=1.0, phases='schroeder', seed=None, nharmonics=None,
-              plant_harmonics=None, **kwargs):
+              plant_harmonics=None, ninputs=None, **kwargs):
     """Multisine experiments time-shifted by fractions of the period.
 
     All experiments share the multisine
@@ -404,11 +449,16 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=None, settle=0,
         Harmonics K to be estimated and ``K_p`` expected in the plant, as
         for `chirp_replicas`: they set the default `nexperiments` and a
         warning names the components a given `nexperiments` leaves aliased.
+    ninputs : int, optional
+        Number m of inputs excited jointly: every experiment is repeated m
+        times, repetition i giving input j the line phases ``φ_l + 2π i j /
+        m`` (module notes).  Default: a single input.
 
     Returns
     -------
     Excitation
-        ``inputs`` has shape (R, nt); ``frequencies`` holds the lines.
+        ``inputs`` has shape (R, nt), or (m, m R, nt) with `ninputs`
+        (experiments shift-major); ``frequencies`` holds the lines.
 
     Examples
     --------
@@ -459,5 +509,6 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=None, settle=0,
         if phi.size != nline:
             raise ValueError(f"phases has {phi.size} entries for {nline} lines")
     time, signal, segments = _periodic_design(
-        omega, period, dt, nperiods, settle, nexp, phi, amplitude, "frequencies")
+        omega, period, dt, nperiods, settle, nexp, phi, amplitude, "frequencies",
+        _input_phases(ninputs))
     return Excitation(time, signal(time), segments, signal, omega)

@@ -3,7 +3,7 @@
 A continuous LTP in Floquet form (constant A, periodic ``B(t)``, ``C(t)``,
 ``D(t)`` with Fourier coefficients ``B_m``, ``C_l``, ``D_n``) has, with
 ``R_m(Ω) = (j(Ω + mω_p) I - A)^{-1}``, the harmonic response to the input
-harmonic 0
+harmonic 0 (an ``ny x nu`` matrix for ``nu`` inputs)
 
     G_n(jΩ) = Σ_{m=-H..H} C_{n-m} R_m(Ω) B_m + D_n,        n = -K..K,
 
@@ -16,11 +16,13 @@ linear in D, linear in B for fixed (A, C) and in C for fixed (A, B), and
 (h > 0) of every coefficient series, so that ``P_{-h} = conj P_h`` and the
 model is real.  The similarity ``x -> S x`` leaves G unchanged; a
 Gauss-Newton step of minimum norm does not move along these ``n_p^2`` flat
-directions.
+directions.  Arrays of harmonic responses have the shape ``(nu, 2K+1, ny,
+M)``: entry ``[j, n + K, :, w]`` is ``G_n(jΩ_w)`` of input j.
 """
 
 import numpy as np
 
+from ._lifting import _real_basis
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix
 
@@ -41,18 +43,28 @@ def _cnm(Cc, K, H):
 
 
 def _model_response(R, Bc, Cc, Dc, K, H):
-    """``G_n = Σ_m C_{n-m} R_m B_m + D_n`` for n = -K..K, shape (2K+1, ny, M)."""
-    X = np.einsum('wmij,mj->wmi', R, Bc[:, :, 0])                 # R_m B_m
-    return np.einsum('nmoi,wmi->now', _cnm(Cc, K, H), X) + Dc[:, :, 0, None]
+    """``G_n = Σ_m C_{n-m} R_m B_m + D_n`` for n = -K..K, shape (nu, 2K+1, ny, M)."""
+    X = np.einsum('wmij,mjq->wmiq', R, Bc)                        # R_m B_m
+    return (np.einsum('nmoi,wmiq->qnow', _cnm(Cc, K, H), X)
+            + Dc.transpose(2, 0, 1)[..., None])
 
 
 def _harmonic_response(sys, omega, K):
     """Continuous harmonic response G_n(jΩ), n = -K..K, of a Floquet-form model
-    (all harmonics of its B, at least K)."""
+    (all harmonics of its B, at least K), shape (nu, 2K+1, ny, M)."""
     H = max(K, sys.B.nharmonics or 0)
     R = _resolvents(sys.A(0.0), omega, 2 * np.pi / sys.period, H)
     Bc, Cc, Dc = _coefficients(sys, K, H)
     return _model_response(R, Bc, Cc, Dc, K, H)
+
+
+def _harmonic_data(frdata, K, N, ny):
+    """Continuous harmonic data ``G_n(jΩ)``, n = -K..K, shape (nu, 2K+1, ny, M), from the
+    real lifted response ``frdata`` ((2K_d+1) ny, nu, M), K_d >= K: ``(V ⊗ I) frdata``."""
+    V, _ = _real_basis(np.arange(-K, K + 1), N)
+    H, nu, M = 2 * K + 1, frdata.shape[1], frdata.shape[2]
+    Gc = np.einsum('ab,bjw->jaw', np.kron(V, np.eye(ny)), frdata[:H * ny])
+    return Gc.reshape(nu, H, ny, M)
 
 
 def _coefficients(sys, K, H):
@@ -83,10 +95,10 @@ class _FloquetFit:
     """Real parameter vector θ = (B, C, D coefficients[, A]) of a model with H
     harmonics in B fitted to K data harmonics."""
 
-    def __init__(self, nx, ny, K, H, period, estimate_d, fit_a):
-        self.nx, self.ny, self.K, self.H, self.wp = nx, ny, K, H, 2 * np.pi / period
-        self.fit_a = fit_a
-        Tb, Tc, Td = _conj_map(H, nx), _conj_map(K + H, ny * nx), _conj_map(K, ny)
+    def __init__(self, nx, ny, nu, K, H, period, estimate_d, fit_a):
+        self.nx, self.ny, self.nu, self.K, self.H = nx, ny, nu, K, H
+        self.wp, self.fit_a = 2 * np.pi / period, fit_a
+        Tb, Tc, Td = _conj_map(H, nx * nu), _conj_map(K + H, ny * nx), _conj_map(K, ny * nu)
         self.nb, self.nc, self.nd = Tb.shape[0], Tc.shape[0], Td.shape[0]
         T = np.zeros((self.nb + self.nc + self.nd,) * 2, complex)
         nb, nc = self.nb, self.nc
@@ -101,17 +113,17 @@ class _FloquetFit:
         return np.concatenate([theta, sys.A(0.0).ravel()]) if self.fit_a else theta
 
     def unpack(self, theta, A=None):
-        K, H, nx, ny, nb, nc = self.K, self.H, self.nx, self.ny, self.nb, self.nc
+        K, H, nx, ny, nu, nb, nc = self.K, self.H, self.nx, self.ny, self.nu, self.nb, self.nc
         c = self.T @ theta[:self.ncoef]
         if self.fit_a:
             A = theta[self.ncoef:].reshape(nx, nx)
-        return (A, c[:nb].reshape(2 * H + 1, nx, 1),
+        return (A, c[:nb].reshape(2 * H + 1, nx, nu),
                 c[nb:nb + nc].reshape(2 * (K + H) + 1, ny, nx),
-                c[nb + nc:].reshape(2 * K + 1, ny, 1))
+                c[nb + nc:].reshape(2 * K + 1, ny, nu))
 
     def response_and_jacobian(self, theta, omega, A=None, jac=True):
-        """Harmonic response (2K+1, ny, M) and its Jacobian ((2K+1) ny M, len θ)."""
-        K, H, nx, ny, nb, nc = self.K, self.H, self.nx, self.ny, self.nb, self.nc
+        """Harmonic response (nu, 2K+1, ny, M) and its Jacobian (nu (2K+1) ny M, len θ)."""
+        K, H, nx, ny, nu = self.K, self.H, self.nx, self.ny, self.nu
         A, Bc, Cc, Dc = self.unpack(theta, A)
         R = _resolvents(A, omega, self.wp, H)
         G = _model_response(R, Bc, Cc, Dc, K, H)
@@ -119,19 +131,21 @@ class _FloquetFit:
             return G, None
         M, m = omega.size, np.arange(-H, H + 1)
         CR = np.einsum('nmoi,wmij->nowmj', _cnm(Cc, K, H), R)     # C_{n-m} R_m
-        X = np.einsum('wmij,mj->wmi', R, Bc[:, :, 0])              # R_m B_m, (w, m, i)
+        X = np.einsum('wmij,mjq->wmiq', R, Bc)                     # R_m B_m, (w, m, i, q)
+        # rows (q, n, o, w) of G;  dG_n = Σ_m C_{n-m} R_m dB_m
+        eu, ey = np.eye(nu), np.eye(ny)
+        JB = np.einsum('nowmi,qr->qnowmir', CR, eu)
         # dG_n = Σ_l dC_l X_{n-l}, |n-l| <= H
-        Xsel = np.zeros((2 * K + 1, 2 * (K + H) + 1, M, nx), complex)
+        Xsel = np.zeros((2 * K + 1, 2 * (K + H) + 1, M, nx, nu), complex)
         for a, n in enumerate(range(-K, K + 1)):
-            Xsel[a, n - m + K + H] = X.transpose(1, 0, 2)
-        eye = np.eye(ny)
-        JC = np.einsum('oq,nlwi->nowlqi', eye, Xsel).reshape(-1, nc)
-        JD = np.einsum('na,oq,w->nowaq', np.eye(2 * K + 1), eye,
-                       np.ones(M)).reshape(-1, self.nd)
-        J = np.hstack([CR.reshape(-1, nb), JC, JD]) @ self.T
+            Xsel[a, n - m + K + H] = X.transpose(1, 0, 2, 3)
+        JC = np.einsum('oz,nlwiq->qnowlzi', ey, Xsel)
+        JD = np.einsum('qr,na,oz,w->qnowazr', eu, np.eye(2 * K + 1), ey, np.ones(M))
+        J = np.hstack([Jx.reshape(G.size, -1) for Jx in (JB, JC, JD)]) @ self.T
         if self.fit_a:
             # dR_m = R_m dA R_m:  dG_n = Σ_m C_{n-m} R_m dA R_m B_m
-            J = np.hstack([J, np.einsum('nowmi,wmj->nowij', CR, X).reshape(-1, nx * nx)])
+            JA = np.einsum('nowmi,wmjq->qnowij', CR, X)
+            J = np.hstack([J, JA.reshape(G.size, nx * nx)])
         return G, J
 
 
@@ -140,19 +154,26 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
     """Least-squares Floquet-form model fitted to ``G_n(jΩ)``, n = -K..K, with
     `harmonics` H >= K harmonics in B (default K), K + H in C, K in D.
 
+    `Gc` has the shape (nu, 2K+1, ny, M) of `_harmonic_response`.
+
     Starts from the Floquet-form LTPStateSpace `sys` and minimises
     ``Σ |G_n(jΩ) - Ĝ_n|²`` over the lines Ω (rad/s) and n = -K..K (module
     notes) by Levenberg-Marquardt steps: Gauss-Newton (minimum-norm, on
     column-scaled Jacobians) while the cost falls, damped otherwise.
-    Returns ``(model, relative residual, converged)``.
+    Returns ``(model, relative residual, converged, number of residual
+    evaluations)``.
     """
-    nx, ny = sys.nstates, Gc.shape[1]
+    nu, ny, nx = Gc.shape[0], Gc.shape[2], sys.nstates
     H = K if harmonics is None else harmonics
-    fit = _FloquetFit(nx, ny, K, H, sys.period, estimate_d, fit_a)
+    fit = _FloquetFit(nx, ny, nu, K, H, sys.period, estimate_d, fit_a)
     A0 = sys.A(0.0)
     scale = max(np.linalg.norm(Gc), np.finfo(float).tiny)
 
+    nfev = 0
+
     def cost(theta, jac=False):
+        nonlocal nfev
+        nfev += 1
         G, J = fit.response_and_jacobian(theta, omega, A0, jac)
         r = (G - Gc).ravel() / scale
         r = np.concatenate([r.real, r.imag])
@@ -196,4 +217,4 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
     model = LTPStateSpace(A, PeriodicMatrix(Bc, period), PeriodicMatrix(Cc, period),
                           PeriodicMatrix(Dc, period), period, states=sys.state_labels,
                           **labels)
-    return model, float(np.sqrt(f)), converged
+    return model, float(np.sqrt(f)), converged, nfev

@@ -2,16 +2,10 @@
 
 Pipeline
 --------
-1. *Lifted frequency response* (eqs. 4.54-4.58, 4.74-4.79, errata).  For a
-   real input line ``u = a cos(Ωt + φ)`` the input coefficient is
-   ``U(Ω) = (1/L) Σ_k u[k] e^{-jΩ t_k} = a e^{jφ}/2`` and the output holds the
-   harmonics ``Y_n = (1/L) Σ_k y[k] e^{-j(Ω + nω_p) t_k}`` (DFT over an integer
-   number of periods of the steady state).  The lifted response to the
-   ``U_0`` input column is ``G_n(e^{jΩTs}) = Y_n / U(Ω)``, which for a unit
-   cosine is twice the DFT coefficient (errata).  The real form is
-   ``V^H [G_{-K}; ...; G_K]`` with the unitary V of `ltpcontrol.lift`, so the
-   data are the frequency response of the real lifted LTI system from its
-   ``c0`` input to all its outputs.
+1. *Lifted frequency response* (eqs. 4.54-4.58, 4.74-4.79, errata):
+   `ltpcontrol.lifted_frequency_response` (``_lifted_response``), the
+   frequency response of the real lifted LTI system from the ``c0``
+   coordinate of every input.
 2. *Subspace step* (eqs. 4.80-4.98): `ltpcontrol.fdsubspace` with order
    ``(2K+1) n_p`` (Remark 8) and ``q`` block rows.
 3. *Floquet realization* (eqs. 4.99-4.112): a similarity that gives the
@@ -32,225 +26,40 @@ from dataclasses import dataclass
 
 import numpy as np
 import control as ct
-from control.exception import ControlArgument, ControlDimension
-from tqdm.auto import tqdm
+from control.exception import ControlArgument
 
 from ._discretize import d2c
 from ._fdsubspace import fdsubspace, FDSubspaceInfo
-from ._floquet_fit import _harmonic_response, fit_floquet
-from ._lifting import _harmonic_labels, _real_basis
+from ._floquet_fit import _harmonic_data, _harmonic_response, fit_floquet
+from ._lifted_response import lifted_frequency_response
 from ._realization import FloquetRealization, floquet_realization
 from ._refine import refine_ltp
-from ._validation import (check_kwargs, check_period, check_positive_int,
-                          real_array, steps_per_period)
+from ._validation import check_kwargs, check_period, check_positive_int, steps_per_period
 
 __all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
 
-# Input lines are DFT bins whose magnitude exceeds this fraction of the largest.
-_LINE_RTOL = 1e-3
-# Energy outside the detected lines (relative) above which leakage is reported.
-_LEAKAGE_RTOL = 1e-8
-_HOLDS = (None, 'foh', 'zoh')
 _CONVERSIONS = ('refit', 'log', 'tustin')
-
-
-def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
-                              transient=0.0, input_hold=None, hold_step=None, real=True,
-                              unusable='raise', batch_size=64, progress=False, name=None,
-                              **kwargs):
-    r"""Lifted frequency response of an LTP system from sine experiments.
-
-    Each experiment applies one real sinusoid (single sine) or a sum of
-    sinusoids (multisine) to a single-input LTP system of known period T.
-    After discarding a transient, the last whole periods of every record
-    are Fourier analysed at the input lines ``Ω`` and at the output
-    harmonics ``Ω + nω_p``, n = -K..K.  The result is the frequency
-    response of the real lifted LTI system (`ltpcontrol.lift`) from its
-    ``c0`` input, i.e. the data of thesis eqs. (4.78)-(4.79).
-
-    Parameters
-    ----------
-    response : control.TimeResponseData or tuple
-        The experiments: a response of `ltpcontrol.forced_response` with
-        several traces, or a tuple ``(timepts, inputs, outputs)`` with
-        ``inputs`` of shape ``(nexp, L)`` or ``(1, nexp, L)`` and
-        ``outputs`` of shape ``(nexp, L)`` (single output) or
-        ``(noutputs, nexp, L)``.  ``timepts`` (length L, uniform step
-        ``Ts``) are absolute times: ``t = 0`` is the phase reference of the
-        period.
-    period : float
-        Period T of the system; ``N = T/Ts`` must be an integer.
-    nharmonics : int
-        Number K of output harmonics kept (``2K+1 <= N``).
-    frequencies : array_like, optional
-        Input lines in rad/s, shape ``(nexp,)`` (one sine per experiment)
-        or ``(nexp, nlines)``.  By default the lines are the DFT bins of
-        each input window whose magnitude exceeds ``1e-3`` of the largest.
-    transient : float, optional
-        Time (s) discarded at the start of every record (default 0).  The
-        analysis window is the largest integer number of periods at the
-        end of the remaining record.
-    input_hold : {None, 'foh', 'zoh'}, optional
-        How the applied input relates to its samples.  None (default): the
-        samples are those of the continuous input.  'foh'/'zoh': the input
-        was interpolated linearly / held between samples (as
-        `ltpcontrol.forced_response` does with ``input_hold``); the input
-        coefficient is then that of the interpolated signal,
-        ``U sinc²(ΩTs/2)`` or ``U sinc(ΩTs/2) e^{-jΩTs/2}``, which removes the
-        hold's gain and phase from the response (its spectral images remain
-        as a small error).
-    hold_step : float, optional
-        Step (s) of the input hold; default the step ``Ts`` of `timepts`.
-        Give it when the records were decimated from a finer simulation
-        (for example ``Ts/4``) or the input is updated faster than sampled.
-    real : bool, optional
-        True (default): real lifted coordinates ``V^H G`` with output
-        labels ``'<y>_c0', '<y>_c1', '<y>_s1', ...`` as in `ltpcontrol.lift`.
-        False: the complex harmonics ``G_n``, n = -K..K (labels
-        ``'<y>_h<n>'``).
-    unusable : {'raise', 'skip'}, optional
-        What to do with lines within one DFT bin of a multiple of ``ω_p/2``
-        (the responses to ``±Ω`` share their output frequencies there):
-        'raise' (default) a ValueError, or 'skip' them with a warning.
-    batch_size : int, optional
-        Number of input lines (experiments, for single sines) analysed at
-        once; bounds the memory use (default 64).
-    progress : bool, optional
-        Show a progress bar over the batches.
-    name : str, optional
-        Name of the result.
-
-    Returns
-    -------
-    control.FrequencyResponseData
-        Discrete-time (``dt = Ts``) response of shape ``((2K+1) noutputs,
-        1, M)`` on the M distinct lines ``Ω`` (increasing, rad/s).  Lines
-        excited in several experiments are averaged.
-
-    Raises
-    ------
-    ValueError
-        If ``T/Ts`` is not an integer, the time points are not uniform, the
-        window is shorter than one period, the lines of an input window
-        are not on its DFT grid and `frequencies` is not given, a line lies within one DFT bin
-        of a multiple of ``ω_p/2`` (with ``unusable='raise'``; the
-        responses to ``±Ω`` then share their output frequencies), no
-        usable line is left, two lines of one experiment produce
-        overlapping harmonics, a line is not below the Nyquist frequency,
-        or an input has no line.
-    ControlDimension
-        If inputs, outputs, time points or frequencies have inconsistent
-        shapes (experiment counts or lengths).
-    ControlArgument
-        For a response of the wrong type or more than one input.
-
-    Warns
-    -----
-    UserWarning
-        If a given frequency is off the DFT grid of the window (leakage
-        biases the response), or when lines are skipped (``unusable='skip'``).
-
-    Notes
-    -----
-    With ``U(Ω)`` and ``Y_n`` as in the module notes, ``G_n = Y_n/U(Ω)``.
-    For ``u = cos(Ωt)``, ``U = 1/2`` and ``G_n`` is twice the DFT
-    coefficient of the output at ``Ω + nω_p`` (thesis-errata page).  The
-    real form uses the unitary ``V`` with columns ``c_0 = e_0``, ``c_n =
-    (e_n + e_{-n})/√2``, ``s_n = j(e_n - e_{-n})/√2`` (errata items 3-4).
-
-    Examples
-    --------
-    Two unit cosines through a static gain ``1 + cos(ω_p t)``:
-
-    >>> sys = ltp.ltpss(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)),
-    ...                 lambda t: np.array([[1 + np.cos(4 * np.pi * t)]]), 0.5)
-    >>> exc = ltp.sine_experiments([1.0, 3.0], 0.5, dt=0.05, nperiods=8)
-    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
-    >>> G = ltp.lifted_frequency_response(resp, 0.5, 1, real=False)
-    >>> np.round(G.frdata[:, 0, 0].real, 6)            # G_{-1}, G_0, G_1
-    array([0.5, 1. , 0.5])
-    >>> G.output_labels[:2]
-    ['y[0]_h-1', 'y[0]_h0']
-    """
-    check_kwargs(kwargs, 'lifted_frequency_response')
-    period = check_period(period)
-    t, u, y, ylabels, ulabel = _parse_response(response)
-    dt = _uniform_step(t)
-    N = steps_per_period(period, dt, 'the time step of timepts')
-    K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
-    if 2 * K + 1 > N:
-        raise ValueError(f"nharmonics={K} needs 2K+1 <= N = {N} samples per period")
-    if input_hold not in _HOLDS:
-        raise ValueError(f"input_hold must be None, 'foh' or 'zoh', got {input_hold!r}")
-    if not isinstance(real, (bool, np.bool_)):
-        raise ControlArgument(f"real must be True or False, got {real!r}")
-    hold_step = dt if hold_step is None else check_period(hold_step, 'hold_step')
-    batch_size = check_positive_int(batch_size, 'batch_size')
-    if unusable not in ('raise', 'skip'):
-        raise ValueError(f"unusable must be 'raise' or 'skip', got {unusable!r}")
-    transient = float(real_array(transient, 'transient', ndim=0))
-    if transient < 0:
-        raise ValueError(f"transient must be >= 0, got {transient}")
-
-    # Window: the last P whole periods after the transient.
-    nexp, L = u.shape
-    skip = int(np.ceil(transient / dt - 1e-9))
-    P = (L - skip) // N
-    if P < 1:
-        raise ValueError(f"the records ({L} samples) hold no whole period ({N} samples) "
-                         f"after the transient of {transient} s")
-    start = L - P * N
-    tw, uw, yw = t[start:], u[:, start:], y[:, :, start:]
-    window = P * period
-    lines = _lines(uw, frequencies, nexp, window, dt, period, unusable == 'skip')
-
-    # Output harmonics: Y_n = (1/L) Σ_k y[k] e^{-jΩt_k} e^{-jnω_p t_k}, where the
-    # second factor repeats every period (N samples).
-    wp = 2 * np.pi / period
-    harm = np.arange(-K, K + 1)
-    tper = tw[:N]
-    Eh = np.exp(-1j * wp * harm[:, None] * tper[None, :])          # (2K+1, N)
-    ny = y.shape[0]
-    # one (experiment, line) pair per data point
-    exp_index = np.concatenate([np.full(Om.size, e) for e, Om in enumerate(lines)])
-    line_omega = np.concatenate(lines)
-    values = []
-    npair, Lw = line_omega.size, uw.shape[1]
-    for b0 in tqdm(range(0, npair, batch_size), desc="lifted FR", leave=False,
-                   disable=(not progress) or None):
-        Om, ex = line_omega[b0:b0 + batch_size], exp_index[b0:b0 + batch_size]
-        Ein = np.exp(-1j * Om[:, None] * tw[None, :])               # (b, Lw)
-        U = np.einsum('bk,bk->b', Ein, uw[ex]) / Lw
-        # Σ over periods of y e^{-jΩt}, then the periodic harmonic factor.
-        Z = (yw[:, ex] * Ein).reshape(ny, Om.size, P, N).sum(2)   # (ny, b, N)
-        Y = np.einsum('obk,hk->hob', Z, Eh) / Lw                   # (2K+1, ny, b)
-        values.append(Y / (U * _hold_factor(Om, hold_step, input_hold)))
-    omega = line_omega
-    G = np.concatenate(values, axis=2).reshape((2 * K + 1) * ny, -1)
-    # Average lines excited by several experiments; sort by frequency.
-    omega, inverse = np.unique(np.round(omega * window / (2 * np.pi), 6), return_inverse=True)
-    omega = omega * 2 * np.pi / window
-    counts = np.bincount(inverse)
-    Gm = np.zeros((G.shape[0], omega.size), complex)
-    np.add.at(Gm.T, inverse, G.T)
-    Gm /= counts
-    if real:
-        V, tags = _real_basis(harm, N)
-        Gm = np.kron(V, np.eye(ny)).conj().T @ Gm
-        outputs = _harmonic_labels(ylabels, tags)
-        inputs = [f'{ulabel}_c0']
-    else:
-        outputs = _harmonic_labels(ylabels, [f'h{n}' for n in harm])
-        inputs = [f'{ulabel}_h0']
-    return ct.frd(Gm[:, None, :], omega, dt, name=name, inputs=inputs, outputs=outputs)
 
 
 @dataclass(frozen=True)
 class LTPSubspaceInfo:
     """Diagnostics returned by `identify_ltp` with ``return_info=True``.
 
+    The first fields follow `scipy.optimize.OptimizeResult`.
+
     Attributes
     ----------
+    success : bool
+        The model is trustworthy: with 'refit', the least-squares refit
+        converged and its relative residual is at most the realization's
+        ``fit_tol`` (default 0.05); with 'log' or 'tustin', the Floquet
+        realization succeeded with all K harmonics; with ``refine='ml'``
+        also the refinement converged.
+    message : str
+        Description of the outcome.
+    nfev : int
+        Model evaluations of the refit and the refinement (0 for 'log' and
+        'tustin' without refinement).
     data : control.FrequencyResponseData
         Real lifted frequency response used for identification.
     lifted : control.StateSpace
@@ -265,18 +74,21 @@ class LTPSubspaceInfo:
         Continuous-time conversion used ('refit', 'log' or 'tustin').
     relative_residual : float
         ``‖G - Ĝ‖ / ‖G‖`` of the continuous-time model on the continuous
-        harmonic response ``G_n(jΩ)`` (all lines, harmonics -K..K; those of
-        the model for 'log' and 'tustin').
+        harmonic response ``G_n(jΩ)`` (all lines, inputs and harmonics
+        -K..K; those of the model for 'log' and 'tustin').
     realized_harmonics : int
         Harmonics of the realized lifted model: K, or fewer when the
         K-harmonic model had no eigenvalue ladders.
 
     Examples
     --------
-    >>> LTPSubspaceInfo.__dataclass_fields__.keys() >= {'lifted', 'realization'}
+    >>> LTPSubspaceInfo.__dataclass_fields__.keys() >= {'success', 'lifted', 'realization'}
     True
     """
 
+    success: bool
+    message: str
+    nfev: int
     data: ct.FrequencyResponseData
     lifted: ct.StateSpace
     subspace: FDSubspaceInfo
@@ -289,8 +101,8 @@ class LTPSubspaceInfo:
 def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
                  realization='direct', realization_options=None, refit_a=True,
                  refit_harmonics=None, refine=None, refine_options=None,
-                 estimate_d=True,
-                 seed=None, progress=False,
+                 estimate_d=True, frequencies=None, transient=None, input_hold=None,
+                 hold_step=None, batch_size=None, seed=None, progress=False,
                  return_info=False, name=None, **kwargs):
     r"""Identify a continuous-time LTP model from sine experiments (thesis §4.2).
 
@@ -303,10 +115,9 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     ----------
     data : control.FrequencyResponseData, control.TimeResponseData or tuple
         Either the real lifted response of `lifted_frequency_response`
-        (with ``2K+1`` harmonics per output) or the experiments themselves
-        (anything `lifted_frequency_response` accepts; its keywords
-        `frequencies`, `transient`, `input_hold`, `hold_step` and `batch_size` may be
-        given here).
+        (with ``2K+1`` harmonics per output, one column per input) or the
+        experiments themselves (anything `lifted_frequency_response`
+        accepts, single- or multi-input).
     period : float
         Period T of the system.
     nstates : int
@@ -350,7 +161,11 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         A plant whose A(t) is periodic has infinitely many harmonics in
         Floquet form; H = K + 1 lets the model carry the input harmonics
         just beyond the data's, which removes most of the truncation bias
-        of the Floquet exponents (see the identification guide).
+        of the Floquet exponents (see the identification guide).  It is no
+        default: for a plant whose B(t), C(t) have at most K harmonics in
+        Floquet form (the thesis's Mathieu example) the data do not
+        determine the extra harmonics, and the HTF away from the data
+        degrades (there from 3e-7 to 2e-2).
     refine : {None, 'ml'}, optional
         'ml': finish with `ltpcontrol.refine_ltp` on the lifted data (the
         maximum-likelihood fit of the Floquet-form model, equal weights
@@ -360,20 +175,25 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         ``harmonics``, ...).
     estimate_d : bool, optional
         Estimate a feedthrough (default True); False forces ``D = 0``.
+    frequencies, transient, input_hold, hold_step, batch_size : optional
+        Time records only: passed to `lifted_frequency_response` (defaults
+        there: lines detected, no transient, no hold, ``Ts``, 64).  Lines at
+        multiples of ``ω_p/2`` are skipped with a warning.
     seed : int, optional
         Seed of the 'pso' realization search (reproducibility).
     progress : bool, optional
-        Show progress bars (experiment batches, realization).
+        Show progress bars (experiment batches, realization; default False).
     return_info : bool, optional
-        Also return an `LTPSubspaceInfo`.
+        Also return an `LTPSubspaceInfo` (``success``, ``message``,
+        ``nfev`` and the intermediate results).
     name : str, optional
         Name of the identified system (default ``'ltp_subspace'``).
 
     Returns
     -------
     sys : LTPStateSpace
-        Continuous-time model in Floquet form (constant A), one input and
-        the outputs of the data.
+        Continuous-time model in Floquet form (constant A) with the inputs
+        and outputs of the data.
     info : LTPSubspaceInfo
         Only with ``return_info=True``.
 
@@ -388,7 +208,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     ControlArgument
         If `data` has the wrong type or is not discrete-time.
     TypeError
-        For unknown keyword arguments.
+        For unknown keyword arguments, or the time-record options
+        (`frequencies`, `transient`, ...) given with frequency-response data.
 
     Warns
     -----
@@ -410,7 +231,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         G_n(jΩ) = \sum_{m=-K}^{K} C_{n-m} R_m(Ω) B_m + D_n,
         \qquad n = -K..K,
 
-    bilinear in (B, C) and linear in D.  'refit' minimises
+    (``ny x nu`` for ``nu`` inputs), bilinear in (B, C) and linear in D.  'refit' minimises
     ``Σ |G_n - Ĝ_n|²`` over all lines and harmonics by Levenberg-Marquardt
     steps (minimum-norm Gauss-Newton steps absorb the similarity freedom).
     The pipeline is robust to imperfect lifted models: the eigenvalue
@@ -446,8 +267,6 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     >>> round(float((B[2] / B[1]).real), 4)
     0.25
     """
-    lfr_keys = ('frequencies', 'transient', 'input_hold', 'hold_step', 'batch_size')
-    lfr_kwargs = {key: kwargs.pop(key) for key in lfr_keys if key in kwargs}
     check_kwargs(kwargs, 'identify_ltp')
     period = check_period(period)
     nstates = check_positive_int(nstates, 'nstates')
@@ -459,47 +278,55 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     if refine not in (None, 'ml'):
         raise ValueError(f"refine must be None or 'ml', got {refine!r}")
     # 1. lifted frequency response
-    G = _lifted_data(data, period, K, progress, lfr_kwargs)
+    record_options = dict(frequencies=frequencies, transient=transient,
+                          input_hold=input_hold, hold_step=hold_step, batch_size=batch_size)
+    G = _lifted_data(data, period, K, progress, record_options)
     ny, N = _check_lifted_data(G, period, K, nstates, q)
     name = 'ltp_subspace' if name is None else name
-    labels = dict(name=name, inputs=[G.input_labels[0].rsplit('_', 1)[0]],
+    labels = dict(name=name, inputs=[lab.rsplit('_', 1)[0] for lab in G.input_labels],
                   outputs=[lab.rsplit('_', 1)[0] for lab in G.output_labels[:ny]])
-    Gc = _harmonic_data(G, K, N, ny)
+    Gc = _harmonic_data(G.frdata, K, N, ny)
     # 2-4. subspace model, Floquet realization (fewer harmonics if better), continuous time
     lifted, sinfo, real, Kr, sysc = _realize(
         G, Gc, period, K, N, nstates, ny, q, estimate_d, realization, seed, progress,
         realization_options, conversion, labels)
     # 5. structured refinement: the Floquet-form model fitted to the harmonic data
+    nfev, converged = 0, True
     if conversion == 'refit':
-        sysc, _, converged = fit_floquet(sysc, Gc, G.omega, K, harmonics=H,
-                                         estimate_d=estimate_d, fit_a=refit_a, **labels)
+        sysc, _, converged, nfev = fit_floquet(sysc, Gc, G.omega, K, harmonics=H,
+                                               estimate_d=estimate_d, fit_a=refit_a, **labels)
         if not converged:
             warnings.warn("the least-squares refit did not converge", UserWarning,
                           stacklevel=2)
     # 6. optional maximum-likelihood refinement weighted by the data's uncertainty
+    ml = None
     if refine == 'ml':
-        sysc = _ml_refine(sysc, G, refine_options)
-    resid = _harmonic_response(sysc, G.omega, min(K, Kr) if conversion != 'refit' else K)
-    Gk = Gc if conversion == 'refit' else _harmonic_data(G, min(K, Kr), N, ny)
-    relres = float(np.linalg.norm(resid - Gk) / np.linalg.norm(Gk))
-    _warn_quality(real, Kr, K, conversion, relres, realization_options)
+        sysc, ml = refine_ltp(sysc, G, return_info=True, **(refine_options or {}))
+        nfev += ml.nfev
+    Kc = K if conversion == 'refit' else min(K, Kr)
+    Gk = Gc if Kc == K else _harmonic_data(G.frdata, Kc, N, ny)
+    relres = float(np.linalg.norm(_harmonic_response(sysc, G.omega, Kc) - Gk)
+                   / np.linalg.norm(Gk))
+    success, message = _quality(real, Kr, K, conversion, relres, converged, ml,
+                                realization_options)
     if not return_info:
         return sysc
-    info = LTPSubspaceInfo(data=G, lifted=lifted, subspace=sinfo, realization=real,
-                           conversion=conversion, relative_residual=relres,
-                           realized_harmonics=Kr)
-    return sysc, info
+    return sysc, LTPSubspaceInfo(
+        success=success, message=message, nfev=nfev, data=G, lifted=lifted, subspace=sinfo,
+        realization=real, conversion=conversion, relative_residual=relres,
+        realized_harmonics=Kr)
 
 
-def _lifted_data(data, period, K, progress, lfr_kwargs):
+def _lifted_data(data, period, K, progress, options):
     """Step 1: the real lifted response, given or computed from time records."""
+    given = {key: val for key, val in options.items() if val is not None}
     if isinstance(data, ct.FrequencyResponseData):
-        if lfr_kwargs:
-            raise TypeError(f"identify_ltp: {sorted(lfr_kwargs)} only apply to time "
+        if given:
+            raise TypeError(f"identify_ltp: {sorted(given)} only apply to time "
                             "records, not to frequency-response data")
         return data
     return lifted_frequency_response(data, period, K, progress=progress,
-                                     unusable='skip', **lfr_kwargs)
+                                     unusable='skip', **given)
 
 
 def _check_lifted_data(G, period, K, nstates, q):
@@ -509,9 +336,9 @@ def _check_lifted_data(G, period, K, nstates, q):
         raise ControlArgument("data must be discrete-time frequency-response data "
                               "with a numeric sampling time (from "
                               "lifted_frequency_response)")
-    if G.ninputs != 1 or G.noutputs % H:
-        raise ValueError(f"data must have one input and (2K+1) = {H} lifted outputs per "
-                         f"system output, got shape {G.frdata.shape[:2]}")
+    if G.noutputs % H:
+        raise ValueError(f"data must have (2K+1) = {H} lifted outputs per system output, "
+                         f"got shape {G.frdata.shape[:2]}")
     N = steps_per_period(period, float(G.dt), 'the sampling time of data')
     order, M = H * nstates, G.omega.size
     # fdsubspace needs 2M >= q + order with q > order: at least order + 1 lines.
@@ -560,160 +387,28 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
     return best[1:]
 
 
-def _harmonic_data(G, K, N, ny):
-    """Continuous harmonic data G_n(jΩ), n = -K..K (undo the real transform)."""
-    V, _ = _real_basis(np.arange(-K, K + 1), N)
-    H = 2 * K + 1
-    return (np.kron(V, np.eye(ny)) @ G.frdata[:H * ny, 0, :]).reshape(H, ny, -1)
-
-
-def _warn_quality(real, Kr, K, conversion, relres, options):
-    """Warn when the returned model is doubtful (see `identify_ltp`, Warns)."""
+def _quality(real, Kr, K, conversion, relres, converged, ml, options):
+    """``(success, message)`` of the returned model; warn when it is doubtful."""
     if Kr < K and conversion != 'refit':
         warnings.warn(f"the lifted model of {K} harmonics has no eigenvalue ladders; "
                       f"realized with {Kr} harmonics instead: the model has {Kr} "
                       "harmonics", UserWarning, stacklevel=3)
     fit_tol = (options or {}).get('fit_tol', 0.05)
     if conversion == 'refit':
+        success = converged and relres <= fit_tol
+        message = (f"refit {'converged' if converged else 'stopped before converging'}, "
+                   f"relative residual {relres:.3g} (fit_tol {fit_tol:g})")
         if relres > fit_tol:
             warnings.warn(f"the identified model misses the data: relative residual "
                           f"{relres:.3g} > {fit_tol:g} (realization: {real.message}); "
                           "try other nstates, nharmonics or q", UserWarning, stacklevel=3)
-    elif not real.success:
-        warnings.warn(f"{real.message}; the model is not trustworthy (try another "
-                      "realization method, seed or q)", UserWarning, stacklevel=3)
-
-
-#
-# Private helpers
-#
-
-def _parse_response(response):
-    """Return ``(t, u (nexp, L), y (ny, nexp, L), output labels, input label)``."""
-    if isinstance(response, ct.TimeResponseData):
-        t, u, y = response.time, response.u, response.y
-        ylabels = list(response.output_labels)
-        ulabel = response.input_labels[0] if response.ninputs else 'u[0]'
-        if u is None:
-            raise ControlArgument("response carries no inputs; pass (timepts, inputs, "
-                                  "outputs) instead")
-        if u.ndim == 2:                          # single trace
-            u, y = u[:, None, :], y[:, None, :]
-    elif isinstance(response, tuple) and len(response) == 3:
-        t, u, y = response
-        u = real_array(u, 'inputs', ndim=(1, 2, 3))
-        y = real_array(y, 'outputs', ndim=(1, 2, 3))
-        u = u.reshape((1,) * (3 - u.ndim) + u.shape)
-        y = y.reshape((1,) * (3 - y.ndim) + y.shape)
-        ylabels, ulabel = [f'y[{i}]' for i in range(y.shape[0])], 'u[0]'
     else:
-        raise ControlArgument("response must be a control.TimeResponseData or a tuple "
-                              f"(timepts, inputs, outputs), got {type(response).__name__}")
-    t = real_array(t, 'timepts', ndim=1)
-    u = real_array(u, 'inputs', ndim=3)
-    y = real_array(y, 'outputs', ndim=3)
-    if u.shape[0] != 1:
-        raise ControlArgument(f"the experiments must have a single input, got {u.shape[0]}")
-    if u.shape[1:] != y.shape[1:]:
-        raise ControlDimension(
-            f"inputs (experiments, samples) = {u.shape[1:]} and outputs "
-            f"{y.shape[1:]} are inconsistent: every experiment needs one input and one "
-            "output record of the same length")
-    if u.shape[2] != t.size:
-        raise ControlDimension(f"the records have {u.shape[2]} samples but timepts has "
-                               f"{t.size}")
-    return t, u[0], y, ylabels, ulabel
-
-
-def _uniform_step(t):
-    """The step of uniformly spaced, increasing `t`."""
-    if t.size < 2:
-        raise ValueError("timepts must hold at least two samples")
-    d = np.diff(t)
-    dt = (t[-1] - t[0]) / (t.size - 1)
-    if dt <= 0 or np.max(np.abs(d - dt)) > 1e-9 * max(dt, np.abs(t).max()):
-        raise ValueError("timepts must be uniformly spaced and increasing")
-    return dt
-
-
-def _lines(uw, frequencies, nexp, window, dt, period, skip=False):
-    """Input lines (rad/s) of every experiment, validated (unusable ones skipped)."""
-    bin_ = 2 * np.pi / window
-    Lw = uw.shape[1]
-    if frequencies is None:
-        spec = np.abs(np.fft.rfft(uw, axis=1)) / Lw
-        spec[:, 0] = 0.0                                  # DC is no line
-        if Lw % 2 == 0:
-            spec[:, -1] = 0.0                             # nor is Nyquist
-        peak = spec.max(axis=1)
-        if np.any(peak == 0):
-            raise ValueError(f"the input of experiment {int(np.argmin(peak))} has no "
-                             "spectral line in the analysis window")
-        on = spec >= _LINE_RTOL * peak[:, None]
-        lines = [np.flatnonzero(row) * bin_ for row in on]
-        total = np.sum(uw ** 2, axis=1)
-        inline = 2 * Lw ** 2 * np.sum(np.where(on, spec, 0.0) ** 2, axis=1) / Lw
-        if np.any(total - inline > _LEAKAGE_RTOL * total):
-            raise ValueError("an input window is not a sum of sinusoids on the DFT grid "
-                             "of the window (leakage), so its lines cannot be detected; "
-                             "choose the record length or pass frequencies=")
-    else:
-        f = real_array(frequencies, 'frequencies', ndim=(1, 2))
-        if f.shape[0] != nexp:
-            raise ControlDimension(f"frequencies has {f.shape[0]} rows for {nexp} "
-                                   "experiments")
-        f = f.reshape(nexp, -1)
-        off = np.abs(f / bin_ - np.round(f / bin_))
-        if np.any(off > 1e-6):
-            warnings.warn("some frequencies are not on the DFT grid 2π/window = "
-                          f"{bin_:.6g} rad/s of the analysis window: leakage biases "
-                          "the response", UserWarning, stacklevel=3)
-        lines = list(f)
-    half = np.pi / period                                 # ω_p / 2
-    skipped = []
-    for e, Om in enumerate(lines):
-        if np.any(Om <= 0) or np.any(Om >= np.pi / dt):
-            raise ValueError(f"frequencies of experiment {e} must lie in (0, π/Ts) = "
-                             f"(0, {np.pi / dt:.6g}) rad/s")
-        # ±Ω share output frequencies when 2Ω ≡ 0 (mod ω_p); lines l, l' when
-        # Ω_l ± Ω_l' ≡ 0 (mod ω_p).
-        dist = np.abs(Om - np.round(Om / half) * half)
-        if skip and np.any(dist < 0.49 * bin_):
-            skipped.extend(Om[dist < 0.49 * bin_])
-            Om = lines[e] = Om[dist >= 0.49 * bin_]
-        elif np.any(dist < 0.49 * bin_):
-            raise ValueError(
-                f"frequencies {np.round(Om[dist < 0.49 * bin_], 6).tolist()} rad/s of "
-                f"experiment {e} are multiples of omega_p/2 = {half:.6g} rad/s (within "
-                "one DFT bin): the responses to +Ω and -Ω fall on the same output "
-                "frequencies")
-        wp = 2 * half
-        for s in (-1, 1):
-            d = Om[:, None] + s * Om[None, :]
-            d = np.abs(d - np.round(d / wp) * wp)
-            np.fill_diagonal(d, np.inf)
-            if np.any(d < 0.49 * bin_):
-                raise ValueError(f"two lines of experiment {e} differ or sum to a "
-                                 "multiple of omega_p: their output harmonics overlap")
-    if skipped:
-        warnings.warn(f"skipped the lines {np.round(np.unique(skipped), 6).tolist()} rad/s "
-                      f"at multiples of omega_p/2 = {half:.6g} rad/s: the responses to +Ω "
-                      "and -Ω fall on the same output frequencies there",
-                      UserWarning, stacklevel=4)
-        if not any(Om.size for Om in lines):
-            raise ValueError("no usable line is left after skipping the multiples of "
-                             "omega_p/2")
-    return lines
-
-
-def _hold_factor(omega, dt, hold):
-    """Gain of the input hold at ω: 1, sinc²(ωTs/2) or sinc(ωTs/2) e^{-jωTs/2}."""
-    if hold is None:
-        return np.ones_like(omega)
-    x = np.sinc(omega * dt / (2 * np.pi))                  # np.sinc(x) = sin(πx)/(πx)
-    return x ** 2 if hold == 'foh' else x * np.exp(-0.5j * omega * dt)
-
-
-def _ml_refine(sys, data, options):
-    """``refine='ml'`` of `identify_ltp`: `refine_ltp` on the lifted data."""
-    return refine_ltp(sys, data, **(options or {}))
+        success = real.success and Kr == K
+        message = f"{real.message}; relative residual {relres:.3g}"
+        if not real.success:
+            warnings.warn(f"{real.message}; the model is not trustworthy (try another "
+                          "realization method, seed or q)", UserWarning, stacklevel=3)
+    if ml is not None:
+        success = success and ml.success
+        message += f"; ML refinement: {ml.message}"
+    return bool(success), message

@@ -46,8 +46,8 @@ import scipy.optimize
 import scipy.sparse as sp
 from control.exception import ControlArgument, ControlDimension
 
+from ._floquet_fit import _harmonic_data
 from ._htf import HTF, HTFData
-from ._lifting import _real_basis
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix
 from ._validation import check_kwargs, check_positive_int, real_array, steps_per_period
@@ -150,27 +150,29 @@ def _data_points(data, period, ny, nu, std=None):
         if std is not None:
             std = np.transpose(std, (0, 3, 1, 2)).reshape(vals.shape)
     elif isinstance(data, ct.FrequencyResponseData):
-        if not data.dt or data.dt is True or data.ninputs != 1 or data.noutputs % ny:
+        if not data.dt or data.dt is True or data.noutputs % ny:
             raise ControlArgument(
                 "frequency-response data must be the discrete-time real lifted response "
-                "of lifted_frequency_response (one input, (2K+1) outputs per model output)")
-        H = data.noutputs // ny
+                "of lifted_frequency_response ((2K+1) outputs per model output)")
+        H, M = data.noutputs // ny, data.omega.size
         K = (H - 1) // 2
         N = steps_per_period(period, float(data.dt), 'the sampling time of data')
-        V, _ = _real_basis(np.arange(-K, K + 1), N)
-        Gc = (np.kron(V, np.eye(ny)) @ data.frdata[:, 0, :]).reshape(H, ny, -1)
-        k = np.repeat(np.arange(-K, K + 1), data.omega.size)
+        Gc = _harmonic_data(data.frdata, K, N, ny)                  # (nu, H, ny, M)
+        k = np.repeat(np.arange(-K, K + 1), M)
         Om = np.tile(data.omega, H)
-        vals = np.transpose(Gc, (0, 2, 1)).reshape(-1, ny, 1)
+        vals = np.transpose(Gc, (1, 3, 2, 0)).reshape(-1, ny, data.ninputs)
         if std is not None:
-            std = real_array(std, 'std', ndim=(0, 1, 2, 3))
+            # one std per (harmonic, output, line), shared by the inputs, or per input
+            std = real_array(std, 'std', ndim=(0, 1, 2, 3, 4))
+            shape = (H, ny, data.ninputs, M)
             try:
-                std = np.broadcast_to(std, (H, ny, data.omega.size))
+                std = np.broadcast_to(std[..., None, :] if 1 <= std.ndim <= 3 else std,
+                                      shape)
             except ValueError:
                 raise ControlDimension(f"std of shape {std.shape} does not broadcast to "
-                                       f"(2K+1, ny, nlines) = {(H, ny, data.omega.size)}"
-                                       ) from None
-            std = np.transpose(std, (0, 2, 1)).reshape(vals.shape)
+                                       f"(2K+1, ny, nlines) = {(H, ny, M)} or (2K+1, ny, "
+                                       f"ninputs, nlines) = {shape}") from None
+            std = np.transpose(std, (0, 3, 1, 2)).reshape(vals.shape)
     else:
         raise ControlArgument("data must be an HTF (estimate_htf) or the "
                               "FrequencyResponseData of lifted_frequency_response, got "
@@ -415,12 +417,13 @@ def refine_ltp(sys, data, *, std=None, harmonics=None, weighted=True, stable=Fal
         A data HTF (`estimate_htf`): all components ``G_k(jω)`` that are not
         NaN are fitted, weighted by ``1/std`` when the HTF carries `std`.
         Or the real lifted response of `lifted_frequency_response` (as for
-        `identify_ltp`), weighted by `std` when given.
+        `identify_ltp`, one column per input), weighted by `std` when given.
     std : array_like, optional
         Lifted frequency-response data only: standard deviations of the
         complex harmonic responses ``G_n(jΩ)`` (which the real lifted
-        coordinates share), broadcastable to ``(2K+1, ny, nlines)``, e.g.
-        one value per line.
+        coordinates share), broadcastable to ``(2K+1, ny, nlines)`` (the
+        same for every input; e.g. one value per line) or to ``(2K+1, ny,
+        ninputs, nlines)``.
     harmonics : int or (int, int, int), optional
         Numbers ``(K_B, K_C, K_D)`` of harmonics of B, C and D in the
         refined model.  Default: those of `sys` (for matrices given as

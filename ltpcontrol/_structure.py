@@ -6,9 +6,10 @@ lines of the training set (all lines but every `holdout`-th) and scored on
 * the held-out lines: ``e_val = ‖Ĝ - G‖ / ‖G‖`` over the harmonics
   ``|n| <= K_max`` of the data (a K-harmonic model predicts them all),
 * an information criterion on the training lines, ``AIC = M_r log(SSE/M_r)
-  + 2 d`` with ``M_r`` real residuals and ``d = (2K+1) n_p + (4K+1) p n_p +
-  (2K+1) p`` free parameters (B, C, D harmonics; A is fixed by the
-  similarity up to its ``n_p`` exponents, which are added).
+  + 2 d`` with ``M_r`` real residuals and ``d = (2K+1) n_p m + (4K+1) p n_p +
+  (2K+1) p m`` free parameters (B, C, D harmonics for m inputs and p
+  outputs; A is fixed by the similarity up to its ``n_p`` exponents, which
+  are added).
 
 The singular values of the subspace step at the largest candidate order
 show the lifted order ``(2K+1) n_p`` as a gap.  A plant whose A(t) is
@@ -24,9 +25,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 import control as ct
 from control.exception import ControlArgument
+from tqdm.auto import tqdm
 
-from ._floquet_fit import _harmonic_response
-from ._lifting import _real_basis
+from ._floquet_fit import _harmonic_data, _harmonic_response
 from ._ltp_subspace import identify_ltp
 from ._validation import check_kwargs, check_period, check_positive_int, steps_per_period
 
@@ -120,7 +121,7 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
     ----------
     data : control.FrequencyResponseData
         Real lifted response (`lifted_frequency_response`) with at least
-        ``max(nharmonics)`` harmonics.
+        ``max(nharmonics)`` harmonics, one column per input.
     period : float
         Period T of the system.
     nstates, nharmonics : array_like of int
@@ -193,11 +194,10 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
     M = data.omega.size
     held = np.zeros(M, bool)
     held[1::holdout] = True
-    V, _ = _real_basis(np.arange(-Kdata, Kdata + 1), N)
-    Gc = (np.kron(V, np.eye(ny)) @ data.frdata[:, 0, :]).reshape(2 * Kdata + 1, ny, M)
+    Gc = _harmonic_data(data.frdata, Kdata, N, ny)             # (m, 2K_d+1, ny, M)
+    nu = data.ninputs
     val = np.full((ns.size, Ks.size), np.nan)
     aic = np.full((ns.size, Ks.size), np.nan)
-    from tqdm.auto import tqdm
     bar = tqdm(total=val.size, desc="structures", disable=not progress, leave=False)
     sv = None
     for i, n in enumerate(ns):
@@ -219,7 +219,7 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
             val[i, j] = np.linalg.norm(err[..., held]) / np.linalg.norm(Gc[..., held])
             sse = np.sum(np.abs(err[..., ~held]) ** 2)
             mr = 2 * err[..., ~held].size
-            d = (2 * K + 1) * n + (4 * K + 1) * ny * n + (2 * K + 1) * ny + n
+            d = (2 * K + 1) * n * nu + (4 * K + 1) * ny * n + (2 * K + 1) * ny * nu + n
             aic[i, j] = mr * np.log(max(sse, np.finfo(float).tiny) / mr) + 2 * d
             bar.update(1)
     bar.close()

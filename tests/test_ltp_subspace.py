@@ -250,8 +250,8 @@ def test_other_bad_arguments(truth, frd):
         lifted_frequency_response((t, u, y), T, 1, input_hold='cubic')
     with pytest.raises(ValueError, match="2K\\+1"):
         lifted_frequency_response((t, u, y), T, 25)
-    with pytest.raises(ControlArgument, match="single input"):
-        lifted_frequency_response((t, np.stack([u, u]), y), T, 1)
+    with pytest.raises(ValueError, match="cannot separate the 2 inputs"):
+        lifted_frequency_response((t, np.stack([u, u]), y), T, 1, transient=2.0)
     with pytest.raises(ControlArgument, match="TimeResponseData or a tuple"):
         lifted_frequency_response([t, u, y], T, 1)
     with pytest.raises(TypeError, match="unrecognized"):

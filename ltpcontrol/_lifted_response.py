@@ -1,0 +1,424 @@
+"""Lifted frequency response of an LTP system from sine experiments (thesis §4.2, step 1).
+
+For a real input line ``u = a cos(Ωt + φ)`` the input coefficient is
+``U(Ω) = (1/L) Σ_k u[k] e^{-jΩ t_k} = a e^{jφ}/2`` and the output holds the
+harmonics ``Y_n = (1/L) Σ_k y[k] e^{-j(Ω + nω_p) t_k}`` (DFT over an integer
+number of periods of the steady state), thesis eqs. 4.54-4.58, 4.74-4.79
+and errata.  The lifted response to the ``U_0`` input column is ``G_n(e^{jΩTs})
+= Y_n / U(Ω)``, which for a unit cosine is twice the DFT coefficient.  The
+real form is ``V^H [G_{-K}; ...; G_K]`` with the unitary V of
+`ltpcontrol.lift`, so the data are the frequency response of the real lifted
+LTI system from its ``c0`` inputs to all its outputs.
+
+Several inputs.  The real lifted system of m inputs has (2K+1) m inputs, but
+its columns of input harmonic k follow from those of harmonic 0,
+``H_{n,k}(jΩ) = H_{n-k,0}(jΩ + jkω_p)``: the data are the m ``c0`` columns.
+Experiment e gives ``Y_n^{(e)}(Ω) = Σ_j G_{n,j}(Ω) U_j^{(e)}(Ω)`` at each of its
+lines (no other line of the experiment reaches ``Ω + nω_p``, checked); the
+experiments exciting a line give ``G_n`` by least squares (`_solve_lines`).
+"""
+
+import warnings
+
+import numpy as np
+import control as ct
+from control.exception import ControlArgument, ControlDimension
+from tqdm.auto import tqdm
+
+from ._lifting import _harmonic_labels, _real_basis
+from ._validation import (check_kwargs, check_period, check_positive, check_positive_int,
+                          real_array, steps_per_period, time_record)
+
+__all__ = ['lifted_frequency_response']
+
+# Input lines are DFT bins whose magnitude exceeds this fraction of the largest.
+_LINE_RTOL = 1e-3
+# Energy outside the detected lines (relative) above which leakage is reported.
+_LEAKAGE_RTOL = 1e-8
+# Smallest/largest eigenvalue of the normalised input Gram matrix of a line below
+# which the experiments cannot separate the inputs (error) or separate them poorly
+# (warning, condition number of the input phasors > 100).
+_SEPARATION_RTOL = 1e-10
+_SEPARATION_WARN = 1e-4
+_HOLDS = (None, 'foh', 'zoh')
+
+
+def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
+                              transient=0.0, input_hold=None, hold_step=None, real=True,
+                              unusable='raise', batch_size=64, progress=False, name=None,
+                              **kwargs):
+    r"""Lifted frequency response of an LTP system from sine experiments.
+
+    Each experiment applies real sinusoids (single sines) or sums of
+    sinusoids (multisines) to the inputs of an LTP system of known period
+    T.  After discarding a transient, the last whole periods of every
+    record are Fourier analysed at the input lines ``Ω`` and at the output
+    harmonics ``Ω + nω_p``, n = -K..K.  The result is the frequency
+    response of the real lifted LTI system (`ltpcontrol.lift`) from the
+    ``c0`` coordinate of every input, i.e. the data of thesis eqs.
+    (4.78)-(4.79).  With several inputs, every line must be excited in at
+    least as many experiments as there are inputs, with input phasors that
+    separate the inputs (`sine_experiments` and `multisine` with
+    ``ninputs``); the response is their least-squares solution per line.
+
+    Parameters
+    ----------
+    response : control.TimeResponseData or tuple
+        The experiments: a response of `ltpcontrol.forced_response` with
+        several traces, or a tuple ``(timepts, inputs, outputs)`` with
+        ``inputs`` of shape ``(nexp, L)`` (single input) or ``(ninputs,
+        nexp, L)`` and ``outputs`` of shape ``(nexp, L)`` (single output)
+        or ``(noutputs, nexp, L)``.  ``timepts`` (length L, uniform step
+        ``Ts``) are absolute times: ``t = 0`` is the phase reference of the
+        period.
+    period : float
+        Period T of the system; ``N = T/Ts`` must be an integer.
+    nharmonics : int
+        Number K of output harmonics kept (``2K+1 <= N``).
+    frequencies : array_like, optional
+        Input lines in rad/s, shape ``(nexp,)`` (one line per experiment)
+        or ``(nexp, nlines)``.  By default the lines are the DFT bins of
+        each experiment's input window whose magnitude (largest over the
+        inputs) exceeds ``1e-3`` of the largest.
+    transient : float, optional
+        Time (s) discarded at the start of every record (default 0).  The
+        analysis window is the largest integer number of periods at the
+        end of the remaining record.
+    input_hold : {None, 'foh', 'zoh'}, optional
+        How the applied input relates to its samples.  None (default): the
+        samples are those of the continuous input.  'foh'/'zoh': the input
+        was interpolated linearly / held between samples (as
+        `ltpcontrol.forced_response` does with ``input_hold``); the input
+        coefficient is then that of the interpolated signal,
+        ``U sinc²(ΩTs/2)`` or ``U sinc(ΩTs/2) e^{-jΩTs/2}``, which removes the
+        hold's gain and phase from the response (its spectral images remain
+        as a small error).
+    hold_step : float, optional
+        Step (s) of the input hold; default the step ``Ts`` of `timepts`.
+        Give it when the records were decimated from a finer simulation
+        (for example ``Ts/4``) or the input is updated faster than sampled.
+    real : bool, optional
+        True (default): real lifted coordinates ``V^H G`` with output
+        labels ``'<y>_c0', '<y>_c1', '<y>_s1', ...`` as in `ltpcontrol.lift`.
+        False: the complex harmonics ``G_n``, n = -K..K (labels
+        ``'<y>_h<n>'``).
+    unusable : {'raise', 'skip'}, optional
+        What to do with lines within one DFT bin of a multiple of ``ω_p/2``
+        (the responses to ``±Ω`` share their output frequencies there):
+        'raise' (default) a ValueError, or 'skip' them with a warning.
+    batch_size : int, optional
+        Number of (experiment, line) pairs analysed at once; bounds the
+        memory use (default 64).
+    progress : bool, optional
+        Show a progress bar over the batches (default False).
+    name : str, optional
+        Name of the result.
+
+    Returns
+    -------
+    control.FrequencyResponseData
+        Discrete-time (``dt = Ts``) response of shape ``((2K+1) noutputs,
+        ninputs, M)`` on the M distinct lines ``Ω`` (increasing, rad/s);
+        input j is the ``c0`` (``h0``) coordinate of input j.  Lines
+        excited in several experiments are solved in the least-squares
+        sense (averaged, for one input).
+
+    Raises
+    ------
+    ValueError
+        If ``T/Ts`` is not an integer, the time points are not uniform, the
+        window is shorter than one period, the lines of an input window
+        are not on its DFT grid and `frequencies` is not given, a line lies within one DFT bin
+        of a multiple of ``ω_p/2`` (with ``unusable='raise'``; the
+        responses to ``±Ω`` then share their output frequencies), no
+        usable line is left, two lines of one experiment produce
+        overlapping harmonics, a line is not below the Nyquist frequency,
+        an experiment has no line, or the experiments cannot separate the
+        inputs at some line (fewer experiments than inputs, or dependent
+        input phasors).
+    ControlDimension
+        If inputs, outputs, time points or frequencies have inconsistent
+        shapes (experiment counts or lengths).
+    ControlArgument
+        For a response of the wrong type.
+
+    Warns
+    -----
+    UserWarning
+        If a given frequency is off the DFT grid of the window (leakage
+        biases the response), when lines are skipped (``unusable='skip'``),
+        or when the experiments separate the inputs only poorly at some
+        line (condition number of the input phasors above 100).
+
+    Notes
+    -----
+    With ``U(Ω)`` and ``Y_n`` as in the module notes, ``G_n = Y_n/U(Ω)``.
+    For ``u = cos(Ωt)``, ``U = 1/2`` and ``G_n`` is twice the DFT
+    coefficient of the output at ``Ω + nω_p`` (thesis-errata page).  The
+    real form uses the unitary ``V`` with columns ``c_0 = e_0``, ``c_n =
+    (e_n + e_{-n})/√2``, ``s_n = j(e_n - e_{-n})/√2`` (errata items 3-4).
+    With m inputs, experiment e gives ``Y_n^{(e)} = G_n U^{(e)}`` (``G_n``
+    of size ``ny x m``, ``U^{(e)}`` the m input coefficients at Ω); the
+    experiments exciting Ω give ``G_n`` by least squares, each weighted by
+    ``1/‖U^{(e)}‖²`` (Conventions page, multi-input identification).
+
+    Examples
+    --------
+    Two unit cosines through a static gain ``1 + cos(ω_p t)``:
+
+    >>> sys = ltp.ltpss(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)),
+    ...                 lambda t: np.array([[1 + np.cos(4 * np.pi * t)]]), 0.5)
+    >>> exc = ltp.sine_experiments([1.0, 3.0], 0.5, dt=0.05, nperiods=8)
+    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
+    >>> G = ltp.lifted_frequency_response(resp, 0.5, 1, real=False)
+    >>> np.round(G.frdata[:, 0, 0].real, 6)            # G_{-1}, G_0, G_1
+    array([0.5, 1. , 0.5])
+    >>> G.output_labels[:2]
+    ['y[0]_h-1', 'y[0]_h0']
+
+    Two inputs excited jointly, two experiments per line with phases
+    ``(0, 0)`` and ``(0, π)``:
+
+    >>> D = lambda t: np.array([[1 + np.cos(4 * np.pi * t), 2.0]])
+    >>> sys2 = ltp.ltpss(np.zeros((0, 0)), np.zeros((0, 2)), np.zeros((1, 0)), D, 0.5)
+    >>> exc = ltp.sine_experiments([1.0, 3.0], 0.5, dt=0.05, nperiods=8, ninputs=2)
+    >>> exc.inputs.shape                              # (inputs, experiments, samples)
+    (2, 4, 80)
+    >>> resp = ltp.forced_response(sys2, exc.time, exc.inputs)
+    >>> G = ltp.lifted_frequency_response(resp, 0.5, 1, real=False)
+    >>> np.round(G.frdata[:, :, 0].real, 6) + 0.0     # rows G_{-1}, G_0, G_1
+    array([[0.5, 0. ],
+           [1. , 2. ],
+           [0.5, 0. ]])
+    """
+    check_kwargs(kwargs, 'lifted_frequency_response')
+    period = check_period(period)
+    t, dt, u, y, ylabels, ulabels = _parse_response(response)
+    N = steps_per_period(period, dt, 'the time step of timepts')
+    K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
+    if 2 * K + 1 > N:
+        raise ValueError(f"nharmonics={K} needs 2K+1 <= N = {N} samples per period")
+    if input_hold not in _HOLDS:
+        raise ValueError(f"input_hold must be None, 'foh' or 'zoh', got {input_hold!r}")
+    if not isinstance(real, (bool, np.bool_)):
+        raise ControlArgument(f"real must be True or False, got {real!r}")
+    hold_step = dt if hold_step is None else check_positive(hold_step, 'hold_step')
+    batch_size = check_positive_int(batch_size, 'batch_size')
+    if unusable not in ('raise', 'skip'):
+        raise ValueError(f"unusable must be 'raise' or 'skip', got {unusable!r}")
+    transient = float(real_array(transient, 'transient', ndim=0))
+    if transient < 0:
+        raise ValueError(f"transient must be >= 0, got {transient}")
+
+    tw, uw, yw = _analysis_window(t, u, y, dt, N, transient)
+    window = tw.size * dt
+    lines = _lines(uw, frequencies, window, dt, period, unusable == 'skip')
+    omega, U, Y = _line_spectra(tw, uw, yw, lines, N, K, period, batch_size, progress)
+    U = U * _hold_factor(omega, hold_step, input_hold)[:, None]
+    omega, G = _solve_lines(omega, U, Y, window)
+    return _lifted_frd(G, omega, dt, K, N, real, ylabels, ulabels, name)
+
+
+def _parse_response(response):
+    """``(t, Ts, u (nu, nexp, L), y (ny, nexp, L), output labels, input labels)``."""
+    if isinstance(response, ct.TimeResponseData):
+        t, u, y = response.time, response.u, response.y
+        if u is None:
+            raise ControlArgument("response carries no inputs; pass (timepts, inputs, "
+                                  "outputs) instead")
+        ylabels = list(response.output_labels)
+        ulabels = list(response.input_labels) if response.ninputs else None
+        if u.ndim == 2:                          # single trace
+            u, y = u[:, None, :], y[:, None, :]
+    elif isinstance(response, tuple) and len(response) == 3:
+        t, u, y = response
+        u = real_array(u, 'inputs', ndim=(1, 2, 3))
+        y = real_array(y, 'outputs', ndim=(1, 2, 3))
+        u = u.reshape((1,) * (3 - u.ndim) + u.shape)
+        y = y.reshape((1,) * (3 - y.ndim) + y.shape)
+        ylabels, ulabels = [f'y[{i}]' for i in range(y.shape[0])], None
+    else:
+        raise ControlArgument("response must be a control.TimeResponseData or a tuple "
+                              f"(timepts, inputs, outputs), got {type(response).__name__}")
+    u = real_array(u, 'inputs', ndim=3)
+    y = real_array(y, 'outputs', ndim=3)
+    if u.shape[1:] != y.shape[1:]:
+        raise ControlDimension(
+            f"inputs (experiments, samples) = {u.shape[1:]} and outputs "
+            f"{y.shape[1:]} are inconsistent: every experiment needs input and "
+            "output records of the same length")
+    t, dt, (uf, yf) = time_record(t, {'the records': u.reshape(-1, u.shape[2]),
+                                      'outputs': y.reshape(-1, y.shape[2])},
+                                  tname='timepts')
+    ulabels = ulabels or [f'u[{j}]' for j in range(u.shape[0])]
+    return t, dt, uf.reshape(u.shape), yf.reshape(y.shape), ylabels, ulabels
+
+
+def _analysis_window(t, u, y, dt, N, transient):
+    """The last P whole periods (P N samples) of every record after the transient."""
+    L = t.size
+    skip = int(np.ceil(transient / dt - 1e-9))
+    P = (L - skip) // N
+    if P < 1:
+        raise ValueError(f"the records ({L} samples) hold no whole period ({N} samples) "
+                         f"after the transient of {transient} s")
+    start = L - P * N
+    return t[start:], u[:, :, start:], y[:, :, start:]
+
+
+def _line_spectra(tw, uw, yw, lines, N, K, period, batch_size, progress):
+    """Input and output coefficients of every (experiment, line) pair.
+
+    Returns the pair's line Ω (rad/s), ``U (pairs, nu)`` with
+    ``U_j = (1/L) Σ_k u_j[k] e^{-jΩt_k}`` and ``Y (pairs, (2K+1) ny)`` with
+    ``Y_n = (1/L) Σ_k y[k] e^{-jΩt_k} e^{-jnω_p t_k}`` (harmonic-major rows);
+    the second factor of Y repeats every period (N samples).
+    """
+    wp = 2 * np.pi / period
+    harm = np.arange(-K, K + 1)
+    Eh = np.exp(-1j * wp * harm[:, None] * tw[None, :N])          # (2K+1, N)
+    ny, Lw = yw.shape[0], tw.size
+    P = Lw // N
+    exp_index = np.concatenate([np.full(Om.size, e) for e, Om in enumerate(lines)])
+    omega = np.concatenate(lines)
+    U, Y = [], []
+    for b0 in tqdm(range(0, omega.size, batch_size), desc="lifted FR", leave=False,
+                   disable=(not progress) or None):
+        Om, ex = omega[b0:b0 + batch_size], exp_index[b0:b0 + batch_size]
+        Ein = np.exp(-1j * Om[:, None] * tw[None, :])              # (b, Lw)
+        U.append(np.einsum('bk,jbk->bj', Ein, uw[:, ex]) / Lw)
+        # Σ over periods of y e^{-jΩt}, then the periodic harmonic factor
+        Z = (yw[:, ex] * Ein).reshape(ny, Om.size, P, N).sum(2)  # (ny, b, N)
+        Y.append(np.einsum('obk,hk->bho', Z, Eh).reshape(Om.size, -1) / Lw)
+    return omega, np.concatenate(U), np.concatenate(Y)
+
+
+def _solve_lines(omega, U, Y, window):
+    """Lifted response ``G (M, (2K+1) ny, nu)`` on the M distinct lines (increasing).
+
+    Each pair e gives ``Y^{(e)} = G U^{(e)}``; the pairs of one line give G by
+    least squares with weights ``1/‖U^{(e)}‖²``:  ``G Σ_e U U^H/‖U‖² =
+    Σ_e Y U^H/‖U‖²`` (for one input the mean of ``Y/U``).
+    """
+    key, inverse = np.unique(np.round(omega * window / (2 * np.pi), 6), return_inverse=True)
+    Un = U / np.linalg.norm(U, axis=1, keepdims=True)
+    Yn = Y / np.linalg.norm(U, axis=1, keepdims=True)
+    nu = U.shape[1]
+    gram = np.zeros((key.size, nu, nu), complex)
+    rhs = np.zeros((key.size, Y.shape[1], nu), complex)
+    np.add.at(gram, inverse, Un[:, :, None] * Un[:, None, :].conj())
+    np.add.at(rhs, inverse, Yn[:, :, None] * Un[:, None, :].conj())
+    eig = np.linalg.eigvalsh(gram)                                   # ascending
+    ratio = eig[:, 0] / eig[:, -1]
+    lines = key * 2 * np.pi / window
+    if np.any(ratio < _SEPARATION_RTOL):
+        bad = lines[ratio < _SEPARATION_RTOL]
+        raise ValueError(
+            f"the experiments cannot separate the {nu} inputs at the lines "
+            f"{np.round(bad[:5], 6).tolist()}{' ...' if bad.size > 5 else ''} rad/s: every "
+            f"line needs at least {nu} experiments with independent input phasors (see "
+            "sine_experiments and multisine with ninputs)")
+    poor = int(np.sum(ratio < _SEPARATION_WARN))
+    if poor:
+        warnings.warn(f"the experiments separate the inputs poorly at {poor} "
+                      f"lines (condition number of the input phasors up to "
+                      f"{np.sqrt(1 / ratio.min()):.3g}): noise is amplified there",
+                      UserWarning, stacklevel=3)
+    # G gram = rhs  <=>  gram^T G^T = rhs^T (gram Hermitian)
+    G = np.linalg.solve(gram.conj(), rhs.transpose(0, 2, 1)).transpose(0, 2, 1)
+    return lines, G
+
+
+def _lifted_frd(G, omega, dt, K, N, real, ylabels, ulabels, name):
+    """FrequencyResponseData of the lifted response G (M, (2K+1) ny, nu): real or complex."""
+    harm = np.arange(-K, K + 1)
+    ny = len(ylabels)
+    data = G.transpose(1, 2, 0)
+    if real:
+        V, tags = _real_basis(harm, N)
+        data = np.einsum('ba,bjw->ajw', np.kron(V, np.eye(ny)).conj(), data)
+        outputs = _harmonic_labels(ylabels, tags)
+        inputs = [f'{lab}_c0' for lab in ulabels]
+    else:
+        outputs = _harmonic_labels(ylabels, [f'h{n}' for n in harm])
+        inputs = [f'{lab}_h0' for lab in ulabels]
+    return ct.frd(data, omega, dt, name=name, inputs=inputs, outputs=outputs)
+
+
+def _lines(uw, frequencies, window, dt, period, skip=False):
+    """Input lines (rad/s) of every experiment, validated (unusable ones skipped)."""
+    bin_ = 2 * np.pi / window
+    nexp, Lw = uw.shape[1:]
+    if frequencies is None:
+        # a line: a bin where some input exceeds _LINE_RTOL of the experiment's peak
+        spec = np.abs(np.fft.rfft(uw, axis=-1)) / Lw
+        spec[..., 0] = 0.0                                # DC is no line
+        if Lw % 2 == 0:
+            spec[..., -1] = 0.0                           # nor is Nyquist
+        peak = spec.max(axis=(0, 2))
+        if np.any(peak == 0):
+            raise ValueError(f"the input of experiment {int(np.argmin(peak))} has no "
+                             "spectral line in the analysis window")
+        on = spec.max(axis=0) >= _LINE_RTOL * peak[:, None]
+        lines = [np.flatnonzero(row) * bin_ for row in on]
+        total = np.sum(uw ** 2, axis=(0, 2))
+        inline = 2 * Lw * np.sum(np.where(on, spec, 0.0) ** 2, axis=(0, 2))
+        if np.any(total - inline > _LEAKAGE_RTOL * total):
+            raise ValueError("an input window is not a sum of sinusoids on the DFT grid "
+                             "of the window (leakage), so its lines cannot be detected; "
+                             "choose the record length or pass frequencies=")
+    else:
+        f = real_array(frequencies, 'frequencies', ndim=(1, 2))
+        if f.shape[0] != nexp:
+            raise ControlDimension(f"frequencies has {f.shape[0]} rows for {nexp} "
+                                   "experiments")
+        f = f.reshape(nexp, -1)
+        off = np.abs(f / bin_ - np.round(f / bin_))
+        if np.any(off > 1e-6):
+            warnings.warn("some frequencies are not on the DFT grid 2π/window = "
+                          f"{bin_:.6g} rad/s of the analysis window: leakage biases "
+                          "the response", UserWarning, stacklevel=3)
+        lines = list(f)
+    half = np.pi / period                                 # ω_p / 2
+    skipped = []
+    for e, Om in enumerate(lines):
+        if np.any(Om <= 0) or np.any(Om >= np.pi / dt):
+            raise ValueError(f"frequencies of experiment {e} must lie in (0, π/Ts) = "
+                             f"(0, {np.pi / dt:.6g}) rad/s")
+        # ±Ω share output frequencies when 2Ω ≡ 0 (mod ω_p); lines l, l' when
+        # Ω_l ± Ω_l' ≡ 0 (mod ω_p).
+        dist = np.abs(Om - np.round(Om / half) * half)
+        if skip and np.any(dist < 0.49 * bin_):
+            skipped.extend(Om[dist < 0.49 * bin_])
+            Om = lines[e] = Om[dist >= 0.49 * bin_]
+        elif np.any(dist < 0.49 * bin_):
+            raise ValueError(
+                f"frequencies {np.round(Om[dist < 0.49 * bin_], 6).tolist()} rad/s of "
+                f"experiment {e} are multiples of omega_p/2 = {half:.6g} rad/s (within "
+                "one DFT bin): the responses to +Ω and -Ω fall on the same output "
+                "frequencies")
+        wp = 2 * half
+        for s in (-1, 1):
+            d = Om[:, None] + s * Om[None, :]
+            d = np.abs(d - np.round(d / wp) * wp)
+            np.fill_diagonal(d, np.inf)
+            if np.any(d < 0.49 * bin_):
+                raise ValueError(f"two lines of experiment {e} differ or sum to a "
+                                 "multiple of omega_p: their output harmonics overlap")
+    if skipped:
+        warnings.warn(f"skipped the lines {np.round(np.unique(skipped), 6).tolist()} rad/s "
+                      f"at multiples of omega_p/2 = {half:.6g} rad/s: the responses to +Ω "
+                      "and -Ω fall on the same output frequencies there",
+                      UserWarning, stacklevel=4)
+        if not any(Om.size for Om in lines):
+            raise ValueError("no usable line is left after skipping the multiples of "
+                             "omega_p/2")
+    return lines
+
+
+def _hold_factor(omega, dt, hold):
+    """Gain of the input hold at ω: 1, sinc²(ωTs/2) or sinc(ωTs/2) e^{-jωTs/2}."""
+    if hold is None:
+        return np.ones_like(omega)
+    x = np.sinc(omega * dt / (2 * np.pi))                  # np.sinc(x) = sin(πx)/(πx)
+    return x ** 2 if hold == 'foh' else x * np.exp(-0.5j * omega * dt)
