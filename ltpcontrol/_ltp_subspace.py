@@ -67,9 +67,9 @@ class LTPSubspaceInfo:
     subspace : FDSubspaceInfo
         Diagnostics of the subspace step (singular values, q, residual).
     realization : FloquetRealization
-        Result of `ltpcontrol.floquet_realization` on `lifted`: the
-        discrete-time Floquet-form system ``realization.sys``, the
-        structure distance (eq. 4.105) and the ``success`` flag.
+        Diagnostics of `ltpcontrol.floquet_realization` on `lifted`: the
+        structure distance (eq. 4.105), the similarity and the ``success``
+        flag.
     conversion : str
         Continuous-time conversion used ('refit', 'log' or 'tustin').
     relative_residual : float
@@ -369,12 +369,12 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
             continue
         lifted, sinfo = fdsubspace(Gk, order=order, q=q, estimate_d=estimate_d,
                                    return_info=True)
-        real = floquet_realization(lifted, k, N, period=period, method=method,
-                                   input_harmonics='zero', seed=seed, progress=progress,
-                                   **(options or {}))
-        if real.sys is None:
+        sysd, real = floquet_realization(lifted, k, N, period=period, method=method,
+                                         input_harmonics='zero', seed=seed, progress=progress,
+                                         return_info=True, **(options or {}))
+        if sysd is None:
             continue
-        sysc = d2c(real.sys, 'tustin' if conversion == 'tustin' else 'log', **labels)
+        sysc = d2c(sysd, 'tustin' if conversion == 'tustin' else 'log', **labels)
         with np.errstate(all='ignore'):
             miss = np.linalg.norm(_harmonic_response(sysc, G.omega, K) - Gc)
         miss = miss if np.isfinite(miss) else np.inf

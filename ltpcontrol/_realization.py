@@ -73,13 +73,10 @@ _SINGULAR_COND = 1e8
 
 @dataclass
 class FloquetRealization:
-    """Result of `floquet_realization`.
+    """Diagnostics of `floquet_realization` with ``return_info=True``.
 
     Attributes
     ----------
-    sys : LTPStateSpace or None
-        Discrete-time LTP in Floquet form (constant A), ``dt = period/N``;
-        None when no realization could be formed (see `message`).
     success : bool
         True when the corrected distance is at most `tol` and the lifted
         model of `sys` reproduces the given model within `fit_tol` (and,
@@ -112,12 +109,11 @@ class FloquetRealization:
     Examples
     --------
     >>> sysd = ltp.ltpss([[0.5]], [[1.0]], [[1.0]], 0, period=1.0, dt=0.25)
-    >>> res = floquet_realization(ltp.lift(sysd, nharmonics=1), 1, 4)
+    >>> _, res = floquet_realization(ltp.lift(sysd, nharmonics=1), 1, 4, return_info=True)
     >>> res.success, res.method, res.corrected_distance < 1e-20, res.fit_error < 1e-12
     (True, 'direct', True, True)
     """
 
-    sys: LTPStateSpace | None
     success: bool
     message: str
     distance: float
@@ -133,7 +129,7 @@ class FloquetRealization:
 def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct',
                         input_harmonics='all', distance='corrected', tol=1e-4,
                         fit_tol=0.05, ladder_tol=0.1, seed=None, progress=False, pso_options=None,
-                        minimize_options=None, name=None, **kwargs):
+                        minimize_options=None, return_info=False, name=None, **kwargs):
     """Floquet-form LTP realization of an identified lifted LTI model.
 
     Finds a real similarity T that gives the identified model the
@@ -192,18 +188,24 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
         Options of the Nelder-Mead refinement (`scipy.optimize.minimize`);
         default ``{'maxfev': 200 n^2, 'xatol': 1e-12, 'fatol': 1e-16,
         'adaptive': True}``.
+    return_info : bool, optional
+        Also return the diagnostics (default False).
     name : str, optional
         Name of the realization (default: the name of `sys` with
         '$floquet').
 
     Returns
     -------
-    FloquetRealization
-        Its ``success`` flag must be checked: a search may end in a local
-        minimum, and 'direct' flags imperfect ladders.  ``sys`` is None
-        only when no realization can be formed: repeated eigenvalues, or
-        eigenvalues that cannot be grouped into ``nstates`` conjugate-closed
-        ladders ('direct'), or a singular similarity ('pso').
+    realization : LTPStateSpace or None
+        Discrete-time LTP in Floquet form (constant A), ``dt = period/N``.
+        None only with ``return_info=True`` when no realization can be
+        formed (see ``info.message``).
+    info : FloquetRealization
+        Only with ``return_info=True``.  Its ``success`` flag tells whether
+        the structure was reached: a search may end in a local minimum,
+        and 'direct' flags imperfect ladders; a realization that misses the
+        tolerances is still returned, with a warning when `info` is not
+        requested.
 
     Raises
     ------
@@ -213,14 +215,19 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
         If the sizes of `sys` do not match `nharmonics` and `input_harmonics`.
     ValueError
         If `sys` is continuous-time, ``2K+1 > N``, `period` disagrees with
-        ``sys.dt`` or an option value is unknown.
+        ``sys.dt`` or an option value is unknown; without ``return_info``,
+        also when no realization can be formed: repeated eigenvalues, or
+        eigenvalues that cannot be grouped into ``nstates``
+        conjugate-closed ladders ('direct'), or a singular similarity
+        ('pso').
     TypeError
         For unknown keyword arguments.
 
     Warns
     -----
     UserWarning
-        'direct' with ill-conditioned eigenvectors (cond > 1e8).
+        'direct' with ill-conditioned eigenvectors (cond > 1e8); without
+        ``return_info``, a realization that misses the tolerances.
 
     Notes
     -----
@@ -237,10 +244,10 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
     >>> L = ltp.lift(sysd, nharmonics=1)
     >>> S = np.array([[1.0, 0.3, 0.0], [0.2, 2.0, 0.1], [0.0, 0.5, 1.0]])
     >>> ident = ct.similarity_transform(L, S)          # arbitrary coordinates
-    >>> res = floquet_realization(ident, 1, 8)
-    >>> res.success, round(float(res.sys.A(0)[0, 0]), 10)
+    >>> real, info = floquet_realization(ident, 1, 8, return_info=True)
+    >>> info.success, round(float(real.A(0)[0, 0]), 10)
     (True, 0.6)
-    >>> np.round(res.sys.B.sample(8)[:3, 0, 0] / res.sys.B.sample(8)[0, 0, 0], 4)
+    >>> np.round(real.B.sample(8)[:3, 0, 0] / real.B.sample(8)[0, 0, 0], 4)
     array([1.    , 0.9024, 0.6667])
     """
     check_kwargs(kwargs, 'floquet_realization')
@@ -271,8 +278,10 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
         message = ('' if np.linalg.cond(T) < _SINGULAR_COND else
                    'the search ended at a singular similarity; try another seed')
     if message:
-        return FloquetRealization(None, False, message, np.inf, {}, np.inf, np.inf, None,
-                                  method, nfev, mismatch)
+        if not return_info:
+            raise ValueError(f"no Floquet realization can be formed: {message}")
+        return None, FloquetRealization(False, message, np.inf, {}, np.inf, np.inf, None,
+                                        method, nfev, mismatch)
     d_corr = float(problem.distance(T[np.newaxis])[0][0])
     d, terms = problem.distance(T[np.newaxis], literal)
     terms = {key: float(val[0]) for key, val in terms.items()}
@@ -290,8 +299,13 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
         message = ("no Floquet structure within tolerance: " + summary
                    + ("; try another seed or more iterations" if method == 'pso' else
                       "; the model is not (close to) a lifted Floquet-form LTP"))
-    return FloquetRealization(realization, bool(success), message, float(d[0]), terms,
-                              d_corr, fit, T, method, nfev, mismatch)
+    info = FloquetRealization(bool(success), message, float(d[0]), terms, d_corr, fit, T,
+                              method, nfev, mismatch)
+    if return_info:
+        return realization, info
+    if not success:
+        warnings.warn(message, UserWarning, stacklevel=2)
+    return realization
 
 
 #

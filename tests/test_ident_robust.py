@@ -64,7 +64,7 @@ def test_periodic_a_plant_returns_model_and_error_decays_with_k():
     for K in (1, 2, 3):
         model, info = _identify(plant, K)
         assert model.nstates == 2 and model.is_floquet_form
-        assert info.realization.sys is not None
+        assert info.realization.transform is not None
         errors.append(ltp.compare_ltp(model, plant, UNSEEN).htf_error)
     assert errors[0] > 10 * errors[1] > 100 * errors[2] and errors[2] < 1e-3
 

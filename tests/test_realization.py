@@ -91,17 +91,17 @@ class TestDirect:
     def test_mathieu_all_inputs(self, mathieu_dt):
         sysc, sysd = mathieu_dt
         ident = _scramble(lift(sysd, nharmonics=1), 0)
-        res = floquet_realization(ident, 1, 50)
+        sys_res, res = floquet_realization(ident, 1, 50, return_info=True)
         assert isinstance(res, FloquetRealization)
         assert res.success and res.corrected_distance < 1e-18 and res.ladder_mismatch < 1e-9
-        assert res.sys.is_floquet_form and res.sys.nsteps == 50
-        assert np.isclose(res.sys.dt, sysd.dt) and np.isclose(res.sys.period, sysd.period)
+        assert sys_res.is_floquet_form and sys_res.nsteps == 50
+        assert np.isclose(sys_res.dt, sysd.dt) and np.isclose(sys_res.period, sysd.period)
         # exact DT-HTF of the realization equals the truth (D has harmonics ±2)
-        assert _htf_error(res.sys, sysd, 1) < 1e-8
-        np.testing.assert_allclose(np.sort_complex(np.linalg.eigvals(res.sys.A(0))),
+        assert _htf_error(sys_res, sysd, 1) < 1e-8
+        np.testing.assert_allclose(np.sort_complex(np.linalg.eigvals(sys_res.A(0))),
                                    np.sort_complex(np.linalg.eigvals(sysd.A(0))), atol=1e-12)
         # T^{-1} Â T is the real lifted model of the realization itself
-        T, Lr = res.transform, lift(res.sys, nharmonics=1)
+        T, Lr = res.transform, lift(sys_res, nharmonics=1)
         np.testing.assert_allclose(np.linalg.solve(T, ident.A @ T), Lr.A, atol=1e-10)
         np.testing.assert_allclose(np.linalg.solve(T, ident.B), Lr.B, atol=1e-10)
         np.testing.assert_allclose(ident.C @ T, Lr.C, atol=1e-10)
@@ -109,8 +109,9 @@ class TestDirect:
     def test_mathieu_thesis_comparison(self, mathieu_dt):
         # thesis 4.122-4.125: inverse Tustin, canonical form, normalised errors
         sysc, sysd = mathieu_dt
-        res = floquet_realization(_scramble(lift(sysd, nharmonics=1), 1), 1, 50)
-        can = to_canonical(ltp.d2c(res.sys, 'tustin'))
+        sys_res, res = floquet_realization(_scramble(lift(sysd, nharmonics=1), 1), 1, 50,
+                                           return_info=True)
+        can = to_canonical(ltp.d2c(sys_res, 'tustin'))
         np.testing.assert_allclose(can.A(0), [[0, 1], [-4 * np.pi ** 2, -1.2 * np.pi]],
                                    atol=1e-9)
         err = matrix_errors(can, sysc)
@@ -121,12 +122,12 @@ class TestDirect:
         # the thesis identifies only the U_0 column (B̄, D̄ of 4.78-4.79)
         sysc, sysd = mathieu_dt
         ident = _scramble(lift(sysd, nharmonics=1), 2)[:, :1]
-        res = floquet_realization(ident, 1, 50, input_harmonics='zero')
+        sys_res, res = floquet_realization(ident, 1, 50, input_harmonics='zero', return_info=True)
         assert res.success and res.terms['B'] < 1e-20
-        lifted = lift(res.sys, nharmonics=1)[:, :1]
+        lifted = lift(sys_res, nharmonics=1)[:, :1]
         np.testing.assert_allclose(_response(lifted, Z), _response(ident, Z), atol=1e-10)
         # B and C have one harmonic and are recovered; D_{±2} is not in the U_0 column
-        can, ref = to_canonical(res.sys), to_canonical(sysd)
+        can, ref = to_canonical(sys_res), to_canonical(sysd)
         err = matrix_errors(can, ref)
         assert max(err.A, err.B, err.C) < 1e-9 and 1e-3 < err.D < 0.1
 
@@ -139,9 +140,9 @@ class TestDirect:
         G = G + 1e-6 * np.abs(G).max() * (rng.standard_normal(G.shape)
                                           + 1j * rng.standard_normal(G.shape))
         ident = ltp.fdsubspace(G, omega, 6, dt=sysd.dt, q=20)
-        res = floquet_realization(ident, 1, 50, input_harmonics='zero')
+        sys_res, res = floquet_realization(ident, 1, 50, input_harmonics='zero', return_info=True)
         assert res.success and res.fit_error < 1e-3
-        err = matrix_errors(to_canonical(ltp.d2c(res.sys, 'tustin')), sysc)
+        err = matrix_errors(to_canonical(ltp.d2c(sys_res, 'tustin')), sysc)
         assert max(err.A, err.B, err.C) < 1e-3
 
     @pytest.mark.parametrize('input_harmonics', ['all', 'zero'])
@@ -156,15 +157,16 @@ class TestDirect:
             ident = _scramble(lift(truth, nharmonics=K), seed)
             if input_harmonics == 'zero':
                 ident = ident[:, :m]
-            res = floquet_realization(ident, K, N, input_harmonics=input_harmonics)
-            if not res.success or _htf_error(res.sys, truth, K) > 1e-8:
+            sys_res, res = floquet_realization(ident, K, N, input_harmonics=input_harmonics,
+                                               return_info=True)
+            if not res.success or _htf_error(sys_res, truth, K) > 1e-8:
                 failures.append((seed, nx, K, N, res.message))
         assert not failures
 
     def test_literal_distance(self, mathieu_dt):
         _, sysd = mathieu_dt
         ident = _scramble(lift(sysd, nharmonics=1), 3)
-        res = floquet_realization(ident, 1, 50, distance='literal')
+        sys_res, res = floquet_realization(ident, 1, 50, distance='literal', return_info=True)
         assert set(res.terms) == {'A', 'B', 'C'}
         assert np.isclose(res.distance, sum(res.terms.values()))
         # the printed demodulation e^{-j2kπ/N} leaves Im Ā ≠ 0 at the true structure
@@ -183,22 +185,35 @@ class TestDirect:
         rng = np.random.default_rng(3)
         bad = ct.ss(0.3 * rng.standard_normal((6, 6)), rng.standard_normal((6, 3)),
                     rng.standard_normal((3, 6)), 0, 0.1)
-        res = floquet_realization(bad, 1, 12)
+        sys_res, res = floquet_realization(bad, 1, 12, return_info=True)
         assert not res.success and 'ladder' in res.message
         assert res.ladder_mismatch > 0.1
 
     def test_repeated_eigenvalues_are_flagged(self):
         sysd = ltp.ltpss(0.5 * np.eye(2), [[1.0], [2.0]], [[1.0, 1.0]], 0, period=1.0, dt=0.25)
-        res = floquet_realization(lift(sysd, nharmonics=1), 1, 4)
-        assert not res.success and res.sys is None and 'repeated' in res.message
+        sys_res, res = floquet_realization(lift(sysd, nharmonics=1), 1, 4, return_info=True)
+        assert not res.success and sys_res is None and 'repeated' in res.message
+        with pytest.raises(ValueError, match="no Floquet realization can be formed"):
+            floquet_realization(lift(sysd, nharmonics=1), 1, 4)
+
+    def test_without_info_returns_the_model_or_warns(self):
+        rng = np.random.default_rng(3)
+        bad = ct.ss(0.3 * rng.standard_normal((6, 6)), rng.standard_normal((6, 3)),
+                    rng.standard_normal((3, 6)), 0, 0.1)
+        with pytest.warns(UserWarning, match="ladder"):
+            model = floquet_realization(bad, 1, 12)
+        assert isinstance(model, ltp.LTPStateSpace)
+        sysd = ltp.ltpss([[0.5]], [[1.0]], [[1.0]], 0, period=1.0, dt=0.25)
+        model = floquet_realization(lift(sysd, nharmonics=1), 1, 4)
+        assert model.is_floquet_form and np.isclose(model.A(0)[0, 0], 0.5)
 
     def test_structure_violation_is_flagged(self, mathieu_dt):
         # right ladders, but an output map that is not block Toeplitz
         _, sysd = mathieu_dt
         L = lift(sysd, nharmonics=1)
         C = L.C + 0.3 * np.random.default_rng(4).standard_normal(L.C.shape)
-        res = floquet_realization(ct.ss(L.A, L.B, C, L.D, L.dt), 1, 50)
-        assert not res.success and res.sys is not None
+        sys_res, res = floquet_realization(ct.ss(L.A, L.B, C, L.D, L.dt), 1, 50, return_info=True)
+        assert not res.success and sys_res is not None
         assert res.corrected_distance > 1e-3 and 'no Floquet structure' in res.message
 
 
@@ -215,12 +230,12 @@ class TestPSO:
         outcomes = []
         for seed in range(3):
             truth, ident = _small_case(seed)
-            res = floquet_realization(ident, 1, 12, method='pso', seed=seed, progress=False,
+            sys_res, res = floquet_realization(ident, 1, 12, method='pso', seed=seed, progress=False,
                                       tol=1e-10, pso_options={'iters': 300},
-                                      minimize_options={'maxfev': 3000})
+                                      minimize_options={'maxfev': 3000}, return_info=True)
             assert res.method == 'pso' and res.nfev > 0
             if res.success:                 # a certified result recovers the true HTF
-                assert _htf_error(res.sys, truth, 1) < 1e-4
+                assert _htf_error(sys_res, truth, 1) < 1e-4
             else:
                 assert res.corrected_distance > 1e-10
             outcomes.append(res.success)
@@ -234,8 +249,8 @@ class TestPSO:
         state = np.random.get_state()[1].copy()
         opts = dict(method='pso', seed=5, progress=False, pso_options={'iters': 10},
                     minimize_options={'maxfev': 50})
-        r1 = floquet_realization(ident, 1, 12, **opts)
-        r2 = floquet_realization(ident, 1, 12, **opts)
+        sys_r1, r1 = floquet_realization(ident, 1, 12, **opts, return_info=True)
+        sys_r2, r2 = floquet_realization(ident, 1, 12, **opts, return_info=True)
         assert r1.corrected_distance == r2.corrected_distance
         np.testing.assert_array_equal(np.random.get_state()[1], state)
 
@@ -283,9 +298,9 @@ class TestInputs:
             floquet_realization(ct.ss(ident.A, ident.B, ident.C, ident.D, True), 1, 4)
 
     def test_timebase_true_with_period(self, ident):
-        res = floquet_realization(ct.ss(ident.A, ident.B, ident.C, ident.D, True), 1, 4,
-                                  period=2.0)
-        assert res.success and res.sys.period == 2.0 and res.sys.dt == 0.5
+        sys_res, res = floquet_realization(ct.ss(ident.A, ident.B, ident.C, ident.D, True), 1, 4,
+                                  period=2.0, return_info=True)
+        assert res.success and sys_res.period == 2.0 and sys_res.dt == 0.5
 
 
 class TestCanonical:
