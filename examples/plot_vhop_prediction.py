@@ -43,6 +43,8 @@ hopping limit cycle, ``y = h − h_lc``.
    harmonics whose estimate stands out from its (calibrated) standard
    deviation; the reduced estimate is then smoothed by GCV and by a strong
    curvature weight (α = 10) that the low-frequency components tolerate.
+   Four draws give 24 ± 3 % before, 15 ± 2 % (GCV) and 11 ± 1 % (α = 10)
+   after.
 
 Set ``LTP_EXAMPLES_QUICK=1`` for a reduced run (shorter chirps, fewer
 sines, fewer harmonic counts).
