@@ -38,8 +38,8 @@ hopping limit cycle, ``y = h − h_lc``.
    draws: the noise-free data give E_rms = 0.6 % at 1 Hz, so the 20 % at
    SNR 12.5 is variance, mostly from output noise (input noise alone gives
    3 %).  Each of the 2K+1 components adds its own estimation variance to
-   the prediction, while the VHOP's components beyond about |k| = 4 are
-   smaller than their standard deviation.  `significant_harmonics` keeps the
+   the prediction, while the VHOP's components beyond about ``|k| = 4`` are
+   smaller than their standard deviation.  ``significant_harmonics`` keeps the
    harmonics whose estimate stands out from its (calibrated) standard
    deviation; the reduced estimate is then smoothed by GCV and by a strong
    curvature weight (α = 10) that the low-frequency components tolerate.
