@@ -54,7 +54,7 @@ def grid_sup(sys, K, npoints, chunk=20000):
     """
     H = ltp.htf(sys, K)
     w = np.linspace(0, sys.omega_p / 2, npoints)
-    return max(float(np.linalg.norm(H(1j * w[i:i + chunk]), ord=2, axis=(1, 2)).max())
+    return max(float(np.linalg.norm(H(1j * w[i:i + chunk]), ord=2, axis=(0, 1)).max())
                for i in range(0, npoints, chunk))
 
 

@@ -168,7 +168,7 @@ def _case(kind, n, K, npoints, method, stride, rss=True):
         err = np.abs(comps - refc).max() / np.abs(refc).max()
         del G
     else:
-        got = value[np.searchsorted(pts, omega[check]).clip(0, len(pts) - 1)]
+        got = value[..., np.searchsorted(pts, omega[check]).clip(0, len(pts) - 1)]
         want = ref(1j * pts[np.searchsorted(pts, omega[check]).clip(0, len(pts) - 1)])
         err = np.abs(got - want).max() / np.abs(want).max()
     if kind == 'htf':

@@ -67,7 +67,7 @@ print("zeros:", np.round(ltp.zeros(sys), 4))
 
 H = ltp.htf(sys, 3)
 w = np.linspace(0, wp / 2, 600)
-sigma = np.linalg.norm(H(1j * w), ord=2, axis=(1, 2))
+sigma = np.linalg.norm(H(1j * w), ord=2, axis=(0, 1))
 
 fig, axes = plt.subplots(3, 1, figsize=(7, 8.5), constrained_layout=True)
 ax = axes[0]

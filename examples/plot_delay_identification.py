@@ -95,7 +95,7 @@ def magnitude_fit(estimates, switching):
     """Fit k, c to the mean magnitude of all estimates (delays do not change it, 3.46)."""
     omega = estimates[0][1].omega
     mags = np.mean([np.abs(H.components()[1]) for _, H in estimates], axis=0)
-    return fit_parameters(ltp.HTF(mags, omega, PERIOD), switching, magnitude_only=True)
+    return fit_parameters(ltp.HTFData(mags, omega, PERIOD), switching, magnitude_only=True)
 
 
 def estimate_all_delays(estimates, reference):

@@ -91,9 +91,11 @@ def steady_state(fs, duration=10.0, tcycle=5.0):
 
 data100 = steady_state(100.0)
 data1k = steady_state(1000.0)
-res1 = ltp.hybrid_ls(*data100, T, [0, T / 2], nharmonics=1, nconv=20, nshifts=2)
-res0 = ltp.hybrid_ls(*data100, T, [0, T / 2], nharmonics=0, nconv=20, nshifts=2)
-res1k = ltp.hybrid_ls(*data1k, T, [0, T / 2], nharmonics=1)
+_, res1 = ltp.hybrid_ls(*data100, T, [0, T / 2], nharmonics=1, nconv=20, nshifts=2,
+                        return_info=True)
+_, res0 = ltp.hybrid_ls(*data100, T, [0, T / 2], nharmonics=0, nconv=20, nshifts=2,
+                        return_info=True)
+_, res1k = ltp.hybrid_ls(*data1k, T, [0, T / 2], nharmonics=1, return_info=True)
 
 # truth (eq. 4.26) and the thesis's estimates (eq. 4.28): A^i_0, A^i_1
 truth = {(i, k): (np.array([[0, 1], [-wn**2, -2 * zeta[i] * wn]]) if k == 0

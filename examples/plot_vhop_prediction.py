@@ -116,20 +116,20 @@ def add_noise(exc, y, snr, rng):
     return noisy(exc.inputs), noisy(y)
 
 
-def identify(exc, y, ncomponents, f1, u=None, alpha=ALPHA):
+def identify(exc, y, ncomponents, f1, u=None, alpha=ALPHA, return_info=False):
     """Regularised HTF estimate (3.35) with ``2K+1 = ncomponents`` components.
 
     Output frequencies up to `WMAX`, and up to ``K ω_p + 2π f1`` beyond
     which no shifted input of the ``0-f1`` Hz chirp is excited; each ``G_k``
     is fitted where ``U(ω − kω_p)`` is excited and filled by the curvature
-    penalty elsewhere (``H.diagnostics['identified']``).
+    penalty elsewhere (``info.identified`` with ``return_info=True``).
     """
     K = (ncomponents - 1) // 2
     wmax = min(WMAX, K * 2 * np.pi / PERIOD + 2 * np.pi * f1)
     u = exc.inputs if u is None else u
     return ltp.estimate_htf((exc.time, u, y), PERIOD, K, segments=exc.segments,
-                            alpha=alpha, omega_limits=(0.0, wmax), progress=False,
-                            name=f'{ncomponents} HTFs')
+                            alpha=alpha, omega_limits=(0.0, wmax),
+                            return_info=return_info, name=f'{ncomponents} HTFs')
 
 
 def significant_harmonics(H):
@@ -182,7 +182,7 @@ def prediction_errors(H, t, u, y):
     """
     with warnings.catch_warnings():
         warnings.filterwarnings('ignore', message='the input excites HTF components')
-        return np.array([ltp.e_rms(yi, H.predict(ui, t)) for ui, yi in zip(u, y)])
+        return np.array([ltp.e_rms(yi, H.predict(t, ui)) for ui, yi in zip(u, y)])
 
 
 def run(quick=QUICK, n_jobs=2, seed=2017):
@@ -218,8 +218,8 @@ def run(quick=QUICK, n_jobs=2, seed=2017):
     one_hz = np.argmin(np.abs(out['sine_frequencies'] - 1.0))
     out['sine_errors'] = errors[bands[0], nbest]
     out['erms_1hz'] = float(out['sine_errors'][one_hz])
-    out['one_hz'] = (t_sine, y_sine[one_hz], best.predict(u_sine[one_hz], t_sine))
-    y_step_hat = best.predict(u_step, t_step)
+    out['one_hz'] = (t_sine, y_sine[one_hz], best.predict(t_sine, u_sine[one_hz]))
+    y_step_hat = best.predict(t_step, u_step)
     out['erms_step'] = ltp.e_rms(y_step, y_step_hat)
     out['step'] = (t_step, y_step, y_step_hat)
 
@@ -230,10 +230,11 @@ def run(quick=QUICK, n_jobs=2, seed=2017):
     out['noise_frequencies'] = out['sine_frequencies'][low]
     out['noise_errors'] = {}
     for alpha in (ALPHA, 'gcv'):
-        H_noisy = identify(exc, y_noisy, nbest, bands[0], u=u_noisy, alpha=alpha)
+        H_noisy, info = identify(exc, y_noisy, nbest, bands[0], u=u_noisy, alpha=alpha,
+                                 return_info=True)
         out['noise_errors'][alpha] = prediction_errors(H_noisy, t_sine, u_sine[low],
                                                        y_sine[low])
-    out['gcv_alpha'] = H_noisy.diagnostics['alpha']
+    out['gcv_alpha'] = info.alpha
     out['noise_components'] = nbest
     out['noise_study'] = noise_study(exc, y, nbest, bands[0], t_sine, u_sine[one_hz],
                                      y_sine[one_hz], 2 if quick else NDRAWS, seed)

@@ -60,9 +60,9 @@ def random_ltp(seed, nstates=2, noutputs=1, harmonics=2, period=1.0, depth=0.3,
 def lifted_data(sys, nharmonics, omega, dt):
     """Exact real lifted response (as `lifted_frequency_response` returns) on `omega`."""
     K, ny = nharmonics, sys.noutputs
-    G = ltp.htf(sys, K)(1j * np.asarray(omega))[:, :, K]            # (M, (2K+1) ny)
+    G = ltp.htf(sys, K)(1j * np.asarray(omega))[:, K]               # ((2K+1) ny, M)
     V, _ = _real_basis(np.arange(-K, K + 1), int(round(sys.period / dt)))
-    Gr = np.kron(V, np.eye(ny)).conj().T @ G.T
+    Gr = np.kron(V, np.eye(ny)).conj().T @ G
     return ct.frd(Gr[:, None, :], omega, dt)
 
 

@@ -15,7 +15,7 @@ from ._interconnect import interconnect
 from ._timeresp import forced_response, step_response, initial_response, impulse_response
 from ._floquet import (monodromy, floquet_multipliers, floquet_exponents, is_stable,
                        floquet_transform)
-from ._htf import HTF, htf
+from ._htf import HTF, HTFModel, HTFData, htf
 from ._htfplot import htf_response, bode_htf, htf_map_plot
 from ._discretize import sample_system, d2c
 from ._lifting import lift
@@ -24,7 +24,7 @@ from ._orbits import PeriodicOrbit, periodic_orbit, period_map, linearize_orbit
 from ._autonomous import limit_cycle, poincare_map
 from ._continuation import Bifurcation, OrbitBranch, orbit_continuation
 from ._excitation import Excitation, chirp_replicas, multisine, sine_experiments
-from ._htf_estimate import estimate_htf
+from ._htf_estimate import estimate_htf, HTFEstimateInfo
 from ._htf_fit import HTFFit, DelayEstimate, fit_htf, estimate_delays
 from ._metrics import e_rms, nrmse
 from ._fdsubspace import fdsubspace, FDSubspaceInfo
@@ -64,7 +64,7 @@ __all__ = [
     'monodromy', 'floquet_multipliers', 'floquet_exponents', 'is_stable',
     'floquet_transform',
     # frequency domain
-    'HTF', 'htf', 'htf_response', 'bode_htf', 'htf_map_plot',
+    'HTF', 'HTFModel', 'HTFData', 'htf', 'htf_response', 'bode_htf', 'htf_map_plot',
     'sample_system', 'c2d', 'd2c', 'lift',
     # rhythmic plants and their orbits
     'HybridMode', 'HybridPlant', 'simulate_hybrid', 'saltation_matrix',
@@ -72,7 +72,7 @@ __all__ = [
     'limit_cycle', 'poincare_map', 'Bifurcation', 'OrbitBranch', 'orbit_continuation',
     # identification
     'Excitation', 'chirp_replicas', 'multisine', 'sine_experiments',
-    'estimate_htf', 'HTFFit', 'DelayEstimate', 'fit_htf', 'estimate_delays',
+    'estimate_htf', 'HTFEstimateInfo', 'HTFFit', 'DelayEstimate', 'fit_htf', 'estimate_delays',
     'e_rms', 'nrmse',
     'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',

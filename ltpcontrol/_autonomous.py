@@ -26,9 +26,9 @@ import numpy as np
 from control.exception import ControlArgument, ControlDimension
 from scipy.optimize import brentq
 
-from ._hybrid import _central_jacobian, _constant_input, _Flow, _params, _solver_options
+from ._hybrid import _central_jacobian, _constant_input, _Flow, _params, _solver_settings
 from ._orbits import PeriodicOrbit, _as_hybrid, _time_mismatch
-from ._validation import check_kwargs, check_period, check_positive_int, real_array
+from ._validation import check_period, check_positive, check_positive_int, real_array
 
 __all__ = ['limit_cycle', 'poincare_map']
 
@@ -139,7 +139,8 @@ class _Problem:
 
 
 def poincare_map(plant, x0, section=None, mode0=0, *, direction=1, max_time=None, u0=None,
-                 params=None, jacobian=False, **kwargs):
+                 params=None, jacobian=False, rtol=1e-10, atol=1e-12, method='DOP853',
+                 max_events=10000):
     """Poincaré (return) map of an autonomous (hybrid) plant.
 
     Integrates from `x0` until the trajectory next crosses the section
@@ -201,12 +202,11 @@ def poincare_map(plant, x0, section=None, mode0=0, *, direction=1, max_time=None
     >>> bool(np.isclose(t1, 2 * np.pi)), bool(np.allclose(J, [[1, 0], [0, 0]], atol=1e-6))
     (True, True)
     """
-    opts = _solver_options(kwargs, 'poincare_map')
-    check_kwargs(kwargs, 'poincare_map')
+    opts = _solver_settings('poincare_map', rtol, atol, method, max_events)
     if not isinstance(jacobian, (bool, np.bool_)):
         raise ControlArgument(f"jacobian must be True or False, got {jacobian!r}")
     hp, x0, mode0, u0, params = _prepare(plant, x0, mode0, u0, params, None)
-    max_time = 1000.0 if max_time is None else check_period(max_time, 'max_time')
+    max_time = 1000.0 if max_time is None else check_positive(max_time, 'max_time')
     sec = _section(hp, section, direction, mode0, x0, u0, params)
     prob = _Problem(hp, u0, params, opts, None)
     t_cross = prob.first_crossing(x0, mode0, sec, max_time)
@@ -243,7 +243,8 @@ def _prepare(plant, x0, mode0, u0, params, jacobian):
 
 def limit_cycle(plant, period, x0, mode0=0, *, section=None, direction=1, u0=None,
                 params=None, jacobian=None, tol=1e-10, max_iter=20, max_periods=200,
-                timeout=None, npoints=200, **kwargs):
+                timeout=None, npoints=200, rtol=1e-10, atol=1e-12, method='DOP853',
+                max_events=10000):
     """Periodic orbit of an autonomous plant, with its period as an unknown.
 
     Single shooting with a Poincaré-section phase condition: Newton's
@@ -340,8 +341,7 @@ def limit_cycle(plant, period, x0, mode0=0, *, section=None, direction=1, u0=Non
     >>> bool(abs(orbit.phase_multiplier - 1) < 1e-8), bool(orbit.stability_multipliers[0] < 1e-3)
     (True, True)
     """
-    opts = _solver_options(kwargs, 'limit_cycle')
-    check_kwargs(kwargs, 'limit_cycle')
+    opts = _solver_settings('limit_cycle', rtol, atol, method, max_events)
     hp, x0, mode0, u0, params = _prepare(plant, x0, mode0, u0, params, jacobian)
     if period is not None:
         period = check_period(period)
@@ -351,7 +351,7 @@ def limit_cycle(plant, period, x0, mode0=0, *, section=None, direction=1, u0=Non
     max_periods = check_positive_int(max_periods, 'max_periods', minimum=0)
     npoints = check_positive_int(npoints, 'npoints', minimum=2)
     if timeout is not None:
-        timeout = check_period(timeout, 'timeout')
+        timeout = check_positive(timeout, 'timeout')
     deadline = None if timeout is None else time.monotonic() + timeout
     sec = _section(hp, section, direction, mode0, x0, u0, params)
     prob = _Problem(hp, u0, params, opts, deadline)

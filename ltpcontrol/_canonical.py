@@ -26,8 +26,10 @@ import numpy as np
 from control.exception import ControlArgument, ControlDimension
 from scipy.optimize import linear_sum_assignment
 
-from ._ltpsys import LTPStateSpace, ltpss
-from ._validation import check_kwargs, check_positive_int, real_array
+from ._ltpsys import ltpss
+from ._floquet import floquet_exponents
+from ._htf import htf
+from ._validation import as_ltp, check_kwargs, check_positive_int, real_array
 
 __all__ = ['to_canonical', 'matrix_errors', 'MatrixErrors', 'compare_ltp', 'LTPComparison']
 
@@ -87,8 +89,7 @@ def to_canonical(sys, input=0, name=None, **kwargs):
            [1.]])
     """
     check_kwargs(kwargs, 'to_canonical')
-    if not isinstance(sys, LTPStateSpace):
-        raise ControlArgument(f"sys must be an LTPStateSpace, got {type(sys).__name__}")
+    sys = as_ltp(sys)
     if not sys.is_floquet_form:
         raise ValueError("sys must be in Floquet form (constant A); apply "
                          "ltpcontrol.floquet_transform first")
@@ -178,7 +179,7 @@ def matrix_errors(est, true, nsamples=512, **kwargs):
     >>> B = ltp.PeriodicMatrix([[[0.4]], [[1.0]], [[0.4]]], 1.0)
     >>> true = ltp.ltpss([[-2.0]], B, [[1.0]], 0, period=1.0)
     >>> est = ltp.ltpss([[-2.2]], B, [[1.0]], 0, period=1.0)
-    >>> err = matrix_errors(est, true)
+    >>> err = ltp.matrix_errors(est, true)
     >>> round(err.A, 6), err.B, err.C
     (0.1, 0.0, 0.0)
     """
@@ -290,16 +291,14 @@ def compare_ltp(est, true, omega, nharmonics=1, **kwargs):
     """
     check_kwargs(kwargs, 'compare_ltp')
     _check_pair(est, true)
-    from ._floquet import floquet_exponents
-    from ._htf import htf
     omega = real_array(omega, 'omega', ndim=(0, 1)).ravel()
     if omega.size == 0:
         raise ValueError("omega must hold at least one frequency")
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
     s = np.exp(1j * omega * true.dt) if true.isdtime(strict=True) else 1j * omega
     Ht, He = htf(true, K)(s), htf(est, K)(s)
-    scale = max(np.linalg.norm(Ht, axis=(1, 2)).max(), np.finfo(float).tiny)
-    htf_error = float(np.linalg.norm(He - Ht, axis=(1, 2)).max() / scale)
+    scale = max(np.linalg.norm(Ht, axis=(0, 1)).max(), np.finfo(float).tiny)
+    htf_error = float(np.linalg.norm(He - Ht, axis=(0, 1)).max() / scale)
     lt, le = floquet_exponents(true), floquet_exponents(est)
     if true.isdtime(strict=True):
         # per-step exponents ρ are defined up to e^{j2πk/N}
@@ -318,9 +317,7 @@ def compare_ltp(est, true, omega, nharmonics=1, **kwargs):
 
 def _check_pair(est, true):
     """Both LTPStateSpace of equal sizes, periods and timebases."""
-    for label, s in (('est', est), ('true', true)):
-        if not isinstance(s, LTPStateSpace):
-            raise ControlArgument(f"{label} must be an LTPStateSpace, got {type(s).__name__}")
+    est, true = as_ltp(est, 'est'), as_ltp(true, 'true')
     if (est.nstates, est.ninputs, est.noutputs) != (true.nstates, true.ninputs, true.noutputs):
         raise ControlDimension(
             f"est has (states, inputs, outputs) = {(est.nstates, est.ninputs, est.noutputs)} "

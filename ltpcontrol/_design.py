@@ -21,7 +21,7 @@ from control.exception import ControlArgument, ControlDimension
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix, as_periodic
 from ._riccati import _check_weights, care, dare
-from ._validation import real_array
+from ._validation import as_ltp, real_array
 
 __all__ = ['lqr', 'dlqr', 'lqe', 'dlqe', 'lqg']
 
@@ -109,7 +109,7 @@ def dlqr(sys, Q, R, N=None):
     >>> K(0.0).shape, K(1.0).shape, bool(np.all(np.abs(E) < 1))
     ((1, 2), (1, 2), True)
     """
-    _check_ltp(sys, 'sys')
+    sys = as_ltp(sys)
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqr: sys must be a discrete-time system (use lqr)")
     steps = sys.nsteps
@@ -205,7 +205,7 @@ def dlqe(sys, QN, RN, NN=None):
     >>> L(0.0).shape, bool(np.all(np.abs(E) < 1))
     ((2, 1), True)
     """
-    _check_ltp(sys, 'sys')
+    sys = as_ltp(sys)
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqe: sys must be a discrete-time system (use lqe)")
     steps = sys.nsteps
@@ -265,7 +265,7 @@ def lqg(sys, Q, R, QN, RN, name=None):
     >>> loop.nstates, ltp.is_stable(loop)
     (4, True)
     """
-    _check_ltp(sys, 'sys')
+    sys = as_ltp(sys)
     K, _, _ = lqr(sys, Q, R)
     L, _, _ = lqe(sys, QN, RN)
     A = sys.A - sys.B @ K - L @ sys.C + L @ sys.D @ K
@@ -280,17 +280,12 @@ def lqg(sys, Q, R, QN, RN, name=None):
 
 def _discrete(sys, nsteps):
     """True for a discrete-time plant (which takes no nsteps)."""
-    _check_ltp(sys, 'sys')
+    sys = as_ltp(sys)
     if sys.isdtime(strict=True):
         if nsteps is not None:
             raise ControlArgument("nsteps applies to continuous-time systems only")
         return True
     return False
-
-
-def _check_ltp(sys, name):
-    if not isinstance(sys, LTPStateSpace):
-        raise ControlArgument(f"{name} must be an LTPStateSpace, got {type(sys).__name__}")
 
 
 def _steps(M, sys, name):

@@ -22,15 +22,15 @@ def describe(M, nsteps=None):
         return "constant"
     if nsteps is not None:
         return f"sequence of {nsteps} matrices per period"
-    if M._coeffs is not None:
+    if M.nharmonics is not None:
         return f"Fourier series, K = {M.nharmonics}"
-    if M._pieces is not None:
-        times = np.round(M._times, 6).tolist()
+    if M.switching_times is not None:
+        times = np.round(M.switching_times, 6).tolist()
         if len(times) > MAX_TIMES:
             shown = ", ".join(f"{x:g}" for x in times[:3]) + f", ..., {times[-1]:g}"
             return f"switching, {len(times)} pieces at [{shown}]"
         return f"switching at {times}"
-    return "smooth function of t" if M._func is not None else "combination"
+    return "smooth function of t" if M.is_function else "combination"
 
 
 def text(sys):

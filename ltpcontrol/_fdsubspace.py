@@ -51,14 +51,20 @@ class FDSubspaceInfo:
     timescale : float or None
         Time scale ``T`` of the bilinear frequency map for continuous-time data,
         ``None`` for discrete-time data.
+    success : bool
+        True when the fit residual is finite (the method is non-iterative).
+    message : str
+        Description of the outcome.
+    nfev : int
+        Number of model evaluations of an iterative search: 0.
 
     Examples
     --------
     >>> sys = ct.ss([[0.5]], [[1.]], [[1.]], [[0.]], True)
     >>> data = ct.frd(sys, np.linspace(0.1, 3, 20))
     >>> model, info = fdsubspace(data, order=1, return_info=True)
-    >>> info.order, info.q, info.relative_residual < 1e-12
-    (1, 2, True)
+    >>> info.order, info.q, info.relative_residual < 1e-12, info.success
+    (1, 2, True, True)
     """
 
     order: int
@@ -67,6 +73,9 @@ class FDSubspaceInfo:
     residual: float
     relative_residual: float
     timescale: float | None
+    success: bool = True
+    message: str = ''
+    nfev: int = 0
 
 
 def fdsubspace(data, omega=None, order=None, *, q=None, dt=None, weights=None,
@@ -283,10 +292,12 @@ def fdsubspace(data, omega=None, order=None, *, q=None, dt=None, weights=None,
     # Weighted residual of the fitted model on the data.
     err = w * (_eval_ss(A, B, C, D, zfit) - G)
     residual = float(np.linalg.norm(err))
-    info = FDSubspaceInfo(order=order, q=q, singular_values=sv,
-                          residual=residual,
-                          relative_residual=residual / float(np.linalg.norm(w * G)),
-                          timescale=T)
+    relative = residual / float(np.linalg.norm(w * G))
+    info = FDSubspaceInfo(order=order, q=q, singular_values=sv, residual=residual,
+                          relative_residual=relative, timescale=T,
+                          success=bool(np.isfinite(residual)),
+                          message=f"order-{order} model from {q} block rows, relative "
+                                  f"residual {relative:.3g}")
     return sys, info
 
 

@@ -1,21 +1,34 @@
-"""Harmonic state space of a continuous-time LTP system as a `control.StateSpace`.
+"""Harmonic state space of an LTP system: construction, evaluation, real form.
 
-The truncated HTF (Conventions page) is ``H(s) = 𝒞 [sI − (𝒜 − 𝒩)]⁻¹ ℬ + 𝒟``
-with complex Toeplitz matrices.  In the real basis of the lifting module
-(columns ``c_0 = e_0``, ``c_n = (e_n + e_{-n})/√2``, ``s_n = j(e_n −
-e_{-n})/√2``, a unitary V) every one of them is real, since the Fourier
-coefficients of a real matrix are conjugate-symmetric and ``V^H 𝒩 V`` is the
-real rotation generator; the returned system has the frequency response
-``V_y^H H(s) V_u``.  The internal truncation ``K_i >= K`` of `htf` is kept
-for the states, so the central blocks converge as in `htf`.
+The truncated HTF (Conventions page) is evaluated from a harmonic state
+space ``(F, G, H, J)`` with ``H(x) = H (xI - F)^{-1} G + J``:
+
+* continuous time, ``F = 𝒜 - 𝒩`` with Toeplitz blocks ``(𝒜)_{n,m} = A_{n-m}``
+  truncated at ``K_i >= K`` harmonics, ``𝒩 = blkdiag(jnω_p I)``, and the
+  central 2K+1 block rows of 𝒞 and columns of ℬ;
+* discrete time (N steps per period), the exact frequency lifting
+  ``F = Λ^{-1}𝒜``, ``G = Λ^{-1}ℬ`` over all N harmonics, built by the lifting
+  module (`lift`) so that both share one construction.
+
+F is diagonalised once when that pays off (in Floquet form it is block
+diagonal, so one eigendecomposition of A suffices), after which each
+frequency costs a diagonal solve.  `harmonic_ss` returns the real form
+``V_y^H H(s) V_u`` (real basis of the lifting module: columns ``c_0 = e_0``,
+``c_n = (e_n + e_{-n})/√2``, ``s_n = j(e_n − e_{-n})/√2``), in which every
+matrix is real since the Fourier coefficients of a real matrix are
+conjugate-symmetric and ``V^H 𝒩 V`` is the real rotation generator.
 """
+
+import warnings
 
 import numpy as np
 import control as ct
-from control.exception import ControlArgument
+from scipy import sparse
+from tqdm.auto import tqdm
 
-from ._lifting import _harmonic_labels, _real_basis
-from ._validation import check_positive_int
+from . import config
+from ._lifting import _frequency_lift, _full_harmonics, _harmonic_labels, _real_basis
+from ._validation import as_ltp, check_positive_int
 
 __all__ = ['harmonic_ss']
 
@@ -60,30 +73,46 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, name=None):
     >>> bool(np.isclose(Hs(0.5j)[0, 0], G(0.5j)))
     True
     """
-    from ._htf import htf
-    from ._ltpsys import LTPStateSpace
-    if not isinstance(sys, LTPStateSpace):
-        raise ControlArgument(f"sys must be an LTPStateSpace, got {sys.__class__.__name__}")
+    sys = as_ltp(sys, 'sys')
     if sys.isdtime():
         raise ValueError("harmonic_ss: sys is discrete-time; lift(sys) is its exact "
                          "(frequency-lifted) harmonic state space")
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
-    return _to_ss(htf(sys, K, internal_harmonics=internal_harmonics), name,
-                  sys.state_labels)
+    hss = build(sys, K, internal_harmonics, 'auto', 'harmonic_ss')
+    return real_ss(hss, name or f'{sys.name}$harmonic', sys.input_labels,
+                   sys.output_labels, sys.state_labels)
 
 
-def htf_to_ss(H, name=None, states=None):
-    """`HTF.to_ss`: the real harmonic state space of a model HTF."""
-    if H._hss is None:
-        raise ValueError("to_ss: this HTF holds data on a frequency grid; only an HTF "
-                         "computed from a model (ltp.htf) has a state space")
-    if H.isdtime():
-        raise ValueError("to_ss: the HTF is discrete-time; lift() the system instead")
-    return _to_ss(H, name, states)
+def build(sys, K, internal_harmonics, method, where, stacklevel=2):
+    """The checked harmonic state space of `sys` with K harmonics.
+
+    `stacklevel` is that of the user's call as seen from the caller of `build`.
+    """
+    if method not in ('auto', 'modal', 'solve'):
+        raise ValueError(f"method must be 'auto', 'modal' or 'solve', got {method!r}")
+    if not sys.is_stable():
+        warnings.warn(f"{sys.name} is unstable: its HTF is defined wherever the harmonic "
+                      "resolvent exists, but on the imaginary axis it describes no "
+                      "steady-state response", UserWarning, stacklevel=stacklevel + 1)
+    if sys.isdtime():
+        N = sys.nsteps
+        if 2 * K + 1 > N:
+            raise ValueError(f"nharmonics={K} exceeds the {N} harmonics of a discrete "
+                             f"system with {N} steps per period (need 2K+1 <= N)")
+        _check_setup_memory(N * sys.nstates, 0, where)
+        return _HarmonicStateSpace.discrete(sys, K, method)
+    Ki = _internal_order(sys, K, internal_harmonics)
+    checked = internal_harmonics is None and not sys.A.is_constant
+    _check_setup_memory((2 * Ki + 1) * sys.nstates,
+                        (2 * Ki + 17) * sys.nstates if checked else 0, where)
+    hss = _HarmonicStateSpace.continuous(sys, K, Ki, method)
+    if internal_harmonics is None and not hss.exact:
+        _check_truncation(sys, K, Ki, hss, method, stacklevel + 2)
+    return hss
 
 
-def _to_ss(H, name, states):
-    hss = H._hss
+def real_ss(hss, name, inputs, outputs, states):
+    """Real form ``V^H (F, G, H, J) V`` of a continuous harmonic state space."""
     K, Ki = hss.K, hss.Ki
     n = hss.F.shape[0] // (2 * Ki + 1)
     Vs, tags_s = _real_basis(np.arange(-Ki, Ki + 1), 2 * Ki + 2)   # no wrap-around
@@ -94,9 +123,247 @@ def _to_ss(H, name, states):
             Vy.conj().T @ hss.Hc @ Vx, Vy.conj().T @ hss.J @ Vu)
     scale = max(1.0, max(np.abs(M).max(initial=0.0) for M in mats))
     assert max(np.abs(M.imag).max(initial=0.0) for M in mats) <= 1e-10 * scale
-    if states is None:
-        states = [f'x[{i}]' for i in range(n)]
-    return ct.ss(*(M.real for M in mats), name=name or f'{H.name}$harmonic',
-                 inputs=_harmonic_labels(H.input_labels, tags),
-                 outputs=_harmonic_labels(H.output_labels, tags),
+    return ct.ss(*(M.real for M in mats), name=name,
+                 inputs=_harmonic_labels(inputs, tags),
+                 outputs=_harmonic_labels(outputs, tags),
                  states=_harmonic_labels(states, tags_s))
+
+
+class _HarmonicStateSpace:
+    """``H(x) = Hc (xI - F)^{-1} G + J`` with the central 2K+1 block rows/cols."""
+
+    def __init__(self, F, G, Hc, J, K, Ki, ny, nu, method, exact, floquet_A=None):
+        self.F, self.G, self.Hc, self.J = F, G, Hc, J
+        self.K, self.Ki, self.ny, self.nu = K, Ki, ny, nu
+        self.exact = exact
+        self.modal = None
+        self._residues = {}
+        if floquet_A is not None and method in ('auto', 'modal'):
+            # Floquet form: F = blkdiag(A - jnω_p I) has eigenvalues λ_i - jnω_p
+            # and eigenvectors blkdiag(W) from ONE eigendecomposition A = W Λ W^{-1}
+            A, w = floquet_A
+            lamA, W = np.linalg.eig(A)
+            if method == 'modal' or np.linalg.cond(W) < 1e8:
+                n, nb = A.shape[0], F.shape[0] // A.shape[0]
+                harm = np.arange(nb) - nb // 2
+                lam = (lamA[None, :] - 1j * w * harm[:, None]).ravel()
+                Winv = np.linalg.inv(W)
+                HV = (Hc.reshape(Hc.shape[0], nb, n) @ W).reshape(Hc.shape[0], -1)
+                VG = (Winv @ G.reshape(nb, n, -1)).reshape(nb * n, -1)
+                self.modal = (lam, HV, VG)
+        self.method = method
+
+    def _ensure_modal(self, npoints):
+        """Diagonalise F once when it pays off (or when asked to)."""
+        if self.modal is not None or self.method == 'solve':
+            return
+        if self.method == 'auto' and npoints < _MODAL_BREAK_EVEN:
+            return                  # a few dense solves are cheaper than eig(F)
+        lam, V = np.linalg.eig(self.F)
+        if self.method == 'modal' or np.linalg.cond(V) < 1e8:
+            Vinv = np.linalg.solve(V, np.eye(len(lam)))
+            self.modal = (lam, self.Hc @ V, Vinv @ self.G)
+        else:
+            self.method = 'solve'   # ill-conditioned eigenvectors: stay with solves
+
+    @classmethod
+    def continuous(cls, sys, K, Ki, method):
+        n, ny, nu = sys.nstates, sys.noutputs, sys.ninputs
+        w = sys.omega_p
+        harm = np.arange(-Ki, Ki + 1)
+        A_T = _toeplitz(sys.A.fourier(2 * Ki), Ki)
+        B_T = _toeplitz(sys.B.fourier(2 * Ki), Ki)
+        C_T = _toeplitz(sys.C.fourier(2 * Ki), Ki)
+        D_T = _toeplitz(sys.D.fourier(2 * Ki), Ki)
+        # F = A_T - N,  N = blkdiag(jnω_p I)
+        F = A_T
+        F[np.diag_indices_from(F)] -= 1j * w * np.repeat(harm, n)
+        rows = _central(Ki, K, ny)
+        cols = _central(Ki, K, nu)
+        exact = sys.A.is_constant and _bandlimited(sys, Ki - K)
+        floquet_A = (sys.A(0.0), w) if sys.A.is_constant else None
+        return cls(F, B_T[:, cols], C_T[rows], D_T[np.ix_(rows, cols)], K, Ki, ny, nu,
+                   method, exact, floquet_A)
+
+    @classmethod
+    def discrete(cls, sys, K, method):
+        N, ny, nu = sys.nsteps, sys.noutputs, sys.ninputs
+        # exact: all N harmonics, the frequency lifting (zΛ - 𝒜)^{-1} = (zI - Λ^{-1}𝒜)^{-1} Λ^{-1}
+        harm = _full_harmonics(N)
+        mats = (sys.A, sys.B, sys.C, sys.D)
+        F, G, C_T, D_T = _frequency_lift([M.sample(N) for M in mats], harm,
+                                         [M.is_constant for M in mats])
+        k0 = N // 2                                  # position of harmonic 0
+        rows, cols = _central(k0, K, ny), _central(k0, K, nu)
+        return cls(F, G[:, cols], C_T[rows], D_T[np.ix_(rows, cols)], K, None, ny, nu,
+                   method, True)
+
+    def evaluate(self, x, rows=None, cols=None, progress=None):
+        """H(x) for points x; `rows`/`cols` select block harmonics (-K..K).
+
+        The points are processed in chunks whose working memory stays
+        within ``ltp.config.defaults['htf.max_memory']``.
+        """
+        K, ny, nu = self.K, self.ny, self.nu
+        r = np.arange(self.Hc.shape[0]) if rows is None else np.concatenate(
+            [np.arange((k + K) * ny, (k + K + 1) * ny) for k in rows])
+        c = np.arange(self.G.shape[1]) if cols is None else np.concatenate(
+            [np.arange((k + K) * nu, (k + K + 1) * nu) for k in cols])
+        self._ensure_modal(len(x))
+        chunk, use_residues = self._plan(len(x), len(r), len(c))
+        J = self.J[np.ix_(r, c)]
+        out = np.empty((len(x), len(r), len(c)), complex)
+        starts = range(0, len(x), chunk)
+        for a in tqdm(starts, desc="HTF", unit="chunk", leave=False,
+                      disable=not config._get('htf.progress', progress) or len(starts) < 2):
+            sl = slice(a, a + chunk)
+            if self.modal is not None:
+                out[sl] = self._modal_chunk(x[sl], r, c, rows, cols, use_residues)
+            else:
+                out[sl] = self._solve_chunk(x[sl], r, c)
+            if J.any():
+                out[sl] += J
+        return out
+
+    def _plan(self, npoints, nr, nc):
+        """Chunk length and modal variant that keep the working memory in budget."""
+        budget = float(config.defaults['htf.max_memory'])
+        nF = self.F.shape[0]
+        out_bytes = _BYTES * npoints * nr * nc
+        use_residues = False
+        if self.modal is not None:
+            # residue matrix R_{q,(ij)} = HV_iq VG_qj, formed once, when it fits
+            use_residues = _BYTES * nF * nr * nc <= budget / 2
+            fixed = _BYTES * nF * nr * nc if use_residues else 0
+            per_point = _BYTES * (2 * nF + 2 * nr * nc + (0 if use_residues else nr * nF))
+        else:
+            fixed = 0
+            per_point = _BYTES * (2 * nF ** 2 + 2 * nF * nc + 2 * nr * nc)
+        room = budget - fixed - out_bytes
+        if room < per_point:
+            raise MemoryError(
+                f"evaluating the HTF at {npoints} points needs about "
+                f"{_size(fixed + out_bytes + per_point)} (result {_size(out_bytes)}, "
+                f"harmonic state space of {nF} states), more than "
+                f"ltp.config.defaults['htf.max_memory'] = {_size(budget)}; evaluate fewer "
+                "points or components, or raise the limit")
+        return max(1, int(room // per_point)), use_residues
+
+    def _modal_chunk(self, x, r, c, rows, cols, use_residues):
+        # H(x)_{ij} = Σ_q HV_iq VG_qj / (x - λ_q)
+        lam, HV, VG = self.modal
+        gap = x[:, None] - lam[None, :]
+        if np.any(np.abs(gap) <= 1e-13 * np.maximum(1.0, np.abs(lam))):
+            raise ValueError("the HTF is not defined at a Floquet exponent "
+                             "(evaluation point is a pole)")
+        inv_gap = 1.0 / gap
+        if not use_residues:
+            return (HV[r][None] * inv_gap[:, None, :]) @ VG[:, c]
+        key = (None if rows is None else tuple(rows), None if cols is None else tuple(cols))
+        if key not in self._residues:
+            self._residues[key] = _residue_matrix(HV[r], VG[:, c])
+        flat, shape = self._residues[key]
+        prod = (flat.T @ inv_gap.T).T if sparse.issparse(flat) else inv_gap @ flat
+        return prod.reshape((len(x),) + shape)
+
+    def _solve_chunk(self, x, r, c):
+        M = -np.broadcast_to(self.F, (len(x),) + self.F.shape)
+        idx = np.arange(self.F.shape[0])
+        M[:, idx, idx] += x[:, None]
+        Gc = self.G[:, c]
+        try:
+            X = np.linalg.solve(M, np.broadcast_to(Gc, (len(x),) + Gc.shape))
+        except np.linalg.LinAlgError:
+            raise ValueError("the HTF is not defined at a pole of the harmonic "
+                             "state space (singular resolvent)") from None
+        return self.Hc[r] @ X
+
+
+#
+# Helpers
+#
+
+_BYTES = 16                 # one complex128
+# eig(F) costs about as much as 25-35 dense resolvent solves of the same size
+# (measured for 100 to 800 harmonic states), plus the inverse eigenvectors
+_MODAL_BREAK_EVEN = 40
+
+
+def _size(nbytes):
+    return f"{nbytes / 1e9:.3g} GB" if nbytes >= 1e8 else f"{nbytes / 1e6:.3g} MB"
+
+
+def _check_setup_memory(nF, nF_check, where):
+    """Refuse a harmonic state space whose construction cannot fit the budget."""
+    # F, its Toeplitz parts and eigenvectors V, V^{-1} (6 nF^2); the
+    # truncation check builds one more of nF_check states (3 nF_check^2)
+    need = _BYTES * (6 * nF ** 2 + 3 * nF_check ** 2)
+    budget = float(config.defaults['htf.max_memory'])
+    if need > budget:
+        raise MemoryError(
+            f"{where}: the harmonic state space has {nF} states and needs about "
+            f"{_size(need)}, more than ltp.config.defaults['htf.max_memory'] = "
+            f"{_size(budget)}; lower nharmonics or internal_harmonics, or raise the limit")
+
+
+def _residue_matrix(HV, VG):
+    """Residues ``R_{q,(ij)} = HV_iq VG_qj`` of the modal form, sparse when mostly zero.
+
+    In Floquet form with band-limited B and C most residues vanish, and the
+    evaluation ``H(x) = (1/(x - λ)) R`` is then a sparse product.
+    """
+    flat = (HV.T[:, :, None] * VG[:, None, :]).reshape(HV.shape[1], -1)
+    big = np.abs(flat) > 1e-15 * np.abs(flat).max(initial=0.0)
+    if np.count_nonzero(big) < 0.2 * flat.size:
+        flat = sparse.csr_matrix(np.where(big, flat, 0))
+    return flat, (HV.shape[0], VG.shape[1])
+
+
+def _toeplitz(coeffs, Ki):
+    """Block Toeplitz ``[P_{n-m}]``, n, m = -Ki..Ki, from coefficients -2Ki..2Ki."""
+    harm = np.arange(-Ki, Ki + 1)
+    idx = harm[:, None] - harm[None, :] + 2 * Ki
+    blocks = coeffs[idx]                          # (2Ki+1, 2Ki+1, r, c)
+    r, c = coeffs.shape[1:]
+    return blocks.transpose(0, 2, 1, 3).reshape((2 * Ki + 1) * r, (2 * Ki + 1) * c)
+
+
+def _central(center, K, size):
+    """Indices of the blocks -K..K when harmonic 0 is block `center`."""
+    return np.arange((center - K) * size, (center + K + 1) * size)
+
+
+def _bandlimited(sys, margin):
+    """True when B, C, D have exact Fourier series with at most `margin` harmonics."""
+    for M in (sys.B, sys.C, sys.D):
+        if M.nharmonics is None or M.nharmonics > margin:
+            return False
+    return sys.B.nharmonics + sys.C.nharmonics <= margin
+
+
+def _internal_order(sys, K, internal):
+    if internal is not None:
+        Ki = check_positive_int(internal, 'internal_harmonics', minimum=0)
+        if Ki < K:
+            raise ValueError(f"internal_harmonics={Ki} must be >= nharmonics={K}")
+        return Ki
+    hb = [M.nharmonics for M in (sys.B, sys.C)]
+    if sys.A.is_constant and None not in hb:
+        return K + hb[0] + hb[1]
+    return K + 10 + max(h if h is not None else 0 for h in hb)
+
+
+def _check_truncation(sys, K, Ki, hss, method, stacklevel):
+    probe = 1j * sys.omega_p * np.array([0.137, 0.61, 1.93])
+    ref = _HarmonicStateSpace.continuous(sys, K, Ki + 8, method)
+    try:
+        a, b = hss.evaluate(probe), ref.evaluate(probe)
+    except ValueError:
+        return
+    err = np.abs(a - b).max() / max(np.abs(b).max(), 1e-300)
+    if err > 1e-6:
+        warnings.warn(f"HTF truncation at internal_harmonics={Ki} has not converged "
+                      f"(relative change {err:.1e} with {Ki + 8}); increase "
+                      "internal_harmonics", UserWarning, stacklevel=stacklevel)
+
+

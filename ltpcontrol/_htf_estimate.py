@@ -27,7 +27,7 @@ excited columns only, so where its shifted input is not excited a component
 is set by the curvature penalty alone.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import warnings
 
@@ -40,11 +40,11 @@ from control.exception import ControlArgument, ControlDimension
 from control.timeresp import TimeResponseData
 from tqdm.auto import tqdm
 
-from ._htf import HTF
-from ._validation import (check_kwargs, check_period, check_positive_int,
+from ._htf import HTFData
+from ._validation import (check_period, check_positive_int,
                           real_array, steps_per_period)
 
-__all__ = ['estimate_htf']
+__all__ = ['estimate_htf', 'HTFEstimateInfo']
 
 # Φ_UU condition number above which the per-frequency solve is flagged
 _COND_WARN = 1e8
@@ -56,57 +56,63 @@ _HARMONIC_PVALUE = 1e-3
 _HARMONIC_RATIO = 1.1
 
 
-@dataclass
-class HTFEstimate:
-    """Result of a nonparametric HTF estimate.
+@dataclass(frozen=True)
+class HTFEstimateInfo:
+    """Diagnostics of `estimate_htf` (``return_info=True``).
+
+    ``success`` and ``message`` follow `scipy.optimize.OptimizeResult`.
+    The arrays are indexed like the components of the returned `HTFData`
+    (shape (2K+1, ny, nu, F), frequency last) or by its frequencies.
 
     Attributes
     ----------
-    components : ndarray, shape (2K+1, ny, nu, F)
-        ``G_k(jω)`` for k = -K..K on `omega`; NaN where the component is
-        not determined: with α = 0 wherever its shifted input
-        ``U(ω - kω_p)`` is not excited; with α > 0 outside the range from
-        the first to the last frequency where it is (inside, the curvature
-        penalty bridges unexcited gaps), and everywhere for a component
-        identified at fewer than two frequencies.
-    omega : ndarray, shape (F,)
-        Output (base) frequencies in rad/s.
-    period : float
-        System period T.
-    std : ndarray, shape (2K+1, ny, nu, F)
-        Standard deviation of each component, ``sqrt(E|Ĝ_k - E Ĝ_k|²)``,
-        from the residual (white output noise assumed).  For α > 0 it
-        excludes the regularisation bias.  NaN where `identified` is False
-        and everywhere when the residual has no degrees of freedom.
+    success : bool
+        False when the unregularised solve is doubtful: ``Φ_UU`` is
+        ill-conditioned at some frequency (the windows do not separate the
+        components).
+    message : str
+        Description of the outcome; it also names detected unmodelled
+        harmonics (a shortcoming of the model order, not of the solve).
+    identified : ndarray of bool, shape (2K+1, ny, nu, F)
+        True where the shifted input ``U(ω - kω_p)`` of input j is excited,
+        i.e. where the data determine ``G_k(jω)``.
     cond : ndarray, shape (F,)
         Condition number of ``Φ_UU`` restricted to the identified
         components at each frequency (NaN where none is identified).
     residual : ndarray, shape (ny,)
         Root-mean-square residual ``|Y - Ŷ|`` per output over all equations.
     noise_var : ndarray, shape (ny,)
-        Estimated variance of one output DFT coefficient.
+        Estimated variance of one output DFT coefficient (NaN without
+        residual degrees of freedom); when unmodelled harmonics are
+        detected, that of the fit with ``G_{±(K+1)}`` modelled.
     alpha : float
-        Relative curvature weight used.
+        Relative curvature weight used (chosen by GCV for ``alpha='gcv'``).
     dof : float
         Residual degrees of freedom ``n - tr H``.
     gcv : float
         Generalised cross-validation score ``n |Y - Ŷ|² / (n - tr H)²``.
     nrecords : int
         Number of analysed windows R.
-    identified : ndarray of bool, shape (2K+1, ny, nu, F)
-        True where the shifted input ``U(ω - kω_p)`` of input j is excited,
-        i.e. where the data determine ``G_k(jω)``.
     harmonic_test : dict or None
-        Test for unmodelled harmonics (`_harmonic_test`): ``statistic``,
-        ``pvalue`` and ``variance_ratio`` (noise variance without over with
-        ``G_{±(K+1)}``; 0, 1, 1 for an exact fit); None when too few
-        windows.
+        Test for unmodelled harmonics (`estimate_htf`, Notes):
+        ``statistic``, ``pvalue`` and ``variance_ratio`` (noise variance
+        without over with ``G_{±(K+1)}``; 0, 1, 1 for an exact fit); None
+        when too few windows.
+
+    Examples
+    --------
+    >>> T = 1.0
+    >>> exc = ltp.chirp_replicas(T, 6, 8.0, 0.1, 20.0, dt=0.01)
+    >>> y = (1 + np.cos(2 * np.pi * exc.time / T)) * exc.inputs
+    >>> _, info = ltp.estimate_htf((exc.time, exc.inputs, y), T, 1,
+    ...                            segments=exc.segments, return_info=True)
+    >>> info.message, info.nrecords, info.alpha
+    ('estimate computed', 6, 0.0)
     """
 
-    components: np.ndarray
-    omega: np.ndarray
-    period: float
-    std: np.ndarray
+    success: bool
+    message: str
+    identified: np.ndarray
     cond: np.ndarray
     residual: np.ndarray
     noise_var: np.ndarray
@@ -114,9 +120,7 @@ class HTFEstimate:
     dof: float
     gcv: float
     nrecords: int
-    identified: np.ndarray
-    harmonic_test: dict | None = None
-    labels: dict = field(default_factory=dict, repr=False)
+    harmonic_test: dict | None
 
 
 # ---------------------------------------------------------------- data input
@@ -202,7 +206,7 @@ def _spectra(records, period, nharmonics, segments):
     if np.any(nperiods > L):
         warnings.warn(f"windows hold between {L} and {nperiods.max()} periods; all are "
                       f"cut to the common {L} periods (data discarded)",
-                      UserWarning, stacklevel=3)
+                      UserWarning, stacklevel=4)
     ns = L * nper
     if ns <= 2 * nharmonics * L:
         raise ValueError(f"nharmonics={nharmonics} needs more than {2 * nharmonics} "
@@ -437,10 +441,57 @@ def _harmonic_test(U, Y, bins, L, K, excited):
             "noise_var": noise_var}
 
 
-# ------------------------------------------------------------- public API
-def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
-              omega_limits=None, threshold=1e-2, progress=True):
-    """Core of `estimate_htf`; returns an `HTFEstimate`."""
+# ------------------------------------------------------------- the estimator
+def _estimate(data, period, nharmonics, segments, alpha, omega_limits, threshold,
+              progress):
+    """`estimate_htf` in named steps; returns (components, omega, std, labels, info)."""
+    period, K, records, segments, alpha, threshold = _check_options(
+        data, period, nharmonics, segments, alpha, threshold)
+    U, Y, L, dt = _spectra(records, period, K, segments)
+    wgrid = 2 * np.pi / (L * period)
+    bins, mask, excited = _frequencies(U, L, K, threshold, omega_limits, alpha, wgrid)
+    phi, Yb, cols, emask = _design(U, Y, bins, mask, L, K, alpha)
+    puu = np.einsum('rfa,rfb->fab', phi.conj(), phi)
+    cond, bad = _conditioning(puu, emask, bins, wgrid, alpha)
+    if alpha == 0:
+        g, trace, var = _solve_bins(phi, Yb)
+    else:
+        penalty = _penalty(bins.size, int(cols.sum()))
+        # s: mean diagonal of Φ_UU over the identified (component, ω) pairs
+        scale = float(np.sum(np.real(np.trace(puu, axis1=1, axis2=2)))) / emask.sum()
+        if alpha == 'gcv':
+            alpha = _gcv_search(phi, Yb, penalty, scale, progress)
+        g, trace, var = _solve_joint(phi, Yb, alpha, penalty, scale, True)
+    sq = _residual(phi, Yb, g)
+    n = phi.shape[0] * bins.size
+    dof = n - trace
+    has_dof = dof > 1e-6 * n
+    noise_var = sq / dof if has_dof else np.full(sq.shape, np.nan)
+    test = _harmonic_test(U, Y, bins, L, K, excited)
+    flagged = _check_harmonics(test, alpha, K, phi.shape[0], int(mask.sum(axis=1).max()),
+                               U.shape[1])
+    if flagged:
+        # the residual holds Σ_{|k|>K} G_k U(ω - kω_p): std from the noise variance of
+        # the fit with G_{±(K+1)} modelled
+        noise_var = test["noise_var"]
+    comps, std, identified = _assemble(g, var, noise_var, mask, emask, cols, alpha, K,
+                                       U.shape[1])
+    info = HTFEstimateInfo(
+        success=not bad,
+        message="; ".join(m for m, on in (
+            ("Φ_UU is ill-conditioned at some frequencies", bad),
+            ("unmodelled harmonics detected in the residual", flagged)) if on)
+        or "estimate computed",
+        identified=identified, cond=cond, residual=np.sqrt(sq / n), noise_var=noise_var,
+        alpha=float(alpha), dof=float(dof),
+        gcv=float(n * sq.sum() / dof ** 2) if has_dof else np.inf,
+        nrecords=phi.shape[0], harmonic_test=test)
+    labels = next((rec[3] for rec in records if rec[3]), {})
+    return comps, bins * wgrid, std, labels, info
+
+
+def _check_options(data, period, nharmonics, segments, alpha, threshold):
+    """Validated period, K, records, segments, alpha and threshold."""
     period = check_period(period)
     K = check_positive_int(nharmonics, "nharmonics", minimum=0)
     records = _as_records(data)
@@ -459,11 +510,17 @@ def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
         alpha = float(real_array(alpha, "alpha", ndim=0))
         if alpha < 0:
             raise ValueError(f"alpha must be >= 0, got {alpha}")
+    return period, K, records, segments, alpha, threshold
 
-    U, Y, L, dt = _spectra(records, period, K, segments)
+
+def _frequencies(U, L, K, threshold, omega_limits, alpha, wgrid):
+    """Output bins estimated, mask (F, P) of excited regressor columns, excited DFT bins.
+
+    Without `omega_limits`: the bins at which every shifted input is excited.
+    With them: the bins in the range with some excited shifted input, and
+    for α > 0 the contiguous band from the first to the last of them.
+    """
     nrec, nu, ns = U.shape
-    nunk = (2 * K + 1) * nu
-    wgrid = 2 * np.pi / (L * period)
     m, mask, excited = _output_bins(U, L, K, threshold)
     if omega_limits is None:
         ok = mask.all(axis=(1, 2))          # every component identifiable at m
@@ -472,7 +529,7 @@ def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
             raise ValueError(
                 f"nharmonics={K} is too large for the excited band: no output frequency "
                 f"has all shifted inputs ω - kω_p, |k| <= {K}, excited (input excited up "
-                f"to {top:.4g} rad/s, 2Kω_p = {2 * K * 2 * np.pi / period:.4g} rad/s); "
+                f"to {top:.4g} rad/s, 2Kω_p = {2 * K * L * wgrid:.4g} rad/s); "
                 "pass omega_limits to estimate each component where its shifted input is "
                 "excited, reduce nharmonics, widen the excitation or lower threshold")
     else:
@@ -488,14 +545,14 @@ def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
                 f"no output frequency in omega_limits has an excited shifted input "
                 f"ω - kω_p, |k| <= {K}; change omega_limits, widen the excitation or "
                 "lower threshold")
-    if omega_limits is not None and not np.all(ok):
-        # α > 0 bridges the gaps between the first and last identifiable frequency
-        span = np.arange(ok.size)
-        inner = (span > np.argmax(ok)) & (span < ok.size - 1 - np.argmax(ok[::-1]))
-        nint = 0 if alpha == 0 else int(np.sum(inner & ~ok))
-        warnings.warn(f"{np.sum(~ok)} frequencies in omega_limits have all shifted "
-                      f"inputs ω - kω_p (|k| <= {K}) unexcited: {np.sum(~ok) - nint} "
-                      f"dropped, {nint} interpolated", UserWarning, stacklevel=3)
+        if not np.all(ok):
+            # α > 0 bridges the gaps between the first and last identifiable frequency
+            span = np.arange(ok.size)
+            inner = (span > np.argmax(ok)) & (span < ok.size - 1 - np.argmax(ok[::-1]))
+            nint = 0 if alpha == 0 else int(np.sum(inner & ~ok))
+            warnings.warn(f"{np.sum(~ok)} frequencies in omega_limits have all shifted "
+                          f"inputs ω - kω_p (|k| <= {K}) unexcited: {np.sum(~ok) - nint} "
+                          f"dropped, {nint} interpolated", UserWarning, stacklevel=4)
     if alpha == 0:
         bins, mask = m[ok], mask[ok]
         need = int(mask.sum(axis=(1, 2)).max())
@@ -503,8 +560,8 @@ def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
             raise ValueError(
                 f"alpha=0 with nharmonics={K} needs at least {need} records or segments "
                 f"(the components identifiable at one frequency; at most (2K+1)·nu = "
-                f"{nunk}), got {nrec}; use phase-shifted replicas (chirp_replicas) or "
-                "alpha > 0 / alpha='gcv'")
+                f"{(2 * K + 1) * nu}), got {nrec}; use phase-shifted replicas "
+                "(chirp_replicas) or alpha > 0 / alpha='gcv'")
     else:
         # contiguous band: bins without any excited shifted input are bridged by the penalty
         first, last = np.nonzero(ok)[0][[0, -1]]
@@ -512,92 +569,100 @@ def _estimate(data, period, nharmonics, *, segments=None, alpha=0.0,
         if bins.size < 3:
             raise ValueError("the curvature penalty needs at least 3 frequencies; "
                              "lengthen the records or widen the band")
-    mask = mask.reshape(bins.size, nunk)    # column (k+K)·nu + j, as in _regressor
-    # unknowns: components with data somewhere (α = 0), at >= 2 frequencies for α > 0
-    # (the curvature penalty leaves a component's affine part free)
+    return bins, mask.reshape(bins.size, -1), excited   # column (k+K)·nu + j
+
+
+def _design(U, Y, bins, mask, L, K, alpha):
+    """Regressor φ (R, F, unknowns), outputs (R, F, ny), unknown columns, their mask.
+
+    The unknowns are the components with data somewhere (α = 0), at two
+    frequencies or more for α > 0 (the curvature penalty leaves a
+    component's affine part free).  An unexcited (component, ω) has no
+    data term: its regressor column U(ω - kω_p) is zeroed.
+    """
     cols = mask.sum(axis=0) >= (1 if alpha == 0 else 2)
     emask = mask[:, cols]
-    # no data term for unexcited (component, ω): zero regressor column U(ω - kω_p)
     phi = _regressor(U, bins, L, K)[:, :, cols] * emask
-    Yb = np.transpose(Y[:, :, bins], (0, 2, 1))                 # (R, F, ny)
-    puu = np.einsum('rfa,rfb->fab', phi.conj(), phi)
-    # cond of Φ_UU restricted to the identified set E: σ_1 / σ_|E|
+    Yb = np.transpose(Y[:, :, bins], (0, 2, 1))
+    return phi, Yb, cols, emask
+
+
+def _conditioning(puu, emask, bins, wgrid, alpha):
+    """cond of Φ_UU restricted to the identified set E, σ_1 / σ_|E|, per frequency.
+
+    Returns it and whether it makes the unregularised (α = 0) solve doubtful.
+    """
     sv = np.linalg.svd(puu, compute_uv=False)
     count = emask.sum(axis=1)
     low = sv[np.arange(bins.size), np.maximum(count, 1) - 1]
     cond = np.divide(sv[:, 0], low, out=np.full(bins.size, np.inf), where=low > 0)
     cond[count == 0] = np.nan
-    n = nrec * bins.size
-    if alpha == 0:
-        if np.max(cond) > _COND_WARN:
-            bad = bins[cond > _COND_WARN] * wgrid
-            warnings.warn(
-                f"Φ_UU is ill-conditioned at {bad.size} frequencies (cond up to "
-                f"{np.max(cond):.2g}, e.g. ω = {bad[0]:.4g} rad/s): the records do not "
-                f"separate the {need} components identifiable there; use >= {need} "
-                "phase-shifted replicas or alpha > 0", UserWarning, stacklevel=3)
-        g, trace, var = _solve_bins(phi, Yb)
-    else:
-        penalty = _penalty(bins.size, int(cols.sum()))
-        # s: mean diagonal of Φ_UU over the identified (component, ω) pairs
-        scale = float(np.sum(np.real(np.trace(puu, axis1=1, axis2=2)))) / emask.sum()
-        if alpha == 'gcv':
-            alpha = _gcv_search(phi, Yb, penalty, scale, progress)
-        g, trace, var = _solve_joint(phi, Yb, alpha, penalty, scale, True)
-    sq = _residual(phi, Yb, g)
-    dof = n - trace
-    has_dof = dof > 1e-6 * n
-    noise_var = sq / dof if has_dof else np.full(sq.shape, np.nan)
-    test = _harmonic_test(U, Y, bins, L, K, excited)
+    bad = alpha == 0 and np.max(cond) > _COND_WARN
+    if bad:
+        need = int(count.max())
+        where = bins[cond > _COND_WARN] * wgrid
+        warnings.warn(
+            f"Φ_UU is ill-conditioned at {where.size} frequencies (cond up to "
+            f"{np.max(cond):.2g}, e.g. ω = {where[0]:.4g} rad/s): the records do not "
+            f"separate the {need} components identifiable there; use >= {need} "
+            "phase-shifted replicas or alpha > 0", UserWarning, stacklevel=4)
+    return cond, bool(bad)
+
+
+def _check_harmonics(test, alpha, K, nrec, need, nu):
+    """Warn about unmodelled harmonics, or that they cannot be tested; True if found."""
     if test is not None and (test["pvalue"] < _HARMONIC_PVALUE
                              and test["variance_ratio"] > _HARMONIC_RATIO):
-        # the residual holds Σ_{|k|>K} G_k U(ω - kω_p): take the noise variance of
-        # the fit with G_{±(K+1)} modelled, so that std describes the noise
-        inflation = float(np.max(noise_var / test["noise_var"])) if has_dof else np.nan
-        noise_var = test["noise_var"]
         warnings.warn(
             f"unmodelled harmonics: the inputs shifted by ±{K + 1}ω_p explain the "
             f"residual (F = {test['statistic']:.3g}, p = {test['pvalue']:.2g}), so the "
             f"plant has components G_k with |k| > {K}; std uses the noise variance of "
-            f"the fit with G_{{±{K + 1}}} modelled (the residual's is {inflation:.3g}× "
-            f"larger), and where U(ω ∓ {K + 1}ω_p) is excited the estimate may carry "
-            f"their alias; increase nharmonics", UserWarning, stacklevel=3)
-    elif test is None and alpha == 0:
+            f"the fit with G_{{±{K + 1}}} modelled (the residual's is "
+            f"{test['variance_ratio']:.3g}× larger where they are excited), and where "
+            f"U(ω ∓ {K + 1}ω_p) is excited the estimate may carry their alias; increase "
+            f"nharmonics", UserWarning, stacklevel=4)
+        return True
+    if test is None and alpha == 0:
         warnings.warn(
             f"too few windows to test for unmodelled harmonics ({nrec} windows, "
             f"{need} components per frequency): components G_k with |k| > {K} would "
             f"alias undetected into the estimate (with {nrec} phase-shifted replicas "
             f"G_{K + 1} into G_{K + 1 - nrec} and G_{-K - 1} into G_{nrec - K - 1}); use at "
             f"least {need + 2 * nu + 1} windows to test for them",
-            UserWarning, stacklevel=3)
-    # reported: identified pairs (α = 0); for α > 0 also the penalty's bridge across
-    # gaps between a component's first and last identified frequency, not its
-    # linear extrapolation beyond them, which no data support
-    span = np.arange(bins.size)[:, None]
+            UserWarning, stacklevel=4)
+    return False
+
+
+def _assemble(g, var, noise_var, mask, emask, cols, alpha, K, nu):
+    """Components, std and identified mask, shape (2K+1, ny, nu, F).
+
+    Reported: the identified pairs (α = 0); for α > 0 also the penalty's
+    bridge across gaps between a component's first and last identified
+    frequency, not its linear extrapolation beyond them, which no data
+    support.  The rest is NaN.
+    """
+    nfreq, nunk = mask.shape
+    span = np.arange(nfreq)[:, None]
     inner = ((span >= np.argmax(emask, axis=0))
-             & (span <= bins.size - 1 - np.argmax(emask[::-1], axis=0)))
-    gfull = np.full((bins.size, nunk, sq.size), np.nan, complex)
-    vfull = np.full((bins.size, nunk), np.nan)
+             & (span <= nfreq - 1 - np.argmax(emask[::-1], axis=0)))
+    gfull = np.full((nfreq, nunk, noise_var.size), np.nan, complex)
+    vfull = np.full((nfreq, nunk), np.nan)
     gfull[:, cols] = np.where((emask if alpha == 0 else inner)[..., None], g, np.nan)
     vfull[:, cols] = np.where(emask, var, np.nan)
     # Var Ĝ_k[o, j](ω_f) = σ_o² · var[f, (k+K)nu + j]
     std = np.sqrt(vfull[None, :, :] * noise_var[:, None, None])  # (ny, F, P)
-    std = np.transpose(std.reshape(-1, bins.size, 2 * K + 1, nu), (2, 0, 3, 1))
-    comps = np.transpose(gfull.reshape(bins.size, 2 * K + 1, nu, -1), (1, 3, 2, 0))
+    std = np.transpose(std.reshape(-1, nfreq, 2 * K + 1, nu), (2, 0, 3, 1))
+    comps = np.transpose(gfull.reshape(nfreq, 2 * K + 1, nu, -1), (1, 3, 2, 0))
     identified = np.broadcast_to(
-        np.transpose(mask.reshape(bins.size, 2 * K + 1, 1, nu), (1, 2, 3, 0)),
+        np.transpose(mask.reshape(nfreq, 2 * K + 1, 1, nu), (1, 2, 3, 0)),
         comps.shape).copy()
-    labels = next((rec[3] for rec in records if rec[3]), {})
-    return HTFEstimate(
-        components=comps, omega=bins * wgrid, period=period, std=std, cond=cond,
-        residual=np.sqrt(sq / n), noise_var=noise_var, alpha=float(alpha),
-        dof=float(dof), gcv=float(n * sq.sum() / dof ** 2) if has_dof else np.inf,
-        nrecords=nrec, identified=identified, harmonic_test=test, labels=labels)
+    return comps, std, identified
 
 
+# ------------------------------------------------------------- public API
 def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
-                 omega_limits=None, threshold=1e-2, progress=True, name=None,
-                 **kwargs):
+                 omega_limits=None, threshold=1e-2, progress=False, return_info=False,
+                 name=None):
     """Estimate harmonic transfer functions from input-output data.
 
     Nonparametric least-squares estimate of ``G_k(jω)``, k = -K..K, in
@@ -641,32 +706,31 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
         Input power, relative to its maximum, below which a DFT bin counts
         as unexcited (default 1e-2).
     progress : bool, optional
-        Show a progress bar during the GCV search (default True; shown only
-        on terminals).
+        Show a progress bar during the GCV search (default False).
+    return_info : bool, optional
+        Also return the diagnostics (`HTFEstimateInfo`).
     name : str, optional
         Name of the returned HTF.
 
     Returns
     -------
-    HTF
-        Data HTF on the estimated grid, with ``std`` (standard deviation of
-        each component, NaN where the component is; None when the residual
-        has no degrees of freedom, e.g. exactly ``(2K+1)·nu`` windows) and
-        ``diagnostics`` holding ``identified`` (bool, shape of the
-        components: True where ``U(ω - kω_p)`` of the input is excited, so
-        that the data determine ``G_k(jω)``), ``cond`` (of
-        ``Φ_UU`` over the identified components per frequency, NaN where
-        there are none), ``residual`` (RMS per output), ``noise_var``,
-        ``alpha``, ``dof``, ``gcv``, ``nrecords`` and ``harmonic_test`` (see
-        Notes; None when there are too few windows).  A component that is
-        not determined at a frequency is NaN in the HTF: with ``alpha=0``
-        where it is not identified, with ``alpha > 0`` outside the range
+    HTFData
+        The components on the estimated grid, with ``std`` (standard
+        deviation of each component, NaN where the component is; None when
+        the residual has no degrees of freedom, e.g. exactly ``(2K+1)·nu``
+        windows).  A component that is not determined at a frequency is
+        NaN: with ``alpha=0`` where it is not identified (its shifted input
+        ``U(ω - kω_p)`` is not excited), with ``alpha > 0`` outside the range
         from its first to its last identified frequency (inside, the
         curvature penalty bridges unexcited gaps) and everywhere for a
         component identified at fewer than two frequencies.  It multiplies
         an input component that the data did not excite, so `HTF.predict`
         takes it as zero (and warns when the input to predict from does
         excite it); `fit_htf` and `estimate_delays` leave it out.
+    info : HTFEstimateInfo
+        Only with ``return_info=True``: identified components, conditioning,
+        residual, noise variance, α, degrees of freedom, GCV score and the
+        test for unmodelled harmonics.
 
     Warns
     -----
@@ -690,7 +754,7 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     not separate them, aliases into the estimate.  The per-frequency
     least-squares fit is therefore repeated with ``G_{±(K+1)}`` added,
     wherever there are enough windows, and an F test on the decrease of
-    the residual (``diagnostics['harmonic_test']``: statistic, p-value and
+    the residual (``info.harmonic_test``: statistic, p-value and
     the ratio of the two noise-variance estimates) warns when it is
     significant (p < 1e-3) and inflates the noise variance by more than
     10 %.
@@ -708,17 +772,20 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     >>> w, G = H.components()
     >>> np.round(G[:, 0, 0, 10].real, 6).tolist()
     [0.5, 1.0, 0.5]
+
+    The diagnostics come with ``return_info=True``:
+
+    >>> H, info = ltp.estimate_htf((exc.time, exc.inputs, y), T, 1,
+    ...                            segments=exc.segments, return_info=True)
+    >>> info.success, bool(info.identified.all())
+    (True, True)
     """
-    check_kwargs(kwargs, "estimate_htf")
-    est = _estimate(data, period, nharmonics, segments=segments, alpha=alpha,
-                    omega_limits=omega_limits, threshold=threshold, progress=progress)
-    diagnostics = {"identified": est.identified, "cond": est.cond,
-                   "residual": est.residual, "noise_var": est.noise_var,
-                   "alpha": est.alpha, "dof": est.dof, "gcv": est.gcv,
-                   "nrecords": est.nrecords, "harmonic_test": est.harmonic_test}
+    comps, omega, std, labels, info = _estimate(
+        data, period, nharmonics, segments, alpha, omega_limits, threshold, progress)
     # NaN marks components the data leave undetermined (U(ω - kω_p) not excited);
     # std is None only when the residual has no degrees of freedom
-    std = None if np.all(np.isnan(est.std[est.identified])) else est.std
-    return HTF(est.components, est.omega, est.period, std=std,
-               diagnostics=diagnostics, name=name,
-               inputs=est.labels.get("inputs"), outputs=est.labels.get("outputs"))
+    if np.all(np.isnan(std[info.identified])):
+        std = None
+    H = HTFData(comps, omega, check_period(period), std=std, name=name,
+                inputs=labels.get("inputs"), outputs=labels.get("outputs"))
+    return (H, info) if return_info else H

@@ -24,8 +24,7 @@ import numpy as np
 import scipy.optimize
 from control.exception import ControlArgument, ControlDimension
 
-from ._htf import HTF
-from ._htf_estimate import HTFEstimate
+from ._htf import HTF, HTFData
 from ._validation import check_kwargs, real_array
 
 __all__ = ['fit_htf', 'estimate_delays', 'HTFFit', 'DelayEstimate']
@@ -36,7 +35,7 @@ _MAX_DELAY_GRID = 2 ** 18
 _DELAY_CHUNK = 2 ** 20
 
 
-@dataclass
+@dataclass(frozen=True)
 class HTFFit:
     """Result of `fit_htf`.
 
@@ -60,12 +59,14 @@ class HTFFit:
         Optimiser success flag.
     message : str
         Optimiser message.
+    nfev : int
+        Number of model evaluations.
 
     Examples
     --------
     >>> omega = np.linspace(0.1, 5, 20)
     >>> model = lambda p, w: (p[0] / (1j * w + 1))[None, None, None, :]
-    >>> fit = ltp.fit_htf(model, ltp.HTF(model([3.0], omega), omega, 1.0), [1.0])
+    >>> fit = ltp.fit_htf(model, ltp.HTFData(model([3.0], omega), omega, 1.0), [1.0])
     >>> fit.success, fit.components.shape
     (True, (1, 1, 1, 20))
     """
@@ -78,9 +79,10 @@ class HTFFit:
     cost: float
     success: bool
     message: str
+    nfev: int
 
 
-@dataclass
+@dataclass(frozen=True)
 class DelayEstimate:
     """Result of `estimate_delays` (seconds).
 
@@ -100,7 +102,7 @@ class DelayEstimate:
     --------
     >>> omega = np.linspace(0.5, 20, 40)
     >>> G = np.ones((1, 1, 1, 40)) / (1j * omega + 1)
-    >>> d = ltp.estimate_delays(ltp.HTF(G * np.exp(-0.1j * omega), omega, 1.0), G,
+    >>> d = ltp.estimate_delays(ltp.HTFData(G * np.exp(-0.1j * omega), omega, 1.0), G,
     ...                         harmonics=[0])
     >>> round(d.total_delay, 6), d.input_delay
     (0.1, None)
@@ -114,16 +116,14 @@ class DelayEstimate:
 
 
 def _estimate_arrays(estimate, name="estimate"):
-    """Return (omega, components, std or None, period) of an HTF or HTFEstimate."""
-    if isinstance(estimate, HTF):
-        if estimate.omega is None:
-            raise ControlArgument(f"{name} must be a data HTF (with a frequency grid)")
-        omega, comps = estimate.components()
-        return omega, comps, estimate.std, estimate.period
-    if isinstance(estimate, HTFEstimate):
-        return estimate.omega, estimate.components, estimate.std, estimate.period
-    raise ControlArgument(f"{name} must be an HTF or HTFEstimate, got "
-                          f"{type(estimate).__name__}")
+    """Return (omega, components, std or None, period) of an `HTFData`."""
+    if not isinstance(estimate, HTFData):
+        what = ("a model HTF (ltp.htf); evaluate it on a grid with HTFData"
+                if isinstance(estimate, HTF) else type(estimate).__name__)
+        raise ControlArgument(f"{name} must be an HTFData (e.g. from estimate_htf), "
+                              f"got {what}")
+    omega, comps = estimate.components()
+    return omega, comps, estimate.std, estimate.period
 
 
 def _select(omega, omega_limits, name="omega_limits"):
@@ -190,8 +190,8 @@ def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
         (2K'+1, ny, nu, len(omega)) with K' >= the harmonics fitted, or an
         object with a ``components(omega)`` method (e.g. an `HTF` built by
         `ltpcontrol.htf` from a parameterised system).
-    estimate : HTF
-        Data HTF (e.g. from `estimate_htf`).
+    estimate : HTFData
+        Estimated HTF (e.g. from `estimate_htf`).
     p0 : array_like
         Initial parameters.
     harmonics : sequence of int, optional
@@ -217,7 +217,7 @@ def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
 
     >>> omega = np.linspace(0.1, 5, 40)
     >>> model = lambda p, w: (1 / (1j * w - p[0]))[None, None, None, :]
-    >>> est = ltp.HTF(model([-2.0], omega), omega, period=1.0)
+    >>> est = ltp.HTFData(model([-2.0], omega), omega, period=1.0)
     >>> fit = ltp.fit_htf(model, est, [-1.0])
     >>> np.round(fit.params, 6).tolist()
     [-2.0]
@@ -288,7 +288,7 @@ def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
                                               comps.shape[1:3] + (omega.size,))
     return HTFFit(params=res.x, cov=cov, std=np.sqrt(np.abs(np.diag(cov))),
                   components=fitted, omega=omega, cost=float(res.cost),
-                  success=bool(res.success), message=str(res.message))
+                  success=bool(res.success), message=str(res.message), nfev=int(res.nfev))
 
 
 def estimate_delays(estimate, reference, *, harmonics=(-1, 0, 1), omega_limits=None,
@@ -306,8 +306,8 @@ def estimate_delays(estimate, reference, *, harmonics=(-1, 0, 1), omega_limits=N
 
     Parameters
     ----------
-    estimate : HTF
-        Data HTF of the delayed system (e.g. from `estimate_htf`).
+    estimate : HTFData
+        Estimated HTF of the delayed system (e.g. from `estimate_htf`).
     reference : HTF or array_like
         Undelayed model (e.g. from a magnitude-only `fit_htf`): an HTF that
         can be evaluated on the estimate's grid, or an array of components
@@ -335,11 +335,35 @@ def estimate_delays(estimate, reference, *, harmonics=(-1, 0, 1), omega_limits=N
     >>> G = np.ones((3, 1, 1, 60)) / (1j * omega + 2) * (1 + 0.5 * k)
     >>> tu, ty, wp = 0.04, 0.05, 2 * np.pi
     >>> Hd = G * np.exp(-1j * ((omega - k * wp) * tu + omega * ty))
-    >>> d = ltp.estimate_delays(ltp.HTF(Hd, omega, 1.0), G)
+    >>> d = ltp.estimate_delays(ltp.HTFData(Hd, omega, 1.0), G)
     >>> round(d.input_delay, 6), round(d.output_delay, 6)
     (0.04, 0.05)
     """
     check_kwargs(kwargs, "estimate_delays")
+    w, ks, weight, obs, period = _delay_data(estimate, reference, harmonics,
+                                             omega_limits, input, output)
+    tmax = period if max_delay is None else float(real_array(max_delay, "max_delay", ndim=0))
+    if tmax <= 0:
+        raise ValueError(f"max_delay must be positive, got {tmax}")
+    separable = bool(np.any(ks != 0))
+    x0 = _initial_delays(w, ks, weight ** 2 * obs, _delay_grid(w, tmax), period, separable)
+    wp = 2 * np.pi / period
+
+    def phase(x):
+        # (ω - kω_p) τ_u + ω τ_y  (eq. 3.47)
+        tin, tout = (x[0], x[1]) if separable else (0.0, x[0])
+        return (w[None, :] - ks[:, None] * wp) * tin + w[None, :] * tout
+
+    def residual(x):
+        r = (weight * (obs - np.exp(-1j * phase(x)))).ravel()
+        return np.concatenate([r.real, r.imag])
+
+    res = scipy.optimize.least_squares(residual, x0, x_scale=max(tmax, 1e-3) * 1e-2)
+    return _delay_result(res, weight, obs, phase(res.x), period, separable)
+
+
+def _delay_data(estimate, reference, harmonics, omega_limits, input, output):
+    """Frequencies, harmonics, weights ``|Ĥ_k|`` and ``e^{j(∠Ĥ_k - ∠G_k)}`` used."""
     omega, comps, _, period = _estimate_arrays(estimate)
     K = comps.shape[0] // 2
     ks = _harmonics(harmonics, K)
@@ -356,7 +380,6 @@ def estimate_delays(estimate, reference, *, harmonics=(-1, 0, 1), omega_limits=N
         if ref.shape != comps.shape:
             raise ControlDimension(f"reference must have shape {comps.shape}, "
                                    f"got {ref.shape}")
-    w = omega[keep]
     meas = comps[ks + K, output, input][:, keep]
     model = np.asarray(ref)[ks + K, output, input][:, keep]
     # components the data leave undetermined (NaN) get zero weight
@@ -366,53 +389,46 @@ def estimate_delays(estimate, reference, *, harmonics=(-1, 0, 1), omega_limits=N
     if np.any(model == 0):
         raise ValueError("reference components vanish on the grid; restrict "
                          "omega_limits or harmonics")
-    wp = 2 * np.pi / period
-    weight = np.abs(meas)                                     # |Ĥ_k| (eq. 3.50)
-    obs = np.exp(1j * np.angle(meas * np.conj(model)))        # e^{j(∠Ĥ_k - ∠G_k)}
-    tmax = period if max_delay is None else float(real_array(max_delay, "max_delay", ndim=0))
-    if tmax <= 0:
-        raise ValueError(f"max_delay must be positive, got {tmax}")
-    # the objective oscillates on the scale 2π/max(ω): sample the total delay
-    # 8 times per oscillation, on a grid of bounded size
+    # |Ĥ_k| (eq. 3.50) and e^{j(∠Ĥ_k - ∠G_k)}
+    return omega[keep], ks, np.abs(meas), np.exp(1j * np.angle(meas * np.conj(model))), period
+
+
+def _delay_grid(w, tmax):
+    """Total delays searched: the objective oscillates on the scale 2π/max(ω),
+    sampled 8 times per oscillation on a grid of bounded size."""
     spacing = 2 * np.pi / (8 * np.max(w))
     if tmax / spacing > _MAX_DELAY_GRID - 2:
         raise ValueError(
             f"max_delay={tmax:.6g} s is too large for this frequency grid: the delay "
             f"search would need {tmax / spacing:.3g} grid points (limit {_MAX_DELAY_GRID}); "
             f"max_delay must be at most {(_MAX_DELAY_GRID - 2) * spacing:.6g} s")
-    separable = bool(np.any(ks != 0))
+    return np.linspace(0, tmax, int(np.ceil(tmax / spacing)) + 2)
+
+
+def _initial_delays(w, ks, coef, tsums, period, separable):
+    """Grid search: total delay τ_s, then τ_u over one period (τ_u, τ_y or τ_s)."""
     # S_k(τ_s) = Σ_ω |Ĥ_k|² e^{j(∠Ĥ_k - ∠G_k + ωτ_s)} ≈ A_k e^{jkω_p τ_u} at the true τ_s
-    tsums = np.linspace(0, tmax, int(np.ceil(tmax / spacing)) + 2)
-    coef = weight ** 2 * obs
     sums = np.empty((ks.size, tsums.size), complex)
     chunk = max(1, _DELAY_CHUNK // w.size)         # bound the F x chunk work array
     for start in range(0, tsums.size, chunk):
         stop = start + chunk
         sums[:, start:stop] = coef @ np.exp(1j * np.outer(w, tsums[start:stop]))
     best = int(np.argmax(np.abs(sums).sum(axis=0)))
-    if separable:
-        # τ_u maximising Re Σ_k S_k(τ_s) e^{-jkω_p τ_u} over [0, T)
-        tins = np.linspace(0, period, 256, endpoint=False)
-        score = np.real(np.exp(-1j * wp * np.outer(tins, ks)) @ sums[:, best])
-        tin0 = tins[np.argmax(score)]
-        x0 = np.array([tin0, tsums[best] - tin0])
-    else:
-        x0 = np.array([tsums[best]])
+    if not separable:
+        return np.array([tsums[best]])
+    # τ_u maximising Re Σ_k S_k(τ_s) e^{-jkω_p τ_u} over [0, T)
+    tins = np.linspace(0, period, 256, endpoint=False)
+    score = np.real(np.exp(-2j * np.pi / period * np.outer(tins, ks)) @ sums[:, best])
+    tin0 = tins[np.argmax(score)]
+    return np.array([tin0, tsums[best] - tin0])
 
-    def phase(x):
-        # (ω - kω_p) τ_u + ω τ_y  (eq. 3.47)
-        tin, tout = (x[0], x[1]) if separable else (0.0, x[0])
-        return (w[None, :] - ks[:, None] * wp) * tin + w[None, :] * tout
 
-    def residual(x):
-        r = (weight * (obs - np.exp(-1j * phase(x)))).ravel()
-        return np.concatenate([r.real, r.imag])
-
-    res = scipy.optimize.least_squares(residual, x0, x_scale=max(tmax, 1e-3) * 1e-2)
+def _delay_result(res, weight, obs, phase, period, separable):
+    """`DelayEstimate` from the least-squares refinement."""
     nres, npar = res.fun.size, res.x.size
     cov = np.linalg.pinv(res.jac.T @ res.jac) * (2 * res.cost / max(nres - npar, 1))
     std = np.sqrt(np.abs(np.diag(cov)))
-    err = np.angle(obs * np.exp(1j * phase(res.x)))
+    err = np.angle(obs * np.exp(1j * phase))
     rms = float(np.sqrt(np.sum((weight * err) ** 2) / np.sum(weight ** 2)))
     if not separable:
         return DelayEstimate(None, None, float(res.x[0]), std, rms)

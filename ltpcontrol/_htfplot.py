@@ -14,8 +14,8 @@ import matplotlib.axes
 import matplotlib.pyplot as plt
 from control.exception import ControlArgument
 
-from ._htf import HTF, _harmonic
-from ._validation import check_positive_int, real_array
+from ._htf import HTF, HTFData, _harmonic, default_omega
+from ._validation import real_array
 
 __all__ = ['htf_response', 'bode_htf', 'htf_map_plot']
 
@@ -29,13 +29,16 @@ def htf_response(htfs, omega=None, harmonics=(-1, 0, 1), *, omega_limits=None,
     htfs : HTF or list of HTF
         Harmonic transfer functions (model or data).
     omega : array_like, optional
-        Frequencies in rad/s.  Data HTFs use their own grid when omitted.
+        Frequencies in rad/s.  An `HTFData` uses its own grid when omitted.
     harmonics : sequence of int
         Harmonic indices k to return (default -1, 0, 1).
     omega_limits : (float, float), optional
-        Frequency range of the default grid for model HTFs.
+        Frequency range of the default grid for an `HTFModel` (default
+        ``ω_p/100`` to ``10 K ω_p``, below the Nyquist frequency in
+        discrete time).
     omega_num : int, optional
-        Number of points of the default grid (default 500).
+        Number of points of the default grid (default
+        ``ltp.config.defaults['htf.omega_num']``).
     progress : bool, optional
         Progress bar over long evaluations (default
         ``ltp.config.defaults['htf.progress']``).
@@ -59,8 +62,8 @@ def htf_response(htfs, omega=None, harmonics=(-1, 0, 1), *, omega_limits=None,
         for k in harmonics:
             _harmonic(k, H.nharmonics)
         w = omega
-        if w is None and H.omega is None:
-            w = _grid(H, omega_limits, omega_num)
+        if w is None and not isinstance(H, HTFData):
+            w = default_omega(H, omega_limits, omega_num)
         elif w is not None:
             w = real_array(w, 'omega', ndim=1)
         # one evaluation of the central block row serves every component
@@ -88,7 +91,7 @@ def bode_htf(htfs, omega=None, *fmt, harmonics=(-1, 0, 1), omega_limits=None,
     harmonics : sequence of int
         Components to draw.
     omega_limits, omega_num : optional
-        Default grid for model HTFs (see `htf_response`).
+        Default grid for an `HTFModel` (see `htf_response`).
     plot_phase : bool, optional
         Draw the phase (default `config.defaults['freqplot.plot_phase']`).
     label : list of str, optional
@@ -145,7 +148,7 @@ def htf_map_plot(htf, omega, *, dB=True, ax=None, title=None, cmap='viridis'):
     Parameters
     ----------
     htf : HTF
-        Model HTF (or data HTF with ``ω + nω_p`` on its grid).
+        An `HTFModel` (or an `HTFData` with ``ω + nω_p`` on its grid).
     omega : float
         Base frequency in rad/s.
     dB : bool
@@ -204,15 +207,3 @@ def _htf_list(htfs):
             raise ControlArgument(f"htfs must be HTF objects, got {type(H).__name__}")
     return htfs
 
-
-def _grid(H, limits, num):
-    num = 500 if num is None else check_positive_int(num, 'omega_num', minimum=2)
-    if limits is None:
-        w = H.omega_p
-        limits = (w / 100, 10 * w * max(1, H.nharmonics))
-        if H.dt:
-            limits = (limits[0], min(limits[1], 0.999 * np.pi / H.dt))
-    lo, hi = real_array(limits, 'omega_limits', ndim=1)
-    if not 0 < lo < hi:
-        raise ValueError(f"omega_limits must satisfy 0 < low < high, got {limits}")
-    return np.logspace(np.log10(lo), np.log10(hi), num)

@@ -19,7 +19,7 @@ from control import TimeResponseData
 from control.exception import ControlArgument, ControlDimension
 from scipy.integrate import solve_ivp
 
-from ._validation import check_kwargs, check_positive_int, real_array
+from ._validation import check_positive_int, real_array
 
 __all__ = ['HybridMode', 'HybridPlant', 'simulate_hybrid', 'saltation_matrix']
 
@@ -505,20 +505,26 @@ class _Flow:
         return states, modes
 
 
-def _solver_options(kwargs, where):
-    rtol = kwargs.pop('rtol', 1e-10)
-    atol = kwargs.pop('atol', 1e-12)
-    method = kwargs.pop('method', 'DOP853')
-    max_events = check_positive_int(kwargs.pop('max_events', 10000), 'max_events')
+def _solver_settings(where, rtol=1e-10, atol=1e-12, method='DOP853', max_events=10000):
+    """Checked `solve_ivp` settings of the hybrid integrator (`_Flow`)."""
     for value, label in [(rtol, 'rtol'), (atol, 'atol')]:
-        if not isinstance(value, numbers.Real) or not value > 0:
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) \
+                or not value > 0:
             raise ValueError(f"{where}: {label} must be a positive number, got {value!r}")
     if not isinstance(method, str):
         raise ControlArgument(f"{where}: method must be a solve_ivp method name, got {method!r}")
-    return dict(rtol=float(rtol), atol=float(atol), method=method, max_events=max_events)
+    return dict(rtol=float(rtol), atol=float(atol), method=method,
+                max_events=check_positive_int(max_events, 'max_events'))
 
 
-def simulate_hybrid(plant, timepts, initial_state, mode0=0, inputs=0.0, params=None, **kwargs):
+def _solver_options(kwargs, where):
+    """`_solver_settings` of the solver keywords in `kwargs` (removed from it)."""
+    keys = ('rtol', 'atol', 'method', 'max_events')
+    return _solver_settings(where, **{key: kwargs.pop(key) for key in keys if key in kwargs})
+
+
+def simulate_hybrid(plant, timepts, initial_state, mode0=0, inputs=0.0, params=None, *,
+                    rtol=1e-10, atol=1e-12, method='DOP853', max_events=10000):
     """Simulate a `HybridPlant` with event detection.
 
     Each mode is integrated with `scipy.integrate.solve_ivp` (tight default
@@ -578,8 +584,7 @@ def simulate_hybrid(plant, timepts, initial_state, mode0=0, inputs=0.0, params=N
     >>> resp.modes[:3], resp.states.shape
     (array([0, 0, 0]), (2, 61))
     """
-    opts = _solver_options(kwargs, 'simulate_hybrid')
-    check_kwargs(kwargs, 'simulate_hybrid')
+    opts = _solver_settings('simulate_hybrid', rtol, atol, method, max_events)
     if not isinstance(plant, HybridPlant):
         raise ControlArgument(f"plant must be a HybridPlant, got {type(plant).__name__}")
     timepts = real_array(timepts, 'timepts', ndim=1)

@@ -76,6 +76,15 @@ class HybridLSResult:
         Real equations per state component and rank of the regression matrix.
     residual : float or None
         Relative residual ``‖N v - Y‖ / ‖Y‖`` of eq. 4.21.
+    success : bool
+        True unless the regression was rank deficient (`rank` below
+        `nunknowns`), in which case the estimate is not unique.
+    message : str
+        Description of the outcome.
+    nfev : int
+        0: the estimate is a single least-squares solve.
+
+    The attributes are read-only.
 
     Examples
     --------
@@ -106,10 +115,22 @@ class HybridLSResult:
         if len(self.switching_times) != M:
             raise ControlDimension(f"switching_times must hold M={M} times (one "
                                    f"per mode of A), got {len(self.switching_times)}")
+        A.flags.writeable = B.flags.writeable = False
         self.A, self.B = A, B
         self.nharmonics = nk // 2
         self.nunknowns = M * nk * (n + B.shape[3])
         self.nequations, self.rank, self.residual = nequations, rank, residual
+        self.success = rank is None or rank >= self.nunknowns
+        self.message = ("" if rank is None else
+                        f"rank {rank} of {self.nunknowns} unknowns from {nequations} "
+                        f"equations, relative residual {residual:.3g}")
+        self.nfev = 0
+        self._frozen = True
+
+    def __setattr__(self, key, value):
+        if getattr(self, '_frozen', False):
+            raise AttributeError(f"HybridLSResult is read-only (cannot set {key})")
+        super().__setattr__(key, value)
 
     def __repr__(self):
         M, _, n, _ = self.A.shape
@@ -145,11 +166,16 @@ class HybridLSResult:
                                      times, self.period)
             for coeffs in (self.A, self.B))
 
-    def model(self):
+    def model(self, name=None):
         """Return the identified model as an `LTPStateSpace`.
 
         The state is the output (``C = I``, ``D = 0``); ``A(t)`` and ``B(t)``
         are the switching periodic matrices of `matrices`.
+
+        Parameters
+        ----------
+        name : str, optional
+            Name of the system.
 
         Returns
         -------
@@ -166,11 +192,11 @@ class HybridLSResult:
         """
         n, m = self.A.shape[2], self.B.shape[3]
         At, Bt = self.matrices()
-        return ltpss(At, Bt, np.eye(n), np.zeros((n, m)), self.period)
+        return ltpss(At, Bt, np.eye(n), np.zeros((n, m)), self.period, name=name)
 
 
 def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, *, nconv=None,
-              nshifts=None, excitation_tol=1e-3):
+              nshifts=None, excitation_tol=1e-3, return_info=False, name=None):
     """Identify a switching LTP system from full-state data by least squares.
 
     Estimates the Fourier coefficients of every mode ``A^i(t)``, ``B^i(t)`` of
@@ -216,13 +242,20 @@ def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, *, nconv=None,
         A DFT line of a record is taken as excited when its input amplitude
         exceeds ``excitation_tol`` times the largest input line of that
         record.  Default 1e-3.
+    return_info : bool, optional
+        Also return the estimated coefficients and regression diagnostics.
+    name : str, optional
+        Name of the identified system.
 
     Returns
     -------
-    result : HybridLSResult
-        Estimated coefficients ``result.A`` (M, 2K+1, n, n) and ``result.B``
-        (M, 2K+1, n, m); ``result.matrices()`` and ``result.model()`` give the
-        identified matrices and system.
+    sys : LTPStateSpace
+        Identified model ``x' = A(t) x + B(t) u``, ``y = x`` with switching
+        periodic matrices (`HybridLSResult.model`).
+    info : HybridLSResult
+        Only with ``return_info=True``: the Fourier coefficients ``info.A``
+        (M, 2K+1, n, n) and ``info.B`` (M, 2K+1, n, m), the rank and residual
+        of the regression and scipy's `success`, `message`, `nfev`.
 
     Raises
     ------
@@ -277,9 +310,12 @@ def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, *, nconv=None,
     >>> xs = [solve_ivp(rhs, [0, 20], [0.0], args=(w,), t_eval=t, method="DOP853",
     ...                 rtol=1e-10, atol=1e-12).y for w in ws]
     >>> us = [np.sin(w * t) for w in ws]
-    >>> res = ltp.hybrid_ls([t] * 3, xs, us, T, [0, T / 2], nharmonics=0)
+    >>> sys, res = ltp.hybrid_ls([t] * 3, xs, us, T, [0, T / 2], nharmonics=0,
+    ...                          return_info=True)
     >>> res
     <HybridLSResult: M=2 modes, K=0, n=1, m=1, period=1.0>
+    >>> res.success, sys.nstates
+    (True, 1)
     >>> res.A[:, 0, 0, 0].real.round(3), res.B[:, 0, 0, 0].real.round(3)
     (array([-1., -3.]), array([1., 1.]))
     """
@@ -341,8 +377,10 @@ def hybrid_ls(t, x, u, period, switching_times, nharmonics=1, *, nconv=None,
     M = len(tsw)
     A = _unpack(v[:M * (2 * K + 1) * n], M, K, n)
     B = _unpack(v[M * (2 * K + 1) * n:], M, K, m)
-    return HybridLSResult(A, B, period, tsw, nequations=Phi.shape[0], rank=int(rank),
+    info = HybridLSResult(A, B, period, tsw, nequations=Phi.shape[0], rank=int(rank),
                           residual=float(residual))
+    sys = info.model(name=name)
+    return (sys, info) if return_info else sys
 
 
 #

@@ -20,6 +20,7 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
+from ._interop import original
 from ._ltpsys import LTPStateSpace, _loop_inverse, _period_and_dt, _to_ltp, append
 
 __all__ = ['interconnect']
@@ -96,7 +97,6 @@ def interconnect(syslist, connections=None, inplist=None, outlist=None, **kwargs
                                   "LTP, LTI and static blocks give an LTPStateSpace (use "
                                   "control.interconnect for nonlinear blocks)")
         blocks.append(s)
-    from ._interop import original
     ic = original('interconnect')(blocks, connections=connections, inplist=inplist,
                                   outlist=outlist, **kwargs)
     ltp_blocks = [_to_ltp(s, period, dt) for s in ic.syslist]

@@ -135,10 +135,7 @@ def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, start=
                      states=list(sysd.state_labels))
     harmonics = _harmonics(N, nharmonics)
     consts = [M.is_constant for M in (sysd.A, sysd.B, sysd.C, sysd.D)]
-    A, B, C, D = (_toeplitz(S, harmonics, N, const) for S, const in zip(samples, consts))
-    # z 𝒳 = Λ^{-1}𝒜 𝒳 + Λ^{-1}ℬ 𝒰,  Λ = blkdiag(w^n I)
-    winv = np.repeat(np.exp(-2j * np.pi * harmonics / N), sysd.nstates)[:, np.newaxis]
-    A, B = winv * A, winv * B
+    A, B, C, D = _frequency_lift(samples, harmonics, consts)
     if not real:
         return A, B, C, D
     V, tags = _real_basis(harmonics, N)
@@ -158,10 +155,41 @@ def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, start=
 # Private helpers
 #
 
+def _frequency_lift(samples, harmonics, constant=(False,) * 4):
+    """Complex matrices of the discrete harmonic state space (module notes).
+
+    The one construction of ``z 𝒳 = Λ^{-1}𝒜 𝒳 + Λ^{-1}ℬ 𝒰``, ``𝒴 = 𝒞 𝒳 + 𝒟 𝒰``,
+    shared by `lift` and the discrete-time `htf`.
+
+    Parameters
+    ----------
+    samples : sequence of 4 ndarray, shapes (N, ., .)
+        ``A[k], B[k], C[k], D[k]`` over one period of N steps.
+    harmonics : ndarray of int
+        Harmonic indices, ascending (`_full_harmonics` for the exact model).
+    constant : sequence of 4 bool
+        Which of the matrices are constant (block diagonal Toeplitz).
+
+    Returns
+    -------
+    A, B, C, D : ndarray of complex
+        ``Λ^{-1}𝒜, Λ^{-1}ℬ, 𝒞, 𝒟`` with ``Λ = blkdiag(w^n I)``.
+    """
+    N = samples[0].shape[0]
+    A, B, C, D = (_toeplitz(S, harmonics, N, const) for S, const in zip(samples, constant))
+    winv = np.repeat(np.exp(-2j * np.pi * harmonics / N), samples[0].shape[1])[:, np.newaxis]
+    return winv * A, winv * B, C, D
+
+
+def _full_harmonics(N):
+    """All N harmonics, ascending: -N/2..N/2-1 (even N), -(N-1)/2..(N-1)/2 (odd N)."""
+    return np.arange(-(N // 2), N - N // 2)
+
+
 def _harmonics(N, nharmonics):
     """Harmonic indices kept by the frequency lifting, ascending."""
     if nharmonics is None:
-        return np.arange(-(N // 2), N - N // 2)
+        return _full_harmonics(N)
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
     if 2 * K + 1 > N:
         raise ValueError(f"nharmonics={K} needs 2K+1 <= N = {N} distinct harmonics; "

@@ -13,14 +13,19 @@ with ``A(t + T) = A(t)`` (``A[k + N] = A[k]``) and likewise for B, C, D.
 interconnects with python-control), never an LTI system.
 """
 
+import numbers
+
 import numpy as np
 import control as ct
 from control.exception import ControlArgument, ControlDimension
 from control.iosys import _process_iosys_keywords
 from control.nlsys import NonlinearIOSystem
 
+from ._display import html, text
+from ._htf import htf
 from ._periodic_matrix import PeriodicMatrix, as_periodic
-from ._validation import check_period, commensurate, real_array, steps_per_period
+from ._validation import (as_ltp, check_period, check_positive, commensurate, real_array,
+                          steps_per_period)
 
 __all__ = ['LTPStateSpace', 'ltpss', 'series', 'parallel', 'feedback',
            'append', 'negate']
@@ -63,15 +68,11 @@ class LTPStateSpace(NonlinearIOSystem):
     <LTPStateSpace mathieu: ['u[0]'] -> ['y[0]'], period=6.28319>
     """
 
-    def __init__(self, A, B, C, D, period, **kwargs):
+    def __init__(self, A, B, C, D, period, *, dt=0, **kwargs):
         period = check_period(period)
-        dt = kwargs.pop('dt', 0)
-        if dt is None or dt is True:
-            raise ValueError("dt must be 0 (continuous) or a positive sampling time")
-        if isinstance(dt, (bool, np.bool_)) or not isinstance(dt, (int, float, np.number)) \
-                or not np.isfinite(dt) or dt < 0:
-            raise ValueError(f"dt must be 0 or a positive finite sampling time, got {dt!r}")
-        dt = float(dt)
+        if isinstance(dt, (bool, np.bool_)) or not isinstance(dt, (numbers.Real, np.number)):
+            raise ValueError(f"dt must be 0 (continuous) or a positive sampling time, got {dt!r}")
+        dt = 0.0 if dt == 0 else check_positive(dt, 'dt')
         nsteps = steps_per_period(period, dt) if dt > 0 else None
         A = _system_matrix(A, period, 'A', nsteps)
         n = A.shape[0]
@@ -132,7 +133,6 @@ class LTPStateSpace(NonlinearIOSystem):
         return self._repr_info_()
 
     def __str__(self):
-        from ._display import text
         return text(self)
 
     def _repr_html_(self):
@@ -142,7 +142,6 @@ class LTPStateSpace(NonlinearIOSystem):
         Jupyter uses this form, and None is returned when the system is
         larger than ``ct.config.defaults['statesp.latex_maxsize']``.
         """
-        from ._display import html
         return html(self)
 
     #
@@ -294,7 +293,6 @@ class LTPStateSpace(NonlinearIOSystem):
 
     def htf(self, nharmonics, **kwargs):
         """Harmonic transfer function truncated to K harmonics; see `ltpcontrol.htf`."""
-        from ._htf import htf
         return htf(self, nharmonics, **kwargs)
 
     def sample(self, Ts, method='zoh', alpha=None, prewarp_frequency=None,
@@ -355,7 +353,7 @@ class LTPStateSpace(NonlinearIOSystem):
                              states=self.state_labels)
 
 
-def ltpss(*args, **kwargs):
+def ltpss(*args, period=None, **kwargs):
     """Create a linear time-periodic state-space system.
 
     ``ltpss(A, B, C, D, period[, dt])`` builds ``ẋ = A(t)x + B(t)u,
@@ -414,9 +412,11 @@ def ltpss(*args, **kwargs):
         K = args[0]
         p, m = K.shape
         return LTPStateSpace(np.zeros((0, 0)), np.zeros((0, m)), np.zeros((p, 0)), K,
-                             kwargs.pop('period', K.period), **kwargs)
-    if 'period' in kwargs and len(args) in (1, 4):
-        args = args + (kwargs.pop('period'),)
+                             K.period if period is None else period, **kwargs)
+    if period is not None:
+        if len(args) not in (1, 4):
+            raise ControlArgument("ltpss: period given both by position and by keyword")
+        args = args + (period,)
     if len(args) == 2 and isinstance(args[0], (ct.StateSpace, ct.TransferFunction)):
         lti, period = args
         lti = ct.ss(lti) if isinstance(lti, ct.TransferFunction) else lti
@@ -629,8 +629,7 @@ def negate(sys, **kwargs):
     >>> (-P).D(0.0)
     array([[-0.5]])
     """
-    if not isinstance(sys, LTPStateSpace):
-        raise ControlArgument(f"sys must be an LTPStateSpace, got {type(sys).__name__}")
+    sys = as_ltp(sys)
     kwargs.setdefault('inputs', sys.input_labels)
     kwargs.setdefault('outputs', sys.output_labels)
     kwargs.setdefault('states', sys.state_labels)
@@ -665,7 +664,7 @@ def _system_matrix(M, period, name, nsteps, rows=None, cols=None, zero_ok=False)
         raise ControlDimension(f"{name} must have {cols} columns, got shape {P.shape}")
     if nsteps is not None and not P.is_constant:
         # discrete time: keep the value at t = k dt on [k dt, (k+1) dt)
-        if P._pieces is None or len(P._times) != nsteps:
+        if P.switching_times is None or len(P.switching_times) != nsteps:
             P = PeriodicMatrix.from_samples(P.sample(nsteps), period, kind='hold')
     return P
 

@@ -27,9 +27,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from control.exception import ControlArgument, ControlDimension
 
+from ._floquet import _log_multipliers
 from ._periodic_matrix import PeriodicMatrix, as_periodic
 from ._steps import step_grid, step_integrals
-from ._validation import check_kwargs, real_array
+from ._validation import as_ltp, real_array
 
 __all__ = ['lyap', 'dlyap', 'gram']
 
@@ -181,9 +182,7 @@ def gram(sys, type):
     >>> np.allclose(P(0.7), ct.gram(G, 'c'))
     True
     """
-    from ._ltpsys import LTPStateSpace
-    if not isinstance(sys, LTPStateSpace):
-        raise ControlArgument(f"sys must be an LTPStateSpace, got {sys.__class__.__name__}")
+    sys = as_ltp(sys)
     if type not in ('c', 'o'):
         raise ValueError(f"type must be 'c' or 'o', got {type!r}")
     if not sys.is_stable():
@@ -259,7 +258,6 @@ def check_unique(Phi):
     ...
     ValueError: the periodic Lyapunov equation has no unique periodic solution: two Floquet multipliers satisfy mu_i mu_j = 1 (|mu_i mu_j - 1| = 0.0e+00)
     """
-    from ._floquet import _log_multipliers
     logmod, arg = _log_multipliers(None, None, grid=None, factors=Phi)
     s = logmod[:, None] + logmod[None, :]
     with np.errstate(over='ignore', invalid='ignore'):

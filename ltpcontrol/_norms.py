@@ -27,12 +27,16 @@ import warnings
 
 import numpy as np
 import control as ct
-from control.exception import ControlArgument
+from scipy.optimize import minimize_scalar
 
+from ._floquet import _log_multipliers
+from ._harmonic_ss import _HarmonicStateSpace, _internal_order
+from ._lifting import lift
 from ._lyapunov import cyclic_lyap, periodic_solution
 from ._periodic_matrix import PeriodicMatrix
 from ._steps import gram_weight, step_grid, step_integrals
 from ._transition import step_transitions
+from ._validation import as_ltp
 
 __all__ = ['norm']
 
@@ -92,9 +96,7 @@ def norm(sys, p=2, tol=1e-6, print_warning=True, *, return_frequency=False,
     >>> bool(np.isclose(ltp.norm(sys, 'inf', tol=1e-9), ct.norm(G, 'inf', tol=1e-9)))
     True
     """
-    from ._ltpsys import LTPStateSpace
-    if not isinstance(sys, LTPStateSpace):
-        raise ControlArgument(f"sys must be an LTPStateSpace, got {sys.__class__.__name__}")
+    sys = as_ltp(sys)
     if isinstance(p, str) and p in ('inf', 'hankel'):
         pass
     elif not isinstance(p, (bool, np.bool_, str)) and isinstance(p, (int, np.integer)) \
@@ -152,7 +154,6 @@ def _h2(sys, nsteps, print_warning):
 
 def _require_stable(Phi, p):
     """Raise unless every multiplier of ``Φ_{M-1} ... Φ_0`` has ``|μ| < 1 - 1e-10``."""
-    from ._floquet import _log_multipliers
     logmod, _ = _log_multipliers(None, None, grid=None, factors=Phi)
     if logmod.size and logmod.max() >= np.log1p(-1e-10):
         raise ValueError(f"norm(p={p!r}): the system is unstable; the "
@@ -273,8 +274,6 @@ def _linf_continuous(sys, tol, nsteps):
 
 def _htf_peak(sys):
     """Largest σ_max of the HTF (4 harmonics) over ω ∈ [0, ω_p/2] and its ω."""
-    from scipy.optimize import minimize_scalar
-    from ._htf import _HarmonicStateSpace, _internal_order
     w = sys.omega_p
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')
@@ -333,7 +332,6 @@ def _hamiltonian(sys, gamma, values):
 
 def _unit_circle_angles(sys, gamma, grid, values):
     """Angles of the unit-circle multipliers of H_γ, or None if there are none."""
-    from ._floquet import _log_multipliers
     H = _hamiltonian(sys, gamma, values)
     # the test needs the multipliers' moduli to well below _UNIT only
     Phi, _, _ = step_transitions(H, None, grid[:-1], np.diff(grid), rtol=1e-9)
@@ -352,6 +350,5 @@ def _peak(angles, T):
 
 
 def _linf_discrete(sys, tol):
-    from ._lifting import lift
     value, freq = ct.linfnorm(lift(sys, method='time'), tol)
     return float(value), float(freq)

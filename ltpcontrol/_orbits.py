@@ -19,9 +19,10 @@ from control import NonlinearIOSystem
 from control.exception import ControlArgument, ControlDimension
 
 from ._hybrid import (HybridMode, HybridPlant, _central_jacobian, _constant_input,
-                      _Flow, _params, _solver_options)
+                      _Flow, _params, _solver_settings)
+from ._ltpsys import ltpss
 from ._periodic_matrix import PeriodicMatrix
-from ._validation import check_kwargs, check_period, check_positive_int, real_array
+from ._validation import check_period, check_positive_int, real_array
 
 __all__ = ['PeriodicOrbit', 'periodic_orbit', 'period_map', 'linearize_orbit']
 
@@ -221,7 +222,8 @@ def _prepare(plant, period, x0, mode0, u0, params, jacobian):
     return hp, period, x0, mode0, u0, _params(hp, params)
 
 
-def period_map(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=False, **kwargs):
+def period_map(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=False,
+               rtol=1e-10, atol=1e-12, method='DOP853', max_events=10000):
     """Stroboscopic period map ``x(0) -> x(T)`` of a forced (hybrid) plant.
 
     Parameters
@@ -263,8 +265,7 @@ def period_map(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=Fal
     >>> bool(np.isclose(J[0, 0], np.exp(-2 * np.pi)))
     True
     """
-    opts = _solver_options(kwargs, 'period_map')
-    check_kwargs(kwargs, 'period_map')
+    opts = _solver_settings('period_map', rtol, atol, method, max_events)
     if not isinstance(jacobian, (bool, np.bool_)):
         raise ControlArgument(f"jacobian must be True or False, got {jacobian!r}")
     hp, period, x0, mode0, u0, params = _prepare(plant, period, x0, mode0, u0, params, None)
@@ -277,7 +278,7 @@ def period_map(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=Fal
 
 def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=None,
                    warmup=0, tol=1e-10, max_iter=20, max_periods=200, npoints=200,
-                   **kwargs):
+                   rtol=1e-10, atol=1e-12, method='DOP853', max_events=10000):
     """T-periodic steady state (limit cycle) of a periodically forced plant.
 
     Solves ``P(x) = x`` for the period map ``P`` by Newton's method
@@ -354,8 +355,7 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
     >>> bool(np.allclose(orbit.x0, [0.0, 1.0], atol=1e-9)), orbit.is_stable
     (True, True)
     """
-    opts = _solver_options(kwargs, 'periodic_orbit')
-    check_kwargs(kwargs, 'periodic_orbit')
+    opts = _solver_settings('periodic_orbit', rtol, atol, method, max_events)
     hp, period, x0, mode0, u0, params = _prepare(plant, period, x0, mode0, u0, params, jacobian)
     tol, max_iter, max_periods, warmup, npoints = _shooting_options(
         tol, max_iter, max_periods, warmup, npoints)
@@ -539,8 +539,6 @@ def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, na
     ...                  np.sort(np.abs(orbit.multipliers)), rtol=1e-6))
     True
     """
-    from ._ltpsys import ltpss
-
     hp = _as_hybrid(plant, jacobian)
     _check_orbit_of(orbit, hp, "an LTP model needs at least one input")
     if not isinstance(piecewise_constant, (bool, np.bool_)):

@@ -18,7 +18,9 @@ import numbers
 import warnings
 
 import numpy as np
+from control.exception import ControlDimension
 
+from ._display import describe
 from ._validation import check_period, check_positive_int, commensurate, real_array
 
 __all__ = ['PeriodicMatrix']
@@ -316,6 +318,16 @@ class PeriodicMatrix:
                                                   for o in self._combine[1])
 
     @property
+    def switching_times(self):
+        """Switching instants ``t_1 = 0 < ... < t_M`` of a switching form, else None."""
+        return None if self._pieces is None else np.array(self._times, float)
+
+    @property
+    def is_function(self):
+        """True when the matrix is defined by a smooth callable (`from_function`)."""
+        return self._func is not None
+
+    @property
     def nharmonics(self):
         """Number K of harmonics of an exact Fourier form, else None."""
         return None if self._coeffs is None else self._coeffs.shape[0] // 2
@@ -324,7 +336,6 @@ class PeriodicMatrix:
         if self._coeffs is not None:
             form = f"K={self.nharmonics}"
         elif self._pieces is not None or self._func is not None:
-            from ._display import describe
             form = describe(self)
         else:
             form = "combination"
@@ -655,7 +666,6 @@ def as_periodic(value, period, name, shape=None):
     else:
         value = PeriodicMatrix.constant(_as_matrix(value, name), period)
     if shape is not None and value.shape != tuple(shape):
-        from control.exception import ControlDimension
         raise ControlDimension(f"{name} must have shape {tuple(shape)}, got {value.shape}")
     return value
 

@@ -26,10 +26,10 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
+from ._discretize import sample_system
 from ._floquet import _log_multipliers
-from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix
-from ._validation import real_array
+from ._validation import as_ltp, real_array
 
 __all__ = ['place']
 
@@ -93,8 +93,7 @@ def place(sys, p, step=None, dt=None):
     >>> np.sort(ltp.floquet_multipliers(loop).real).round(8)
     array([-0.2,  0.5])
     """
-    if not isinstance(sys, LTPStateSpace):
-        raise ControlArgument(f"sys must be an LTPStateSpace, got {type(sys).__name__}")
+    sys = as_ltp(sys)
     n = sys.nstates
     p = real_array(p, 'p', ndim=1, allow_complex=True)
     if p.size != n:
@@ -109,7 +108,6 @@ def place(sys, p, step=None, dt=None):
         if dt is None:
             raise ControlArgument("place: a continuous-time plant with time-varying "
                                   "matrices is placed through sampling; give dt")
-        from ._discretize import sample_system
         sysd = sample_system(sys, dt)
         return place(sysd, np.exp(p * sys.period), step=step)
     if dt is not None:

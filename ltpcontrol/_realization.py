@@ -50,20 +50,19 @@ d_{n+1,i} = w^{n} B̂_{(n,i),m} d_{n,i}``.  Method 'pso' is the thesis's
 particle swarm over the real entries of T, refined by Nelder-Mead.
 """
 
-import contextlib
 import numbers
 import warnings
 from dataclasses import dataclass, field
-from unittest import mock
 
 import numpy as np
 import control as ct
 from control.exception import ControlArgument, ControlDimension
 from scipy.optimize import linear_sum_assignment, minimize
+from tqdm.auto import tqdm
 
 from ._lifting import _real_basis, lift
 from ._ltpsys import LTPStateSpace, ltpss
-from ._validation import check_kwargs, check_period, check_positive_int
+from ._validation import check_kwargs, check_period, check_positive, check_positive_int
 
 __all__ = ['floquet_realization', 'FloquetRealization']
 
@@ -133,7 +132,7 @@ class FloquetRealization:
 
 def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct',
                         input_harmonics='all', distance='corrected', tol=1e-4,
-                        fit_tol=0.05, ladder_tol=0.1, seed=None, progress=True, pso_options=None,
+                        fit_tol=0.05, ladder_tol=0.1, seed=None, progress=False, pso_options=None,
                         minimize_options=None, name=None, **kwargs):
     """Floquet-form LTP realization of an identified lifted LTI model.
 
@@ -182,10 +181,9 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
         for `success` (default 0.1; a spectrum without ladders gives O(1)).
         A larger mismatch still gives a realization, flagged unsuccessful.
     seed : int, optional
-        Seed of the swarm ('pso'); the global NumPy random state used by
-        pyswarms is restored afterwards.
+        Seed of the swarm ('pso'); the global NumPy random state is not used.
     progress : bool
-        Show tqdm progress bars during the search ('pso'; default True).
+        Show tqdm progress bars during the search ('pso'; default False).
     pso_options : dict, optional
         'pso' settings: ``iters`` (default 500), ``particles`` (default
         ``n^2``), ``c1`` (0.5), ``c2`` (0.3), ``w`` (0.9) and ``bound``
@@ -251,9 +249,9 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
         raise ValueError(f"method must be 'direct' or 'pso', got {method!r}")
     if distance not in ('corrected', 'literal'):
         raise ValueError(f"distance must be 'corrected' or 'literal', got {distance!r}")
-    tol = _positive(tol, 'tol')
-    fit_tol = _positive(fit_tol, 'fit_tol')
-    ladder_tol = _positive(ladder_tol, 'ladder_tol')
+    tol = check_positive(tol, 'tol')
+    fit_tol = check_positive(fit_tol, 'fit_tol')
+    ladder_tol = check_positive(ladder_tol, 'ladder_tol')
     if not isinstance(progress, (bool, np.bool_)):
         raise ControlArgument(f"progress must be True or False, got {progress!r}")
     if seed is not None and (isinstance(seed, (bool, np.bool_))
@@ -686,19 +684,32 @@ def _options(given, name, defaults):
     return {**defaults, **given}
 
 
-@contextlib.contextmanager
-def _quiet_pyswarms():
-    """Keep pyswarms from reconfiguring the root logger and writing report.log."""
-    with mock.patch('logging.config.dictConfig'):
-        yield
+def _swarm(cost, dim, pso, rng, progress):
+    """Global-best particle swarm in ``[-bound, bound]^dim``: best cost and position.
+
+    Velocities follow ``v <- w v + c1 r1 (p - x) + c2 r2 (g - x)`` with
+    uniform ``r1, r2`` per coordinate, ``p`` each particle's best and ``g``
+    the swarm's best position; positions are clipped to the box.
+    """
+    nparticles, bound = int(pso['particles']), float(pso['bound'])
+    x = rng.uniform(-bound, bound, (nparticles, dim))
+    v = rng.uniform(-bound, bound, (nparticles, dim)) * 0.1
+    pbest, pcost = x.copy(), cost(x)
+    for _ in tqdm(range(int(pso['iters'])), desc='particle swarm', disable=not progress,
+                  leave=False):
+        g = pbest[np.argmin(pcost)]
+        r1, r2 = rng.random((2, nparticles, dim))
+        v = pso['w'] * v + pso['c1'] * r1 * (pbest - x) + pso['c2'] * r2 * (g - x)
+        x = np.clip(x + v, -bound, bound)
+        c = cost(x)
+        better = c < pcost
+        pbest[better], pcost[better] = x[better], c[better]
+    i = np.argmin(pcost)
+    return float(pcost[i]), pbest[i]
 
 
 def _pso_transform(problem, literal, seed, progress, pso, nm):
     """Best T found by the swarm and Nelder-Mead, and the number of evaluations."""
-    from tqdm.auto import tqdm
-    with _quiet_pyswarms():
-        import pyswarms as ps
-
     n = problem.H * problem.nx
     nfev = 0
 
@@ -714,18 +725,7 @@ def _pso_transform(problem, literal, seed, progress, pso, nm):
                                         nan=_SINGULAR_COST, posinf=_SINGULAR_COST)
         return out
 
-    bound = float(pso['bound'])
-    state = np.random.get_state()
-    try:
-        np.random.seed(np.random.default_rng(seed).integers(2 ** 32))
-        with _quiet_pyswarms():
-            opt = ps.single.GlobalBestPSO(
-                n_particles=int(pso['particles']), dimensions=n * n,
-                options={'c1': pso['c1'], 'c2': pso['c2'], 'w': pso['w']},
-                bounds=(-bound * np.ones(n * n), bound * np.ones(n * n)))
-            best, x = opt.optimize(cost, iters=int(pso['iters']), verbose=progress)
-    finally:
-        np.random.set_state(state)
+    best, x = _swarm(cost, n * n, pso, np.random.default_rng(seed), progress)
     bar = tqdm(total=int(nm.get('maxfev', 0)) or None, desc='Nelder-Mead',
                disable=not progress, leave=False)
 
@@ -737,12 +737,3 @@ def _pso_transform(problem, literal, seed, progress, pso, nm):
         res = minimize(scalar, x, method='Nelder-Mead', options=nm)
     x = res.x if res.fun <= best else x
     return x.reshape(n, n), nfev
-
-
-def _positive(value, name):
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.number)):
-        raise ControlArgument(f"{name} must be a real number, got {value!r}")
-    value = float(value)
-    if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"{name} must be positive and finite, got {value}")
-    return value

@@ -46,7 +46,7 @@ import scipy.optimize
 import scipy.sparse as sp
 from control.exception import ControlArgument, ControlDimension
 
-from ._htf import HTF
+from ._htf import HTF, HTFData
 from ._lifting import _real_basis
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix
@@ -136,7 +136,7 @@ def _data_points(data, period, ny, nu, std=None):
         raise ControlArgument("std applies to lifted frequency-response data; an HTF "
                               "carries its own std")
     if isinstance(data, HTF):
-        if data.omega is None:
+        if not isinstance(data, HTFData):
             raise ControlArgument("data must be a data HTF (from estimate_htf) or lifted "
                                   "frequency-response data, got a model HTF")
         if not np.isclose(data.period, period, rtol=1e-9, atol=0):

@@ -54,7 +54,7 @@ from ._floquet import _log_multipliers, chebyshev_nodes, piecewise_chebyshev
 from ._periodic_matrix import PeriodicMatrix, as_periodic
 from ._steps import step_grid
 from ._transition import step_transitions
-from ._validation import real_array
+from ._validation import check_period, real_array
 
 __all__ = ['care', 'dare']
 
@@ -448,7 +448,6 @@ def _period_of(args, period):
             if isinstance(M, PeriodicMatrix):
                 return M.period
         raise ControlArgument("period must be given when no argument is a PeriodicMatrix")
-    from ._validation import check_period
     return check_period(period)
 
 

@@ -14,10 +14,13 @@ that names the offending argument.  There is one helper per concept:
 """
 
 import numbers
+from fractions import Fraction
 
 import control as ct
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
+
+from .config import _get
 
 __all__ = []
 
@@ -52,7 +55,7 @@ def as_ltp(sys, name="sys", *, period=None, discrete=None, lti_hint=None):
     >>> as_ltp(ct.ss(-1, 1, 1, 0), lti_hint='control.forced_response')
     Traceback (most recent call last):
     ...
-    control.exception.ControlArgument: sys is an LTI system: use control.forced_response, or convert it with ltpss(sys, period)
+    control.exception.ControlArgument: sys must be an LTPStateSpace; it is an LTI system: use control.forced_response, or convert it with ltpss(sys, period)
     """
     # _ltpsys imports this module: the system class is looked up at call time
     from ._ltpsys import LTPStateSpace, ltpss
@@ -63,8 +66,8 @@ def as_ltp(sys, name="sys", *, period=None, discrete=None, lti_hint=None):
     elif isinstance(sys, (ct.StateSpace, ct.TransferFunction)):
         if period is None:
             use = f"use {lti_hint}, or " if lti_hint else ""
-            raise ControlArgument(f"{name} is an LTI system: {use}convert it with "
-                                  "ltpss(sys, period)")
+            raise ControlArgument(f"{name} must be an LTPStateSpace; it is an LTI system: "
+                                  f"{use}convert it with ltpss(sys, period)")
         sys = ltpss(sys, check_period(period))
     else:
         raise ControlArgument(f"{name} must be an LTPStateSpace, got {type(sys).__name__}")
@@ -213,8 +216,6 @@ def commensurate(a, b, rtol=None, max_multiple=None):
     >>> commensurate(1.0, 1.5)
     3.0
     """
-    from fractions import Fraction
-    from .config import _get
     rtol, qmax = _get('period.rtol', rtol), _get('period.max_multiple', max_multiple)
     ratio = a / b
     frac = Fraction(ratio).limit_denominator(int(qmax))

@@ -18,9 +18,11 @@ step as ``ρ = μ^{1/N}`` (principal root) like the poles
 
 import numpy as np
 import scipy.linalg as la
-from control.exception import ControlArgument, ControlDimension
+from control.exception import ControlDimension
 
-from ._validation import check_positive_int
+from ._harmonic_ss import _toeplitz
+from ._lifting import lift
+from ._validation import as_ltp, check_positive_int
 
 __all__ = ['zeros']
 
@@ -69,9 +71,7 @@ def zeros(sys, nharmonics=None, *, rtol=1e-8):
     >>> bool(np.allclose(ct.zeros(sys), z))      # python-control dispatches here
     True
     """
-    from ._ltpsys import LTPStateSpace
-    if not isinstance(sys, LTPStateSpace):
-        raise ControlArgument(f"sys must be an LTPStateSpace, got {sys.__class__.__name__}")
+    sys = as_ltp(sys)
     if sys.ninputs != sys.noutputs:
         raise ControlDimension(f"zeros: the system must be square, got {sys.noutputs} "
                                f"outputs and {sys.ninputs} inputs")
@@ -101,7 +101,6 @@ def _bandwidth(M):
 
 def _harmonic_zeros(sys, K):
     """Finite pencil eigenvalues of truncation K in the central strip."""
-    from ._htf import _toeplitz
     n, m = sys.nstates, sys.ninputs
     w = sys.omega_p
     T = [_toeplitz(M.fourier(2 * K), K) for M in (sys.A, sys.B, sys.C, sys.D)]
@@ -118,7 +117,6 @@ def _harmonic_zeros(sys, K):
 
 
 def _discrete(sys):
-    from ._lifting import lift
     L = lift(sys, method='time')
     n = L.nstates
     pencil = np.block([[L.A, L.B], [L.C, L.D]])

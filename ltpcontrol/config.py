@@ -7,6 +7,9 @@
     `bode_htf` and `htf_response` split the frequency axis into chunks
     that fit; a request whose fixed part (the harmonic state space and its
     factorisation) does not fit is refused with the estimated size.
+``htf.omega_num`` : int, default 500
+    Number of points of the default frequency grid of a model HTF
+    (`htf_response`, `bode_htf`, `HTF.components`).
 ``htf.progress`` : bool, default False
     Show a progress bar over the frequency chunks of long evaluations.
 ``period.max_multiple`` : int, default 100
@@ -30,6 +33,7 @@ __all__ = ['defaults', 'set_defaults', 'reset_defaults', 'defaults_context']
 
 _DEFAULTS = {
     'htf.max_memory': 1e9,
+    'htf.omega_num': 500,
     'htf.progress': False,
     'period.max_multiple': 100,
     'period.rtol': 1e-9,

@@ -54,7 +54,7 @@ OMEGA = np.linspace(0.5, 10.0, 20)
 G_DATA = np.zeros((3, 1, 1, OMEGA.size), complex)
 G_DATA[1, 0, 0] = 1 / (1j * OMEGA + 1)
 G_DATA[0, 0, 0] = G_DATA[2, 0, 0] = 0.1 / (1j * OMEGA + 2)
-H_DATA = ltp.HTF(G_DATA, OMEGA, T)
+H_DATA = ltp.HTFData(G_DATA, OMEGA, T)
 BALL = ltp.HybridPlant([ltp.HybridMode(
     lambda t, x, u, p: [x[1], -9.81], guard=lambda t, x, u, p: x[0],
     reset=lambda t, x, u, p: [x[0], -0.8 * x[1]], target=0)], states=['h', 'v'])
@@ -214,6 +214,7 @@ _RESULT_CLASSES |= {'ClosedLoopOrbit'}
 _RESULT_CLASSES |= {'OrbitBranch', 'Bifurcation'}
 _RESULT_CLASSES |= {'LMIDesign'}
 _RESULT_CLASSES |= {'RefineInfo', 'MonteCarloResult'}
+_RESULT_CLASSES |= {'HTFEstimateInfo'}
 
 DOC_DEFECTS = {}
 
@@ -347,7 +348,7 @@ def _representative_slice():
     ltp.floquet_exponents(sys), ltp.monodromy(sys), ltp.is_stable(sys)
     ltp.floquet_transform(sys)
     H = ltp.htf(sys, 2)
-    H(0.5j), H.components([1.0, 2.0]), H.to_frd([1.0]), H.predict(u[:100], t[:100])
+    H(0.5j), H.components([1.0, 2.0]), H.to_frd([1.0]), H.predict(t[:100], u[:100])
     ltp.htf(damped_mathieu(), 1)
     ltp.bode_htf(H, omega_num=20)
     ltp.htf_map_plot(H, 1.0)
@@ -369,9 +370,8 @@ def _representative_slice():
     ltp.e_rms(u, 1.01 * u), ltp.nrmse(u, 1.01 * u)
     G = ct.ss([[0.6, 0.3], [-0.3, 0.6]], [[1.0], [0.0]], [[1.0, 1.0]], [[0.5]], 0.1)
     ltp.fdsubspace(ct.frd(G, np.linspace(0.5, 30, 30)))
-    res = ltp.hybrid_ls(T_LS, np.sin(6 * np.pi * T_LS), np.cos(6 * np.pi * T_LS), T, [0.0],
-                        0, nshifts=1)
-    res.model()
+    ltp.hybrid_ls(T_LS, np.sin(6 * np.pi * T_LS), np.cos(6 * np.pi * T_LS), T, [0.0],
+                  0, nshifts=1)
 
 
 def test_representative_slice_emits_no_warnings():

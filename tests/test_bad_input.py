@@ -74,7 +74,7 @@ OMEGA = np.linspace(0.5, 10.0, 20)
 G_DATA = np.zeros((3, 1, 1, OMEGA.size), complex)
 G_DATA[1, 0, 0] = 1 / (1j * OMEGA + 1)
 G_DATA[0, 0, 0] = G_DATA[2, 0, 0] = 0.1 / (1j * OMEGA + 2)
-H_DATA = ltp.HTF(G_DATA, OMEGA, T, name='data')
+H_DATA = ltp.HTFData(G_DATA, OMEGA, T, name='data')
 
 
 def _pm(coeffs, period=T):
@@ -336,24 +336,29 @@ CATALOGUE = [
     ('htf-eval-at-pole', lambda: H_POLE(0.0), VE, 'pole'),
     ('htf-component-out-of-range', lambda: H.component(5), VE, 'harmonic index k'),
     ('htf-component-float', lambda: H.component(0.5), CA, 'k must be an integer'),
-    ('htf-predict-shape', lambda: H.predict(np.ones((2, 100)), np.arange(100) * 0.01),
-     CD, 'u must have shape'),
+    ('htf-predict-shape', lambda: H.predict(np.arange(100) * 0.01, np.ones((2, 100))),
+     CD, 'inputs must have shape'),
     ('htf-predict-fractional-periods',
-     lambda: H.predict(np.ones(150), np.arange(150) * 0.01), VE, 'integer number of periods'),
-    ('htf-predict-nonuniform', lambda: H.predict(np.ones(3), [0.0, 0.1, 1.0]), VE, 't must'),
-    ('HTF-components-3d', _call(ltp.HTF, np.ones((3, 1, 4)), np.arange(1, 5.0), T), CD,
+     lambda: H.predict(np.arange(150) * 0.01, np.ones(150)), VE, 'integer number of periods'),
+    ('htf-predict-nonuniform', lambda: H.predict([0.0, 0.1, 1.0], np.ones(3)), VE,
+     'timepts must'),
+    ('htf-predict-old-order', lambda: H.predict(np.sin(np.arange(100) * 0.01),
+                                                np.arange(100) * 0.01), VE, 'order'),
+    ('HTF-is-an-interface', _call(ltp.HTF, np.ones((3, 1, 1, 3)), [1.0, 2.0, 3.0], T), TE,
+     'HTF'),
+    ('HTF-components-3d', _call(ltp.HTFData, np.ones((3, 1, 4)), np.arange(1, 5.0), T), CD,
      'components'),
-    ('HTF-even-harmonics', _call(ltp.HTF, np.ones((2, 1, 1, 4)), np.arange(1, 5.0), T), CD,
+    ('HTF-even-harmonics', _call(ltp.HTFData, np.ones((2, 1, 1, 4)), np.arange(1, 5.0), T), CD,
      'components'),
-    ('HTF-omega-length', _call(ltp.HTF, np.ones((3, 1, 1, 4)), np.arange(1, 4.0), T), CD,
+    ('HTF-omega-length', _call(ltp.HTFData, np.ones((3, 1, 1, 4)), np.arange(1, 4.0), T), CD,
      'omega'),
-    ('HTF-omega-decreasing', _call(ltp.HTF, np.ones((3, 1, 1, 3)), [3.0, 2.0, 1.0], T), VE,
+    ('HTF-omega-decreasing', _call(ltp.HTFData, np.ones((3, 1, 1, 3)), [3.0, 2.0, 1.0], T), VE,
      'omega'),
-    ('HTF-period-zero', _call(ltp.HTF, np.ones((3, 1, 1, 3)), [1.0, 2.0, 3.0], 0.0), VE,
+    ('HTF-period-zero', _call(ltp.HTFData, np.ones((3, 1, 1, 3)), [1.0, 2.0, 3.0], 0.0), VE,
      'period'),
-    ('HTF-std-shape', _call(ltp.HTF, np.ones((3, 1, 1, 3)), [1.0, 2.0, 3.0], T,
+    ('HTF-std-shape', _call(ltp.HTFData, np.ones((3, 1, 1, 3)), [1.0, 2.0, 3.0], T,
                             std=np.ones((3, 1, 1, 2))), CD, 'std'),
-    ('HTF-input-names', _call(ltp.HTF, np.ones((3, 1, 1, 3)), [1.0, 2.0, 3.0], T,
+    ('HTF-input-names', _call(ltp.HTFData, np.ones((3, 1, 1, 3)), [1.0, 2.0, 3.0], T,
                               inputs=['a', 'b']), CD, 'inputs'),
     ('data-htf-off-axis', lambda: H_DATA(1.0 + 1.0j), VE, 'imaginary axis'),
     ('data-htf-off-grid', lambda: H_DATA.component(0, [0.123]), VE, 'omega'),

@@ -5,7 +5,7 @@ import pytest
 from control.exception import ControlArgument
 
 from ltpcontrol._excitation import chirp_replicas, multisine, sine_experiments
-from ltpcontrol._htf_estimate import _estimate
+from ltpcontrol._htf_estimate import estimate_htf
 from test_htf_estimate import ScalarLTP
 
 
@@ -160,8 +160,8 @@ def test_multisine_experiments_identify_htf():
     records = [(exc.time, exc.inputs[r], system.simulate(lambda s: exc.signal(s)[r],
                                                           exc.time)[0])
                for r in range(5)]
-    est = _estimate(records, 1.0, 1, segments=exc.segments)
+    est = estimate_htf(records, 1.0, 1, segments=exc.segments)
     bins = np.round(est.omega / (2 * np.pi / 8)).astype(int)
     assert np.all(bins % 4 != 0) and est.omega.size >= 12
     true = system.htf(est.omega, 1)
-    assert np.max(np.abs(est.components - true) / np.abs(true)) < 0.02
+    assert np.max(np.abs(est.components()[1] - true) / np.abs(true)) < 0.02

@@ -353,3 +353,13 @@ def test_bad_timescale():
         fdsubspace(G, omega, order=1, timescale=-1.0)
     with pytest.raises(ControlArgument, match="timescale"):
         fdsubspace(G, omega, order=1, timescale="fast")
+
+
+def test_info_uses_optimize_result_vocabulary():
+    # the diagnostics answer as scipy's OptimizeResult does, and cannot be altered
+    import dataclasses
+    data = ct.frd(ct.ss([[0.5]], [[1.0]], [[1.0]], [[0.0]], True), np.linspace(0.1, 3, 20))
+    _, info = fdsubspace(data, order=1, return_info=True)
+    assert info.success is True and info.nfev == 0 and 'order-1' in info.message
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        info.order = 2

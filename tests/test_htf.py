@@ -54,9 +54,9 @@ def test_lti_limit_is_shifted_diagonal():
     wp = 2 * np.pi / T
     for a, n in enumerate(range(-3, 4)):
         for b in range(7):
-            blk = M[:, 2 * a:2 * a + 2, 2 * b:2 * b + 2]
-            expected = (np.moveaxis(G(s + 1j * n * wp), -1, 0) if a == b
-                        else np.zeros_like(blk))
+            # frequency last, as in python-control: G(s) is (ny, nu, len(s))
+            blk = M[2 * a:2 * a + 2, 2 * b:2 * b + 2]
+            expected = G(s + 1j * n * wp) if a == b else np.zeros_like(blk)
             np.testing.assert_allclose(blk, expected, rtol=1e-12, atol=1e-12)
 
 
@@ -69,14 +69,14 @@ def test_component_convention_and_shift_property():
     M = H(1j * w)
     for k in range(-K, K + 1):
         # G_k(s) = H_{0,-k}(s)
-        np.testing.assert_allclose(G[k + K, 0, 0], M[:, K, K - k], atol=1e-14)
+        np.testing.assert_allclose(G[k + K, 0, 0], M[K, K - k], atol=1e-14)
     # H_{n,m}(s) = G_{n-m}(s + jnω_p)
     n, m = 1, -1
     _, Gs = H.components(w + n * sys.omega_p)
-    np.testing.assert_allclose(M[:, n + K, m + K], Gs[n - m + K, 0, 0], rtol=1e-8)
+    np.testing.assert_allclose(M[n + K, m + K], Gs[n - m + K, 0, 0], rtol=1e-8)
     # real system: G_k(-jω) = conj(G_{-k}(jω))
     neg = H(-1j * w)
-    np.testing.assert_allclose(neg[:, K, K - 1], np.conj(M[:, K, K + 1]), atol=1e-13)
+    np.testing.assert_allclose(neg[K, K - 1], np.conj(M[K, K + 1]), atol=1e-13)
 
 
 def test_modal_and_dense_solves_agree():
@@ -111,7 +111,7 @@ def test_predict_equals_simulated_steady_state():
     u = np.cos(2 * np.pi * 0.7 * t) + 0.5 * np.sin(2 * np.pi * 1.3 * t)
     y = ltp.forced_response(sys, t, u).y[0]
     window = t >= 20
-    yp = H.predict(u[window], t[window] - 20)
+    yp = H.predict(t[window] - 20, u[window])
     # agreement up to the input-hold effect (sinc² ≈ 1 - 2e-4 at 1.3 Hz)
     assert np.abs(yp - y[window]).max() <= 1e-3 * np.abs(y).max()
 
@@ -121,7 +121,7 @@ def test_data_htf_round_trip_and_frd():
     model = ltp.htf(sys, 2)
     w = np.linspace(0.5, 40, 80)
     _, G = model.components(w)
-    data = ltp.HTF(G, w, sys.period, name='data')
+    data = ltp.HTFData(G, w, sys.period, name='data')
     np.testing.assert_allclose(data.component(1).frdata, model.component(1, w).frdata)
     frd = data.to_frd()
     assert frd.ninputs == 5 and frd.noutputs == 1
@@ -140,7 +140,7 @@ def test_bode_htf_control_plot_and_defaults():
     # overlay of two HTFs with a legend
     w = np.logspace(-1, 2, 40)
     _, G = H.components(w)
-    est = ltp.HTF(G * 1.01, w, H.period, name='estimate')
+    est = ltp.HTFData(G * 1.01, w, H.period, name='estimate')
     cplt = ltp.bode_htf([H, est], w)
     labels = [t.get_text() for t in cplt.legend[0, 0].get_texts()] if cplt.legend.ndim == 2 \
         else [t.get_text() for t in cplt.legend[0].get_texts()]
@@ -156,14 +156,14 @@ def test_bode_htf_control_plot_and_defaults():
     (lambda: ltp.htf(mathieu(), 2, internal_harmonics=1), ValueError, "internal_harmonics"),
     (lambda: ltp.htf(mathieu(), 2, method='fast'), ValueError, "method"),
     (lambda: ltp.htf(ct.rss(2), 2), ControlArgument, "period"),
-    (lambda: ltp.htf(mathieu(), 2, foo=3), TypeError, "unrecognized"),
+    (lambda: ltp.htf(mathieu(), 2, foo=3), TypeError, "unexpected keyword"),
     (lambda: ltp.htf(ltp.ltpss([[0.5]], [[1]], [[1]], 0, period=1.0, dt=0.25), 2),
      ValueError, "nharmonics"),
-    (lambda: ltp.htf(mathieu(), 1).predict(np.ones(10), np.arange(10) * 0.01), ValueError,
+    (lambda: ltp.htf(mathieu(), 1).predict(np.arange(10) * 0.01, np.ones(10)), ValueError,
      "integer number of periods"),
-    (lambda: ltp.HTF(np.ones((2, 1, 1, 3)), [1, 2, 3], 1.0), ControlDimension, "2K\\+1"),
-    (lambda: ltp.HTF(np.ones((3, 1, 1, 3)), [1, 3, 2], 1.0), ValueError, "increasing"),
-    (lambda: ltp.HTF(np.ones((3, 1, 1, 3)), [1, 2, 3], 1.0).component(0, [1.5]), ValueError,
+    (lambda: ltp.HTFData(np.ones((2, 1, 1, 3)), [1, 2, 3], 1.0), ControlDimension, "2K\\+1"),
+    (lambda: ltp.HTFData(np.ones((3, 1, 1, 3)), [1, 3, 2], 1.0), ValueError, "increasing"),
+    (lambda: ltp.HTFData(np.ones((3, 1, 1, 3)), [1, 2, 3], 1.0).component(0, [1.5]), ValueError,
      "subset"),
 ])
 def test_bad_input(call, exc, match):
@@ -185,14 +185,55 @@ def test_data_htf_marks_unidentified_components_with_nan():
     w = 2 * np.pi * np.arange(1, 40) / 4          # grid of a 4 s record
     _, G = model.components(w)
     G[2, :, :, w > 20] = np.nan                   # G_1 not identified above 20 rad/s
-    data = ltp.HTF(G, w, 1.0)
+    data = ltp.HTFData(G, w, 1.0)
     t = np.arange(400) * 0.01
     low = np.cos(2 * np.pi * 0.5 * t)             # excites only identified terms
     with warnings.catch_warnings():
         warnings.simplefilter('error')
-        np.testing.assert_allclose(data.predict(low, t), model.predict(low, t), atol=1e-12)
+        np.testing.assert_allclose(data.predict(t, low), model.predict(t, low), atol=1e-12)
     high = np.cos(2 * np.pi * 3.5 * t)            # ω = 22 rad/s needs G_1 there
     with pytest.warns(UserWarning, match="did not identify"):
-        data.predict(high, t)
+        data.predict(t, high)
     with pytest.raises(ValueError, match="inf"):
-        ltp.HTF(np.where(np.isnan(G), np.inf, G), w, 1.0)
+        ltp.HTFData(np.where(np.isnan(G), np.inf, G), w, 1.0)
+
+
+def test_models_and_data_are_two_classes_behind_one_interface():
+    sys = mathieu()
+    H = ltp.htf(sys, 2)
+    assert type(H) is ltp.HTFModel and isinstance(H, ltp.HTF)
+    w = np.linspace(0.5, 5, 10)
+    direct = ltp.HTFModel(sys, 2)
+    np.testing.assert_array_equal(direct(1j * w), H(1j * w))
+    data = ltp.HTFData(H.components(w)[1], w, sys.period)
+    assert isinstance(data, ltp.HTF) and not isinstance(data, ltp.HTFModel)
+    np.testing.assert_allclose(data.to_frd().frdata, H.to_frd(w).frdata, rtol=1e-14)
+    # the period of an LTI system is an explicit keyword, refused for an LTP system
+    G = ct.rss(2, 1, 1)
+    np.testing.assert_allclose(ltp.htf(G, 1, period=2.0)(0.3j),
+                               ltp.htf(ltp.ltpss(G, 2.0), 1)(0.3j), rtol=1e-14)
+    with pytest.raises(TypeError, match="period"):
+        ltp.htf(sys, 1, period=2.0)
+
+
+def test_default_grid_is_one_setting():
+    H = ltp.htf(mathieu(), 1)
+    with ltp.config.defaults_context({'htf.omega_num': 37}):
+        w, G = H.components()
+        resp = ltp.htf_response(H)[0][0]
+    assert w.size == G.shape[-1] == 37
+    np.testing.assert_array_equal(resp.omega, w)
+    assert w[0] == pytest.approx(H.omega_p / 100) and w[-1] == pytest.approx(10 * H.omega_p)
+    # discrete time: the same grid, below the Nyquist frequency
+    Hd = ltp.htf(ltp.sample_system(mathieu(), 0.05), 1)
+    wd, _ = Hd.components()
+    assert wd.size == ltp.config.defaults['htf.omega_num'] and wd[-1] < np.pi / 0.05
+
+
+def test_predict_in_the_old_order_is_refused():
+    H = ltp.htf(mathieu(), 1)
+    t = np.arange(200) * 0.01
+    u = np.cos(2 * np.pi * t)
+    with pytest.raises(ValueError, match="order"):
+        H.predict(u, t)
+    np.testing.assert_array_equal(H.predict(timepts=t, inputs=u), H.predict(t, u))

@@ -9,17 +9,27 @@ K = 20 (central block row, ``G_k = H_{0,-k}``).
 """
 
 import warnings
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from control.exception import ControlArgument, ControlDimension
 
 from ltpcontrol._excitation import chirp_replicas
-from ltpcontrol._htf import HTF
-from ltpcontrol._htf_estimate import HTFEstimate, _estimate, estimate_htf
+from ltpcontrol._htf import HTFData
+from ltpcontrol._htf_estimate import HTFEstimateInfo, estimate_htf
 from ltpcontrol._metrics import e_rms, nrmse
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
+
+
+def estimate_arrays(*args, **kwargs):
+    """`estimate_htf` as arrays: components, omega, std (NaN without dof) and the info."""
+    H, info = estimate_htf(*args, return_info=True, **kwargs)
+    assert isinstance(H, HTFData) and isinstance(info, HTFEstimateInfo)
+    omega, G = H.components()
+    std = np.full(G.shape, np.nan) if H.std is None else H.std
+    return SimpleNamespace(components=G, omega=omega, std=std, **vars(info))
 
 
 class ScalarLTP:
@@ -105,8 +115,8 @@ def test_simulator_matches_harmonic_balance():
 
 def test_replicas_noise_free_match_truth(replica_data):
     system, exc, y = replica_data
-    est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments)
-    assert isinstance(est, HTFEstimate)
+    est = estimate_arrays((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments)
+    assert est.success
     assert est.components.shape == (5, 1, 1, est.omega.size)
     assert est.identified.all()                       # default: fully excited band
     assert est.omega[0] == 0 and est.omega[-1] > 2 * np.pi * 2.5
@@ -124,7 +134,7 @@ def test_reported_std_covers_errors(replica_data):
     rng = np.random.default_rng(7)
     sigma = 0.01
     noisy = y + sigma * rng.standard_normal(y.size)
-    est = _estimate((exc.time, exc.inputs, noisy), 1.0, 2, segments=exc.segments)
+    est = estimate_arrays((exc.time, exc.inputs, noisy), 1.0, 2, segments=exc.segments)
     # noise variance of one DFT coefficient: dt · T_w · σ²
     assert est.noise_var[0] == pytest.approx(0.01 * 29 * sigma ** 2, rel=0.2)
     z = np.abs(est.components - system.htf(est.omega, 2)) / est.std
@@ -137,14 +147,15 @@ def test_too_few_replicas_warns_ill_conditioned(replica_data):
     system, exc, y = replica_data
     # five copies of one window (same cycle phase) cannot separate five components
     with pytest.warns(UserWarning, match="ill-conditioned"):
-        est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments[[0] * 5])
+        est = estimate_arrays((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments[[0] * 5])
     assert np.min(est.cond) > 1e8 and np.all(np.isfinite(est.components))
+    assert not est.success and "ill-conditioned" in est.message
 
 
 def test_large_alpha_gives_straight_lines(single_record):
     system, exc, y = single_record
     lim = (2 * np.pi * 1.5, 2 * np.pi * 2.5)
-    est = _estimate((exc.time, exc.inputs, y), 1.0, 1, alpha=1e10, omega_limits=lim)
+    est = estimate_arrays((exc.time, exc.inputs, y), 1.0, 1, alpha=1e10, omega_limits=lim)
     g = est.components[:, 0, 0]
     assert np.max(np.abs(np.diff(g, 2, axis=-1))) < 1e-8 * np.max(np.abs(g))
     # independent truth: least squares over affine components a_k + b_k ω
@@ -163,8 +174,8 @@ def test_gcv_beats_unregularised_single_record(single_record):
     system, exc, y = single_record
     lim = (2 * np.pi * 1.2, 2 * np.pi * 2.8)
     data = (exc.time, exc.inputs, y)
-    raw = _estimate(data, 1.0, 1, alpha=1e-9, omega_limits=lim)
-    gcv = _estimate(data, 1.0, 1, alpha='gcv', omega_limits=lim, progress=False)
+    raw = estimate_arrays(data, 1.0, 1, alpha=1e-9, omega_limits=lim)
+    gcv = estimate_arrays(data, 1.0, 1, alpha='gcv', omega_limits=lim, progress=False)
     assert 1e-6 < gcv.alpha < 1e6
     true = system.htf(gcv.omega, 1)
     err_raw = np.median(np.abs(raw.components - true) / np.abs(true), axis=-1)
@@ -186,7 +197,7 @@ def test_mimo_two_inputs_two_outputs():
     sig = lambda s: np.stack([exc.signal(s), u2(s)])
     y = system.simulate(sig, t)
     segs = np.vstack([exc.segments, exc.segments + exc.time.size])
-    est = _estimate((t, sig(t), y), 1.0, 1, segments=segs)
+    est = estimate_arrays((t, sig(t), y), 1.0, 1, segments=segs)
     assert est.components.shape[:3] == (3, 2, 2)
     true = system.htf(est.omega, 1)
     assert np.max(np.abs(est.components - true)) < 0.01 * np.max(np.abs(true))
@@ -196,8 +207,8 @@ def test_time_response_data_input(replica_data):
     import control as ct
     system, exc, y = replica_data
     resp = ct.TimeResponseData(exc.time, y, inputs=exc.inputs)
-    a = _estimate(resp, 1.0, 1, segments=exc.segments)
-    b = _estimate([(exc.time, exc.inputs, y)], 1.0, 1, segments=exc.segments)
+    a = estimate_arrays(resp, 1.0, 1, segments=exc.segments)
+    b = estimate_arrays([(exc.time, exc.inputs, y)], 1.0, 1, segments=exc.segments)
     assert np.allclose(a.components, b.components)
 
 
@@ -205,7 +216,7 @@ def test_time_origin_is_phase_reference(replica_data):
     # relabelling time t -> t + τ shifts the cycle phase: G'_k = G_k e^{-jkω_p τ}
     system, exc, y = replica_data
     tau = 0.3
-    est = _estimate((exc.time + tau, exc.inputs, y), 1.0, 2, segments=exc.segments)
+    est = estimate_arrays((exc.time + tau, exc.inputs, y), 1.0, 2, segments=exc.segments)
     k = np.arange(-2, 3)[:, None, None, None]
     true = system.htf(est.omega, 2) * np.exp(-1j * k * system.wp * tau)
     assert np.max(np.abs(est.components[1:4] - true[1:4]) / np.abs(true[1:4])) < 0.01
@@ -216,7 +227,7 @@ def test_unequal_windows_are_cut_with_warning(replica_data):
     segs = exc.segments.copy()
     segs[-1, 1] -= 150                                 # last window: 27 periods
     with pytest.warns(UserWarning, match="cut to the common 27 periods"):
-        est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=segs)
+        est = estimate_arrays((exc.time, exc.inputs, y), 1.0, 2, segments=segs)
     true = system.htf(est.omega, 2)
     assert np.max(np.abs(est.components[1:4] - true[1:4]) / np.abs(true[1:4])) < 0.01
 
@@ -225,26 +236,30 @@ def test_returns_htf_that_predicts_new_inputs(replica_data):
     system, exc, y = replica_data
     H = estimate_htf((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
                      name='hop')
-    assert isinstance(H, HTF) and H.name == 'hop' and H.nharmonics == 2
-    est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments)
+    assert isinstance(H, HTFData) and H.name == 'hop' and H.nharmonics == 2
+    H2, info = estimate_htf((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
+                            return_info=True)
     w, G = H.components()
-    assert np.array_equal(w, est.omega) and np.allclose(G, est.components)
-    assert H.std.shape == G.shape and H.diagnostics["identified"].all()
-    assert set(H.diagnostics) >= {"cond", "residual", "alpha", "dof", "gcv"}
+    assert np.array_equal(w, H2.omega) and np.array_equal(G, H2.components()[1])
+    assert H.std.shape == G.shape and info.identified.all()
+    assert info.success and info.cond.shape == w.shape and info.alpha == 0
+    with pytest.raises(AttributeError):          # frozen, like OptimizeResult's fields
+        info.alpha = 1.0
     # validation on an input not used for training: steady-state response to a
     # sum of two sines whose output lines all lie in the estimated band
     t = np.arange(0, 60, 0.01)
     u = lambda s: 0.5 * np.cos(2 * np.pi * 0.3 * s) + np.sin(2 * np.pi * 0.45 * s)
     yv = system.simulate(u, t)[0]
     keep = t >= 40                                    # 20 periods of T and of u
-    y_hat = H.predict(u(t[keep]), t[keep])
+    y_hat = H.predict(t[keep], u(t[keep]))
     assert e_rms(yv[keep], y_hat) < 0.5
 
 
 def test_no_residual_dof_gives_no_std(replica_data):
     system, exc, y = replica_data
-    H = estimate_htf((exc.time, exc.inputs, y), 1.0, 3, segments=exc.segments)
-    assert H.std is None and H.diagnostics["dof"] == pytest.approx(0, abs=1e-6)
+    H, info = estimate_htf((exc.time, exc.inputs, y), 1.0, 3, segments=exc.segments,
+                           return_info=True)
+    assert H.std is None and info.dof == pytest.approx(0, abs=1e-6)
 
 
 LIMITS = (0.0, 2 * np.pi * 15)          # G_3 reaches 12 + 3.6 Hz
@@ -261,7 +276,7 @@ def narrow_band():
 @pytest.mark.parametrize("alpha", [0.0, 1e-3])
 def test_narrow_band_estimates_excited_components(narrow_band, alpha):
     system, exc, y = narrow_band
-    est = _estimate((exc.time, exc.inputs, y), 0.25, 3, segments=exc.segments,
+    est = estimate_arrays((exc.time, exc.inputs, y), 0.25, 3, segments=exc.segments,
                     alpha=alpha, omega_limits=LIMITS)
     ident = est.identified[:, 0, 0]
     # at most two shifted inputs |ω - 4k Hz| <= 3 Hz (+ leakage) per output frequency
@@ -291,7 +306,7 @@ def test_narrow_band_estimates_excited_components(narrow_band, alpha):
         # ... but bridges gaps inside it: a high threshold cuts the chirp's
         # spectral ripple into excited and unexcited stretches
         with pytest.warns(UserWarning, match="interpolated"):
-            gap = _estimate((exc.time, exc.inputs, y), 0.25, 3, alpha=alpha,
+            gap = estimate_arrays((exc.time, exc.inputs, y), 0.25, 3, alpha=alpha,
                             segments=exc.segments, omega_limits=LIMITS, threshold=0.5)
         g1, id1 = gap.components[4, 0, 0], gap.identified[4, 0, 0]
         inside = (gap.omega > gap.omega[id1][0]) & (gap.omega < gap.omega[id1][-1])
@@ -300,20 +315,20 @@ def test_narrow_band_estimates_excited_components(narrow_band, alpha):
         # is weak, is a smooth guess across the peak of |G_1|)
         true1 = system.htf(gap.omega, 3)[4, 0, 0]
         assert np.max(np.abs(g1 - true1)[id1]) < 0.01 * np.max(np.abs(true1))
-    H = estimate_htf((exc.time, exc.inputs, y), 0.25, 3, segments=exc.segments,
-                     alpha=alpha, omega_limits=LIMITS)
+    H, info = estimate_htf((exc.time, exc.inputs, y), 0.25, 3, segments=exc.segments,
+                           alpha=alpha, omega_limits=LIMITS, return_info=True)
     # the HTF marks what the data do not determine as NaN, like the estimate
     np.testing.assert_array_equal(np.isnan(H.components()[1]), np.isnan(est.components))
     assert np.all(np.isnan(H.components()[1][:3]))
-    assert np.array_equal(H.diagnostics["identified"], est.identified)
+    assert np.array_equal(info.identified, est.identified)
 
 
 def test_partial_frequencies_keep_fully_excited_estimates(replica_data):
     # omega_limits adds partially identified frequencies; where every component
     # is identified the per-frequency estimate is unchanged
     _, exc, y = replica_data
-    full = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments)
-    part = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
+    full = estimate_arrays((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments)
+    part = estimate_arrays((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
                      omega_limits=(0.0, 2 * np.pi * 6))
     assert part.omega.size > full.omega.size
     assert np.array_equal(part.omega[:full.omega.size], full.omega)
@@ -325,13 +340,13 @@ def test_partial_frequencies_keep_fully_excited_estimates(replica_data):
 def test_record_shorter_than_one_period():
     t = np.arange(50) * 0.01
     with pytest.raises(ValueError, match="shorter than one period"):
-        _estimate((t, np.sin(t), np.cos(t)), 1.0, 1, alpha=1.0)
+        estimate_arrays((t, np.sin(t), np.cos(t)), 1.0, 1, alpha=1.0)
 
 
 def test_period_not_commensurate_with_sampling():
     t = np.arange(1000) * 0.01
     with pytest.raises(ValueError, match="integer number of samples per period"):
-        _estimate((t, np.sin(t), np.cos(t)), 1.005, 1, alpha=1.0)
+        estimate_arrays((t, np.sin(t), np.cos(t)), 1.005, 1, alpha=1.0)
 
 
 def test_nan_in_data(replica_data):
@@ -339,27 +354,27 @@ def test_nan_in_data(replica_data):
     bad = y.copy()
     bad[10] = np.nan
     with pytest.raises(ValueError, match="outputs contains NaN"):
-        _estimate((exc.time, exc.inputs, bad), 1.0, 1, segments=exc.segments)
+        estimate_arrays((exc.time, exc.inputs, bad), 1.0, 1, segments=exc.segments)
 
 
 def test_nharmonics_too_large_for_band(replica_data):
     _, exc, y = replica_data
     with pytest.raises(ValueError, match="too large for the excited band.*omega_limits"):
-        _estimate((exc.time, exc.inputs, y), 1.0, 5, segments=exc.segments)
+        estimate_arrays((exc.time, exc.inputs, y), 1.0, 5, segments=exc.segments)
 
 
 def test_no_identifiable_frequency_in_limits(replica_data):
     # inputs excited up to 4 Hz: no shift |k| <= 2 reaches outputs at 40-45 Hz
     _, exc, y = replica_data
     with pytest.raises(ValueError, match="no output frequency in omega_limits"):
-        _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
+        estimate_arrays((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
                   omega_limits=(2 * np.pi * 40, 2 * np.pi * 45))
 
 
 def test_zero_input_rejected():
     t = np.arange(500) * 0.01
     with pytest.raises(ValueError, match="identically zero"):
-        _estimate((t, np.zeros(500), np.sin(t)), 1.0, 1, alpha=1.0)
+        estimate_arrays((t, np.zeros(500), np.sin(t)), 1.0, 1, alpha=1.0)
 
 
 def test_gcv_on_pure_noise_warns_at_range_edge(single_record):
@@ -367,7 +382,7 @@ def test_gcv_on_pure_noise_warns_at_range_edge(single_record):
     _, exc, _ = single_record
     y = 0.01 * np.random.default_rng(5).standard_normal(exc.time.size)
     with pytest.warns(UserWarning, match="edge of the searched range"):
-        est = _estimate((exc.time, exc.inputs, y), 1.0, 1, alpha='gcv', progress=False,
+        est = estimate_arrays((exc.time, exc.inputs, y), 1.0, 1, alpha='gcv', progress=False,
                         omega_limits=(2 * np.pi * 1.2, 2 * np.pi * 2.8))
     assert est.alpha == pytest.approx(1e6)
 
@@ -375,14 +390,14 @@ def test_gcv_on_pure_noise_warns_at_range_edge(single_record):
 def test_alpha_zero_needs_enough_records(single_record):
     _, exc, y = single_record
     with pytest.raises(ValueError, match="at least"):
-        _estimate((exc.time, exc.inputs, y), 1.0, 1)
+        estimate_arrays((exc.time, exc.inputs, y), 1.0, 1)
 
 
 def test_unexcited_frequencies_in_limits_warn(replica_data):
     _, exc, y = replica_data
     # output frequencies up to 6 Hz have U(ω - 2ω_p) excited (chirp 0-4 Hz + leakage)
     with pytest.warns(UserWarning, match="unexcited: 42 dropped, 0 interpolated"):
-        est = _estimate((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
+        est = estimate_arrays((exc.time, exc.inputs, y), 1.0, 2, segments=exc.segments,
                         omega_limits=(0.0, 2 * np.pi * 8))
     assert 2 * np.pi * 6 < est.omega[-1] < 2 * np.pi * 7
 
@@ -404,15 +419,15 @@ def test_argument_errors(replica_data, kwargs, exc_type, match):
 def test_data_type_errors():
     t = np.arange(200) * 0.01
     with pytest.raises(ControlArgument, match="data"):
-        _estimate("abc", 1.0, 1)
+        estimate_arrays("abc", 1.0, 1)
     with pytest.raises(ControlArgument, match=r"data\[0\]"):
-        _estimate([np.ones(3)], 1.0, 1)
+        estimate_arrays([np.ones(3)], 1.0, 1)
     with pytest.raises(ControlDimension, match="time axis"):
-        _estimate((t, np.ones(199), np.ones(200)), 1.0, 1)
+        estimate_arrays((t, np.ones(199), np.ones(200)), 1.0, 1)
     with pytest.raises(ValueError, match="uniformly"):
-        _estimate((t ** 2, np.ones(200), np.ones(200)), 1.0, 1)
+        estimate_arrays((t ** 2, np.ones(200), np.ones(200)), 1.0, 1)
     with pytest.raises(ValueError, match="period"):
-        _estimate((t, np.ones(200), np.ones(200)), -1.0, 1)
+        estimate_arrays((t, np.ones(200), np.ones(200)), -1.0, 1)
 
 
 def test_metrics():
@@ -442,8 +457,10 @@ def test_unmodelled_harmonics_are_detected(ten_replicas):
     noisy = y + 0.01 * np.random.default_rng(3).standard_normal(y.size)
     with pytest.warns(UserWarning, match=r"unmodelled harmonics: the inputs shifted by "
                                          r"±2ω_p .*\|k\| > 1"):
-        H = estimate_htf((exc.time, exc.inputs, noisy), 1.0, 1, segments=exc.segments)
-    test = H.diagnostics["harmonic_test"]
+        H, info = estimate_htf((exc.time, exc.inputs, noisy), 1.0, 1,
+                               segments=exc.segments, return_info=True)
+    assert "unmodelled harmonics" in info.message
+    test = info.harmonic_test
     assert test["pvalue"] < 1e-6 and test["variance_ratio"] > 3
 
 
@@ -458,11 +475,12 @@ def test_std_calibrated_when_k_is_too_small(ten_replicas, seed):
     noisy = y + sigma * np.random.default_rng(seed).standard_normal(y.size)
     with pytest.warns(UserWarning, match=r"unmodelled harmonics.*std uses the noise "
                                          r"variance of the fit with G_\{±2\} modelled"):
-        H = estimate_htf((exc.time, exc.inputs, noisy), 1.0, 1, segments=exc.segments)
+        H, info = estimate_htf((exc.time, exc.inputs, noisy), 1.0, 1,
+                               segments=exc.segments, return_info=True)
     dt, nsamples = 0.01, 1900                # 19 periods of 100 samples per window
-    noise_var = H.diagnostics["noise_var"][0]
+    noise_var = info.noise_var[0]
     assert noise_var == pytest.approx(dt ** 2 * nsamples * sigma ** 2, rel=0.15)
-    inflation = H.diagnostics["residual"][0] ** 2 / noise_var
+    inflation = info.residual[0] ** 2 / noise_var
     assert inflation > 2
     z2 = (np.abs(H.components()[1] - system.htf(H.omega, 1)) / H.std) ** 2
     # complex Gaussian errors: E|e|²/σ² = 1 (a few % of G_{±3} and aliasing remain)
@@ -476,8 +494,9 @@ def test_two_sigma_coverage_when_k_is_large_enough(ten_replicas):
         noisy = y + 0.03 * np.random.default_rng(seed).standard_normal(y.size)
         with warnings.catch_warnings():
             warnings.simplefilter("error")       # K = 3 passes the harmonic test
-            H = estimate_htf((exc.time, exc.inputs, noisy), 1.0, 3, segments=exc.segments)
-        assert H.diagnostics["harmonic_test"]["pvalue"] > 1e-3
+            H, info = estimate_htf((exc.time, exc.inputs, noisy), 1.0, 3,
+                                   segments=exc.segments, return_info=True)
+        assert info.harmonic_test["pvalue"] > 1e-3 and info.success
         z.append(np.abs(H.components()[1] - system.htf(H.omega, 3)) / H.std)
     z = np.concatenate([zi.ravel() for zi in z])
     # complex Gaussian errors: P(|e| < 2σ) = 1 - e^{-4} = 0.982

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import ltpcontrol as ltp
-from ltpcontrol import _htf
+from ltpcontrol import _harmonic_ss
 from systems import random_periodic_plant
 
 matplotlib.use('Agg')
@@ -76,13 +76,13 @@ def test_auto_path_is_modal_for_many_points_and_solve_for_few():
 
 def test_bode_htf_evaluates_the_block_row_once(monkeypatch):
     calls = []
-    orig = _htf._HarmonicStateSpace.evaluate
+    orig = _harmonic_ss._HarmonicStateSpace.evaluate
 
     def counting(self, *args, **kwargs):
         calls.append(kwargs.get('cols'))
         return orig(self, *args, **kwargs)
     H = ltp.htf(SYS[0, 0], 3)
-    monkeypatch.setattr(_htf._HarmonicStateSpace, 'evaluate', counting)
+    monkeypatch.setattr(_harmonic_ss._HarmonicStateSpace, 'evaluate', counting)
     cplt = ltp.bode_htf(H, S.imag, harmonics=(-2, -1, 0, 1, 2))
     assert len(calls) == 1 and len(calls[0]) == 5
     resp = ltp.htf_response(H, S.imag, harmonics=(-2, 0, 2))[0]

@@ -121,7 +121,7 @@ def errors(res):
 
 def test_mathieu_thesis_settings_beat_published_estimates(mathieu100):
     # thesis settings: 100 Hz, K = 1, N = 20, h = 2
-    res = hybrid_ls(*mathieu100, T_M, [0, T_M / 2], 1, nconv=20, nshifts=2)
+    _, res = hybrid_ls(*mathieu100, T_M, [0, T_M / 2], 1, nconv=20, nshifts=2, return_info=True)
     assert res.A.shape == (2, 3, 2, 2) and res.B.shape == (2, 3, 2, 1)
     assert np.iscomplexobj(res.A) and np.iscomplexobj(res.B)
     np.testing.assert_array_equal(res.A[:, ::-1].conj(), res.A)
@@ -142,7 +142,7 @@ def test_mathieu_thesis_settings_beat_published_estimates(mathieu100):
 
 
 def test_mathieu_high_rate_below_1e3(mathieu1k):
-    res = hybrid_ls(*mathieu1k, T_M, [0, T_M / 2], 1, nconv=20)
+    _, res = hybrid_ls(*mathieu1k, T_M, [0, T_M / 2], 1, nconv=20, return_info=True)
     e0, e1, eB = errors(res)
     assert max(e0.max(), e1.max(), eB.max()) < 1e-3
     # the higher-order harmonics of the constant damping vanish
@@ -151,13 +151,14 @@ def test_mathieu_high_rate_below_1e3(mathieu1k):
 
 def test_larger_nconv_lowers_error(mathieu1k):
     err = [max(e.max() for e in errors(
-        hybrid_ls(*mathieu1k, T_M, [0, T_M / 2], 1, nconv=N))) for N in (5, 20, 100)]
+        hybrid_ls(*mathieu1k, T_M, [0, T_M / 2], 1, nconv=N, return_info=True)[1]))
+        for N in (5, 20, 100)]
     assert err[0] > err[1] > err[2]
     assert err[2] < 3e-4
 
 
 def test_matrices_reproduce_compliance_and_damping(mathieu1k):
-    res = hybrid_ls(*mathieu1k, T_M, [0, T_M / 2], 1)
+    _, res = hybrid_ls(*mathieu1k, T_M, [0, T_M / 2], 1, return_info=True)
     At, Bt = res.matrices()
     s = np.linspace(0, T_M, 101)[:-1]
     first = s < T_M / 2
@@ -173,14 +174,14 @@ def test_matrices_reproduce_compliance_and_damping(mathieu1k):
 def test_record_offset_and_closed_endpoint(mathieu1k):
     # a record started later in the steady state gives the same estimate
     t, x, u = mathieu_data(1000.0, tstart=2.3456)
-    ref = hybrid_ls(*mathieu1k, T_M, [0, T_M / 2], 1)
-    shifted = hybrid_ls(t, x, u, T_M, [0, T_M / 2], 1)
+    _, ref = hybrid_ls(*mathieu1k, T_M, [0, T_M / 2], 1, return_info=True)
+    _, shifted = hybrid_ls(t, x, u, T_M, [0, T_M / 2], 1, return_info=True)
     np.testing.assert_allclose(shifted.A, ref.A, atol=5e-4)
     # a closing sample at t = 10 s (one period beyond the record) is dropped
     tc = [np.append(tk, 10.0) for tk in mathieu1k[0]]
     xc = [np.concatenate([xk, xk[:, :1]], axis=1) for xk in mathieu1k[1]]
     uc = [np.append(uk, uk[0]) for uk in mathieu1k[2]]
-    closed = hybrid_ls(tc, xc, uc, T_M, [0, T_M / 2], 1)
+    _, closed = hybrid_ls(tc, xc, uc, T_M, [0, T_M / 2], 1, return_info=True)
     np.testing.assert_array_equal(closed.A, ref.A)
 
 
@@ -206,7 +207,7 @@ def lti_data(nrec=3, period=1.0, fs=200.0):
 
 
 def test_lti_exact():
-    res = hybrid_ls(*lti_data(), 1.0, [0], 0)
+    _, res = hybrid_ls(*lti_data(), 1.0, [0], 0, return_info=True)
     np.testing.assert_allclose(res.A[0, 0], A_LTI, atol=1e-10)
     np.testing.assert_allclose(res.B[0, 0], B_LTI, atol=1e-10)
     assert res.residual < 1e-12
@@ -214,7 +215,7 @@ def test_lti_exact():
 
 def test_lti_seen_as_three_mode_ltp():
     # every mode equals the LTI system and has no higher harmonics
-    res = hybrid_ls(*lti_data(nrec=4), 1.0, [0, 0.2, 0.7], 1, nconv=10)
+    _, res = hybrid_ls(*lti_data(nrec=4), 1.0, [0, 0.2, 0.7], 1, nconv=10, return_info=True)
     assert res.A.shape == (3, 3, 3, 3) and res.B.shape == (3, 3, 3, 2)
     np.testing.assert_allclose(res.A[:, 1], np.broadcast_to(A_LTI, (3, 3, 3)), atol=1e-8)
     np.testing.assert_allclose(res.B[:, 1], np.broadcast_to(B_LTI, (3, 3, 2)), atol=1e-8)
@@ -226,7 +227,8 @@ def test_non_integer_samples_per_period():
     # LTI data only reveal the harmonics |h| <= nshifts of A(t): 2h+1 >= M(2K+1)
     with pytest.warns(UserWarning, match="rank deficient"):
         hybrid_ls(*lti_data(nrec=3), 1 / 3, [0, 0.1], 1, nconv=10, nshifts=2)
-    res = hybrid_ls(*lti_data(nrec=3), 1 / 3, [0, 0.1], 1, nconv=10, nshifts=3)
+    _, res = hybrid_ls(*lti_data(nrec=3), 1 / 3, [0, 0.1], 1, nconv=10, nshifts=3,
+                       return_info=True)
     assert res.rank == res.nunknowns
     np.testing.assert_allclose(res.A[:, 1], np.broadcast_to(A_LTI, (2, 3, 3)), atol=1e-8)
     np.testing.assert_allclose(res.B[:, 1], np.broadcast_to(B_LTI, (2, 3, 2)), atol=1e-8)
@@ -259,7 +261,7 @@ def test_three_mode_ltp_sums_of_sines():
     t = np.arange(10000) / 1000.0
     x = steady_state(Afuns, Bfuns, tsw, period, ufun, t, 10.0)
     u = [np.sin(2 * np.pi * np.outer(f, t)).sum(axis=0) for f in freqs]
-    res = hybrid_ls([t] * 4, list(x), u, period, tsw, 1)
+    _, res = hybrid_ls([t] * 4, list(x), u, period, tsw, 1, return_info=True)
     # A^i_{±1} = (ac ∓ j as) / 2
     A_true = np.stack([np.stack([(ac[i] + 1j * as_[i]) / 2, a0[i], (ac[i] - 1j * as_[i]) / 2])
                        for i in range(3)])
@@ -282,7 +284,7 @@ def test_single_record_arrays_and_scalar_state():
     t = np.arange(5000) / 500.0
     x = steady_state(Afuns, Bfuns, [0, 0.5], period, ufun, t, 10.0)[0, 0]
     u = np.sin(2 * np.pi * np.outer(freqs, t)).sum(axis=0)
-    res = hybrid_ls(t, x, u, period, [0, 0.5], 0)
+    _, res = hybrid_ls(t, x, u, period, [0, 0.5], 0, return_info=True)
     assert isinstance(res, HybridLSResult)
     assert "M=2" in repr(res)
     np.testing.assert_allclose(res.A[:, 0, 0, 0], [-1, -3], atol=2e-4)
@@ -294,7 +296,7 @@ def test_model_reproduces_record(mathieu1k):
     from ltpcontrol._timeresp import forced_response
 
     t, x, u = mathieu1k
-    sys = hybrid_ls(t, x, u, T_M, [0, T_M / 2], 1).model()
+    sys = hybrid_ls(t, x, u, T_M, [0, T_M / 2], 1)
     assert isinstance(sys, LTPStateSpace)
     assert (sys.period, sys.nstates, sys.ninputs, sys.noutputs) == (T_M, 2, 1, 2)
     # simulate the identified model for 2 s from the recorded state
@@ -322,8 +324,8 @@ def test_too_little_data():
 def test_rank_deficient_warns():
     # 2 identical records, 5 shifts each: 20 equations, rank 10 < 12 unknowns
     with pytest.warns(UserWarning, match="rank deficient"):
-        res = hybrid_ls(*one_sine(2), 1.0, [0, 0.5], 1, nshifts=2)
-    assert res.rank < res.nunknowns
+        _, res = hybrid_ls(*one_sine(2), 1.0, [0, 0.5], 1, nshifts=2, return_info=True)
+    assert res.rank < res.nunknowns and not res.success
 
 
 def test_transient_records_warn():
@@ -337,7 +339,7 @@ def test_transient_records_warn():
 def test_no_warning_on_steady_state_full_rank(mathieu100):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        res = hybrid_ls(*mathieu100, T_M, [0, T_M / 2], 1)
+        _, res = hybrid_ls(*mathieu100, T_M, [0, T_M / 2], 1, return_info=True)
     assert res.rank == res.nunknowns
 
 
@@ -429,11 +431,25 @@ def test_default_nshifts_identifies_switching_input_matrix():
     B_true[:, 1], A_true[:, 1] = b, a
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        res = hybrid_ls([t] * 3, list(x), u, period, [0, 0.5], 1)
+        _, res = hybrid_ls([t] * 3, list(x), u, period, [0, 0.5], 1, return_info=True)
     assert res.rank == res.nunknowns == 12
     np.testing.assert_allclose(res.B[:, :, 0, 0], B_true, atol=1e-4)
     np.testing.assert_allclose(res.A[:, :, 0, 0], A_true, atol=1e-4)
     # the former default h = 2 is rank deficient and misses B by far more
     with pytest.warns(UserWarning, match="rank deficient"):
-        bad = hybrid_ls([t] * 3, list(x), u, period, [0, 0.5], 1, nshifts=2)
+        _, bad = hybrid_ls([t] * 3, list(x), u, period, [0, 0.5], 1, nshifts=2, return_info=True)
     assert np.abs(bad.B[:, :, 0, 0] - B_true).max() > 1e-2
+
+
+def test_returns_the_model_and_read_only_info(mathieu100):
+    # the model is the LTPStateSpace of the coefficients; the info cannot be altered
+    sys, info = hybrid_ls(*mathieu100, T_M, [0, T_M / 2], 1, return_info=True, name='est')
+    assert sys.name == 'est' and info.success and info.nfev == 0 and 'rank 18 of 18' in info.message
+    t = np.array([0.1, 0.3, 0.6]) * T_M
+    At, Bt = info.matrices()
+    np.testing.assert_array_equal(sys.A(t), At(t))
+    np.testing.assert_array_equal(sys.B(t), Bt(t))
+    with pytest.raises(AttributeError, match="read-only"):
+        info.rank = 3
+    with pytest.raises(ValueError):
+        info.A[0, 0, 0, 0] = 1.0

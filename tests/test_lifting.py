@@ -171,3 +171,42 @@ def test_bad_inputs():
         lift(sysd, method='time', nharmonics=1)
     with pytest.raises(ControlArgument, match="real"):
         lift(sysd, real='yes')
+
+
+@pytest.mark.parametrize("N", [6, 5])
+def test_dt_htf_is_the_central_part_of_the_frequency_lifting(N):
+    # one construction serves both: the HTF's blocks -K..K are those of lift()
+    sysd = _random_dt(N, seed=20 + N)
+    K = (N - 1) // 2
+    A, B, C, D = lift(sysd, real=False)
+    full = np.arange(-(N // 2), N - N // 2)
+    keep = [int(np.flatnonzero(full == k)[0]) for k in range(-K, K + 1)]
+    ny, nu = sysd.noutputs, sysd.ninputs
+    rows = np.concatenate([np.arange(i * ny, (i + 1) * ny) for i in keep])
+    cols = np.concatenate([np.arange(i * nu, (i + 1) * nu) for i in keep])
+    H = ltp.htf(sysd, K)
+    z = np.array([np.exp(0.3j), 1.2 * np.exp(-2.1j), 0.9])
+    for i, zi in enumerate(z):
+        np.testing.assert_allclose(H(z)[..., i], _eval(A, B, C, D, zi)[np.ix_(rows, cols)],
+                                   rtol=1e-11, atol=1e-13)
+
+
+def test_harmonic_modules_import_at_the_top():
+    # the HTF modules import each other at module level; the one function-level
+    # import left is HTF.plot -> bode_htf, whose module draws HTF objects (a cycle)
+    import ast
+    import pathlib
+    root = pathlib.Path(ltp.__file__).parent
+    lazy = {}
+    for mod in ('_htf', '_htfplot', '_harmonic_ss', '_lifting', '_htf_estimate',
+                '_htf_fit', '_ltpsys'):
+        tree = ast.parse((root / f'{mod}.py').read_text())
+        for func in ast.walk(tree):
+            if isinstance(func, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                for node in ast.walk(func):
+                    if isinstance(node, ast.ImportFrom) and node.level == 1:
+                        lazy.setdefault(mod, set()).add(node.module)
+    assert lazy.get('_htf') == {'_htfplot'}
+    assert not any(lazy.get(m) for m in ('_htfplot', '_harmonic_ss', '_lifting',
+                                         '_htf_estimate', '_htf_fit'))
+    assert '_htf' not in lazy.get('_ltpsys', set())

@@ -81,7 +81,7 @@ def test_linf_is_certified_upper_bound_of_htf():
     value = ltp.norm(sys, 'inf', tol=1e-8)
     H = ltp.htf(sys, 6)
     w = np.linspace(0, sys.omega_p / 2, 400)
-    sig = np.linalg.norm(H(1j * w), ord=2, axis=(1, 2))
+    sig = np.linalg.norm(H(1j * w), ord=2, axis=(0, 1))
     assert sig.max() <= value * (1 + 1e-8)
     assert sig.max() >= value * (1 - 1e-4)
 

@@ -225,7 +225,7 @@ class TestPSO:
                 assert res.corrected_distance > 1e-10
             outcomes.append(res.success)
         assert any(outcomes)
-        # pyswarms must not reconfigure logging or write report.log
+        # the search must not reconfigure logging or write files
         assert logging.getLogger().handlers == handlers
         assert not list(tmp_path.iterdir())
 

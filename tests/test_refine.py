@@ -61,7 +61,7 @@ def perturbed(sys, seed, size=0.1):
 
 def data_htf(sys, K, omega, std=None):
     _, G = ltp.htf(sys, K).components(omega)
-    return ltp.HTF(G, omega, sys.period, std=None if std is None else np.broadcast_to(
+    return ltp.HTFData(G, omega, sys.period, std=None if std is None else np.broadcast_to(
         std, G.shape).copy()), G
 
 
@@ -143,7 +143,7 @@ def test_lifted_response_with_std_and_identify_ltp_start():
 def _mc_draw(rng, true_G, omega, std, start):
     noise = std * (rng.standard_normal(true_G.shape)
                    + 1j * rng.standard_normal(true_G.shape)) / np.sqrt(2)
-    H = ltp.HTF(true_G + noise, omega, start.period, std=std)
+    H = ltp.HTFData(true_G + noise, omega, start.period, std=std)
     _, info = ltp.refine_ltp(start, H, return_info=True)
     return np.concatenate([info.x, info.std ** 2])
 
@@ -155,7 +155,7 @@ def test_monte_carlo_unbiased_and_efficient():
     omega = np.linspace(0.3, 12.0, 30)
     H0, G = data_htf(true, 1, omega)
     std = 0.05 * np.abs(G) + 0.005
-    _, crb = ltp.refine_ltp(true, ltp.HTF(G, omega, true.period, std=std), maxiter=0,
+    _, crb = ltp.refine_ltp(true, ltp.HTFData(G, omega, true.period, std=std), maxiter=0,
                             return_info=True)
     res = ltp.monte_carlo(_mc_draw, 120, seed=11, n_jobs=2,
                           args=(G, omega, std, perturbed(true, 7, 0.05)))
@@ -220,7 +220,7 @@ def test_bad_input():
     bad = H.std.copy()
     bad[1, 0, 0, 3] = 0
     with pytest.raises(ValueError, match="std must be positive"):
-        ltp.refine_ltp(true, ltp.HTF(H.components()[1], H.omega, 1.0, std=bad))
+        ltp.refine_ltp(true, ltp.HTFData(H.components()[1], H.omega, 1.0, std=bad))
     with pytest.raises(ControlArgument, match="std applies"):
         ltp.refine_ltp(true, H, std=1.0)
     for kwargs, exc in (({'stable': -1.0}, ValueError), ({'maxiter': -1}, ValueError),
@@ -228,7 +228,7 @@ def test_bad_input():
                         ({'harmonics': (1, 2)}, ValueError), ({'colour': 1}, TypeError)):
         with pytest.raises(exc):
             ltp.refine_ltp(true, H, **kwargs)
-    few = ltp.HTF(H.components()[1][:, :, :, :2], H.omega[:2], 1.0)
+    few = ltp.HTFData(H.components()[1][:, :, :, :2], H.omega[:2], 1.0)
     with pytest.raises(ValueError, match="cannot determine"):
         ltp.refine_ltp(true, few, harmonics=(3, 6, 0))
 

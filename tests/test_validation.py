@@ -25,7 +25,7 @@ def test_as_ltp_converts_lti_given_a_period():
 
 
 @pytest.mark.parametrize('arg, kw, exc, match', [
-    (ct.tf([1], [1, 1]), {}, ControlArgument, 'sys is an LTI system'),
+    (ct.tf([1], [1, 1]), {}, ControlArgument, 'sys must be an LTPStateSpace; it is an LTI system'),
     ('plant', {}, ControlArgument, 'sys must be an LTPStateSpace, got str'),
     (SYS, {'period': 1.0}, TypeError, 'do not pass period'),
     (SYS, {'discrete': True}, ValueError, 'discrete-time'),
