@@ -34,6 +34,17 @@ hopping limit cycle, ``y = h − h_lc``.
    0.1-1 Hz.  With the light curvature weight used for the noise-free data
    the noise is hardly averaged out; ``alpha='gcv'`` picks a larger α that
    trades bias for variance.  Both are shown.
+5. Where the noisy estimate's error at 1 Hz comes from, over several noise
+   draws: the noise-free data give E_rms = 0.6 % at 1 Hz, so the 20 % at
+   SNR 12.5 is variance, mostly from output noise (input noise alone gives
+   3 %).  Each of the 2K+1 components adds its own estimation variance to
+   the prediction, while the VHOP's components beyond about ``|k| = 4`` are
+   smaller than their standard deviation.  ``significant_harmonics`` keeps the
+   harmonics whose estimate stands out from its (calibrated) standard
+   deviation; the reduced estimate is then smoothed by GCV and by a strong
+   curvature weight (α = 10) that the low-frequency components tolerate.
+   Four draws give 24 ± 3 % before, 15 ± 2 % (GCV) and 11 ± 1 % (α = 10)
+   after.
 
 Set ``LTP_EXAMPLES_QUICK=1`` for a reduced run (shorter chirps, fewer
 sines, fewer harmonic counts).
@@ -75,6 +86,10 @@ SOLVER = {'rtol': 1e-7, 'atol': 1e-10}
 SNR = 12.5
 #: Validation windows: 33 periods (10.9 s) after 30 settling periods.
 NPERIODS, SETTLE = 33, 30
+#: Noise draws of the 1 Hz study (quick run: 2).
+NDRAWS = 4
+#: Strong curvature weight of the 1 Hz study.
+ALPHA_SMOOTH = 10.0
 
 
 def _deviation(plant, orbit, ufun, nsamples):
@@ -115,6 +130,22 @@ def identify(exc, y, ncomponents, f1, u=None, alpha=ALPHA, return_info=False):
     return ltp.estimate_htf((exc.time, u, y), PERIOD, K, segments=exc.segments,
                             alpha=alpha, omega_limits=(0.0, wmax),
                             return_info=return_info, name=f'{ncomponents} HTFs')
+
+
+def significant_harmonics(H):
+    """Largest |k| whose components stand out from their standard deviation.
+
+    A component whose true magnitude is below its standard deviation adds
+    more variance to a prediction than it removes bias.  Since
+    ``E|Ĝ_k|² = |G_k|² + std²``, a harmonic is kept when the median of
+    ``|Ĝ_{±k}|² / std²`` over its identified frequencies exceeds 2.
+    """
+    _, G = H.components()
+    ratio = np.abs(G) ** 2 / H.std ** 2
+    K = H.nharmonics
+    keep = [k for k in range(1, K + 1)
+            if np.nanmedian(np.concatenate([ratio[K + k].ravel(), ratio[K - k].ravel()])) > 2]
+    return max(keep, default=0)
 
 
 def sine_data(plant, orbit, frequencies_hz, amplitude=0.1, n_jobs=2):
@@ -204,8 +235,32 @@ def run(quick=QUICK, n_jobs=2, seed=2017):
         out['noise_errors'][alpha] = prediction_errors(H_noisy, t_sine, u_sine[low],
                                                        y_sine[low])
     out['gcv_alpha'] = info.alpha
+    out['noise_components'] = nbest
+    out['noise_study'] = noise_study(exc, y, nbest, bands[0], t_sine, u_sine[one_hz],
+                                     y_sine[one_hz], 2 if quick else NDRAWS, seed)
     out['time'] = time.time() - start
     return out
+
+
+def noise_study(exc, y, ncomponents, f1, t, u, y_sine, ndraws, seed):
+    """E_rms at 1 Hz over `ndraws` noise draws: thesis setting and reduced estimates."""
+    rows = {'thesis': [], 'reduced_gcv': [], 'reduced_smooth': [], 'K': []}
+    rng = np.random.default_rng(seed + 1)
+    for _ in range(ndraws):
+        u_noisy, y_noisy = add_noise(exc, y, SNR, rng)
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore')     # unmodelled harmonics at the reduced K
+            full = identify(exc, y_noisy, ncomponents, f1, u=u_noisy)
+            K = significant_harmonics(full)
+            fits = {'thesis': full,
+                    'reduced_gcv': identify(exc, y_noisy, 2 * K + 1, f1, u=u_noisy,
+                                            alpha='gcv'),
+                    'reduced_smooth': identify(exc, y_noisy, 2 * K + 1, f1, u=u_noisy,
+                                               alpha=ALPHA_SMOOTH)}
+        for key, H in fits.items():
+            rows[key].append(prediction_errors(H, t, u[None], y_sine[None])[0])
+        rows['K'].append(K)
+    return {key: np.array(v) for key, v in rows.items()}
 
 
 def main():
@@ -226,6 +281,13 @@ def main():
     print(f"f [Hz]  α={ALPHA:g}  GCV α={res['gcv_alpha']:.3g}")
     for fi, e, g in zip(res['noise_frequencies'], *res['noise_errors'].values()):
         print(f'{fi:6.2f}  {e:7.2f}  {g:7.2f}')
+    study = res['noise_study']
+    print(f"\nE_rms [%] at 1 Hz over {study['K'].size} noise draws (mean ± std), SNR {SNR}:")
+    labels = {'thesis': f"{res['noise_components']} HTFs, α={ALPHA:g} (before)",
+              'reduced_gcv': f"significant harmonics K={study['K'].tolist()}, GCV α",
+              'reduced_smooth': f'significant harmonics, α={ALPHA_SMOOTH:g} (after)'}
+    for key, label in labels.items():
+        print(f"  {label:45s} {study[key].mean():6.1f} ± {study[key].std(ddof=1):.1f}")
 
     fig, axes = plt.subplots(1, len(res['bands']), figsize=(6 * len(res['bands']), 4),
                              squeeze=False)

@@ -83,7 +83,8 @@ class HTFEstimateInfo:
         Root-mean-square residual ``|Y - Ŷ|`` per output over all equations.
     noise_var : ndarray, shape (ny,)
         Estimated variance of one output DFT coefficient (NaN without
-        residual degrees of freedom).
+        residual degrees of freedom); when unmodelled harmonics are
+        detected, that of the fit with ``G_{±(K+1)}`` modelled.
     alpha : float
         Relative curvature weight used (chosen by GCV for ``alpha='gcv'``).
     dof : float
@@ -398,6 +399,11 @@ def _harmonic_test(U, Y, bins, L, K, excited):
     ``F = ((RSS₀ - RSS₁)/Q) / (RSS₁/N₁) ~ F(2Q, 2N₁)`` (complex data),
     Q and N₁ summed over frequencies and outputs.  Returns None when no
     frequency has enough windows.
+
+    ``noise_var`` (per output) is the residual variance of the extended
+    per-frequency fit over every frequency with more windows than its
+    excited columns, ``Σ_f RSS₁(f) / Σ_f (R - p₁(f))``: the noise with the
+    ``G_{±(K+1)}`` terms modelled and free of any regularisation bias.
     """
     nrec, nu, ns = U.shape
     ks = np.arange(-K - 1, K + 2)
@@ -411,13 +417,19 @@ def _harmonic_test(U, Y, bins, L, K, excited):
     use = (nrec > p1) & (p1 > p0)
     if not np.any(use):
         return None
+    fits = nrec > p1                               # extended fit has residual dof
+    Yf = np.transpose(Y[:, :, bins[fits]], (0, 2, 1))
+    g, _, _ = _solve_bins(phi[:, fits] * mask[fits], Yf)
+    noise_var = (np.sum(np.abs(Yf - np.einsum('rfa,fao->rfo', phi[:, fits] * mask[fits], g))
+                        ** 2, axis=(0, 1)) / np.sum(nrec - p1[fits]))
     Yb = np.transpose(Y[:, :, bins[use]], (0, 2, 1))
     rss = []
     for cols in (mask[use] & ~outer, mask[use]):
         g, _, _ = _solve_bins(phi[:, use] * cols, Yb)
         rss.append(float(_residual(phi[:, use] * cols, Yb, g).sum()))
     if rss[0] <= 1e-24 * float(np.sum(np.abs(Yb) ** 2)):
-        return {"statistic": 0.0, "pvalue": 1.0, "variance_ratio": 1.0}   # exact fit
+        return {"statistic": 0.0, "pvalue": 1.0, "variance_ratio": 1.0,   # exact fit
+                "noise_var": noise_var}
     ny = Y.shape[1]
     q = ny * int(np.sum(p1[use] - p0[use]))
     dof0 = ny * int(np.sum(nrec - p0[use]))
@@ -425,7 +437,8 @@ def _harmonic_test(U, Y, bins, L, K, excited):
     stat = (rss[0] - rss[1]) / q / (rss[1] / dof1)
     return {"statistic": float(stat),
             "pvalue": float(scipy.stats.f.sf(stat, 2 * q, 2 * dof1)),
-            "variance_ratio": float((rss[0] / dof0) / (rss[1] / dof1))}
+            "variance_ratio": float((rss[0] / dof0) / (rss[1] / dof1)),
+            "noise_var": noise_var}
 
 
 # ------------------------------------------------------------- the estimator
@@ -457,6 +470,10 @@ def _estimate(data, period, nharmonics, segments, alpha, omega_limits, threshold
     test = _harmonic_test(U, Y, bins, L, K, excited)
     flagged = _check_harmonics(test, alpha, K, phi.shape[0], int(mask.sum(axis=1).max()),
                                U.shape[1])
+    if flagged:
+        # the residual holds Σ_{|k|>K} G_k U(ω - kω_p): std from the noise variance of
+        # the fit with G_{±(K+1)} modelled
+        noise_var = test["noise_var"]
     comps, std, identified = _assemble(g, var, noise_var, mask, emask, cols, alpha, K,
                                        U.shape[1])
     info = HTFEstimateInfo(
@@ -599,9 +616,11 @@ def _check_harmonics(test, alpha, K, nrec, need, nu):
         warnings.warn(
             f"unmodelled harmonics: the inputs shifted by ±{K + 1}ω_p explain the "
             f"residual (F = {test['statistic']:.3g}, p = {test['pvalue']:.2g}), so the "
-            f"plant has components G_k with |k| > {K}; they are counted as noise (noise "
-            f"variance about {test['variance_ratio']:.3g}× too large, std inflated) or "
-            f"alias into the estimate; increase nharmonics", UserWarning, stacklevel=4)
+            f"plant has components G_k with |k| > {K}; std uses the noise variance of "
+            f"the fit with G_{{±{K + 1}}} modelled (the residual's is "
+            f"{test['variance_ratio']:.3g}× larger where they are excited), and where "
+            f"U(ω ∓ {K + 1}ω_p) is excited the estimate may carry their alias; increase "
+            f"nharmonics", UserWarning, stacklevel=4)
         return True
     if test is None and alpha == 0:
         warnings.warn(

@@ -462,9 +462,29 @@ def test_unmodelled_harmonics_are_detected(ten_replicas):
     assert "unmodelled harmonics" in info.message
     test = info.harmonic_test
     assert test["pvalue"] < 1e-6 and test["variance_ratio"] > 3
-    # the std it reports are indeed too large: errors are far below them
-    z = np.abs(H.components()[1] - system.htf(H.omega, 1)) / H.std
-    assert np.mean(z < 1) > 0.9
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_std_calibrated_when_k_is_too_small(ten_replicas, seed):
+    # With K = 1 the residual holds G_{±2} U(ω ∓ 2ω_p), many times the noise.  The
+    # noise variance comes from the fit with G_{±2} modelled instead: it equals the
+    # true variance of one output DFT bin, dt² N σ², and the std describe the errors
+    # of the K = 1 components (the residual's variance would make them 2-6× too large).
+    system, exc, y = ten_replicas
+    sigma = 0.01
+    noisy = y + sigma * np.random.default_rng(seed).standard_normal(y.size)
+    with pytest.warns(UserWarning, match=r"unmodelled harmonics.*std uses the noise "
+                                         r"variance of the fit with G_\{±2\} modelled"):
+        H, info = estimate_htf((exc.time, exc.inputs, noisy), 1.0, 1,
+                               segments=exc.segments, return_info=True)
+    dt, nsamples = 0.01, 1900                # 19 periods of 100 samples per window
+    noise_var = info.noise_var[0]
+    assert noise_var == pytest.approx(dt ** 2 * nsamples * sigma ** 2, rel=0.15)
+    inflation = info.residual[0] ** 2 / noise_var
+    assert inflation > 2
+    z2 = (np.abs(H.components()[1] - system.htf(H.omega, 1)) / H.std) ** 2
+    # complex Gaussian errors: E|e|²/σ² = 1 (a few % of G_{±3} and aliasing remain)
+    assert np.mean(z2) == pytest.approx(1, abs=0.25)
 
 
 def test_two_sigma_coverage_when_k_is_large_enough(ten_replicas):
