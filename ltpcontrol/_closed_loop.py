@@ -33,6 +33,7 @@ from typing import Optional
 import numpy as np
 import control as ct
 from control.exception import ControlArgument, ControlDimension
+from tqdm.auto import tqdm
 
 from ._hybrid import (HybridMode, HybridPlant, _central_jacobian, _Flow, _input_function,
                       _solver_settings)
@@ -523,7 +524,6 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
 
 
 def _progress(progress, timepts):
-    from tqdm.auto import tqdm
     if not isinstance(progress, (bool, np.bool_)):
         raise ControlArgument(f"progress must be True or False, got {progress!r}")
     return tqdm(total=float(timepts[-1] - timepts[0]), desc='closed loop', unit='s',

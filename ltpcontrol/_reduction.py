@@ -33,7 +33,7 @@ from control.exception import ControlArgument
 from ._ltpsys import LTPStateSpace
 from ._lyapunov import dlyap
 from ._periodic_balancing import gramians, hankel_svd, truncate
-from ._validation import check_positive_int, real_array
+from ._validation import as_ltp, check_positive_int, real_array
 
 __all__ = ['hsvd', 'balred', 'minreal']
 
@@ -259,8 +259,7 @@ def minreal(sys, tol=None, *, nsteps=None):
 #
 
 def _check(sys):
-    if not isinstance(sys, LTPStateSpace):
-        raise ControlArgument(f"sys must be an LTPStateSpace, got {type(sys).__name__}")
+    as_ltp(sys)
 
 
 def _require_stable(sys):
