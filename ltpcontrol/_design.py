@@ -317,4 +317,5 @@ def _reverse(M, transpose):
         out = M._eval(np.mod(-np.asarray(t, float), T))
         return np.swapaxes(out, 1, 2) if transpose else out
     shape = M.shape[::-1] if transpose else M.shape
-    return PeriodicMatrix._new(T, shape, func=value, breakpoints=np.mod(-M.breakpoints, T))
+    return PeriodicMatrix.from_function(value, T, shape, breakpoints=np.mod(-M.breakpoints, T),
+                                        check=False)

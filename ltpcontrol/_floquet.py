@@ -532,12 +532,13 @@ def _assemble(sys, grid, G, E, R):
     transform = _chebyshev_transform(sys.A, grid, G, E, R)
     breaks = np.concatenate([M.with_period(period).breakpoints
                              for M in (sys.A, sys.B, sys.C)])
-    P = PeriodicMatrix._new(period, (n, n), func=transform, breakpoints=breaks)
+    P = PeriodicMatrix.from_function(transform, period, (n, n), breakpoints=breaks,
+                                     check=False)
     B, C = sys.B, sys.C
-    BF = PeriodicMatrix._new(period, B.shape, breakpoints=breaks,
-                             func=lambda t: np.linalg.solve(transform(t), B(t)))
-    CF = PeriodicMatrix._new(period, C.shape, breakpoints=breaks,
-                             func=lambda t: C(t) @ transform(t))
+    BF = PeriodicMatrix.from_function(lambda t: np.linalg.solve(transform(t), B(t)), period,
+                                      B.shape, breakpoints=breaks, check=False)
+    CF = PeriodicMatrix.from_function(lambda t: C(t) @ transform(t), period, C.shape,
+                                      breakpoints=breaks, check=False)
     # F = R^{-1} E R (E = Λ_r for Floquet vectors, R = Pm_0^{-1})
     sysF = ltpss(np.linalg.solve(R, E @ R), BF, CF, sys.D, period, **labels)
     return sysF, P

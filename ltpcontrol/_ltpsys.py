@@ -689,8 +689,7 @@ def _loop_inverse(loop, where):
         return np.linalg.inv(values)
     if loop.is_constant:
         return PeriodicMatrix.constant(inv(loop(0.0)[None])[0], loop.period)
-    return PeriodicMatrix._new(loop.period, loop.shape, combine=(inv, [loop]),
-                               breakpoints=loop.breakpoints)
+    return PeriodicMatrix.pointwise(inv, [loop], loop.shape)
 
 
 def _merge_period(p1, p2):

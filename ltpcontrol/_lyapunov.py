@@ -291,7 +291,7 @@ def periodic_solution(A, Q, grid, X, adjoint):
         return Phi @ X[k] @ np.swapaxes(Phi, 1, 2) + W
 
     breaks = np.concatenate([A.breakpoints, Q.breakpoints])
-    return PeriodicMatrix._new(T, (n, n), func=evaluate, breakpoints=breaks)
+    return PeriodicMatrix.from_function(evaluate, T, (n, n), breakpoints=breaks, check=False)
 
 
 #

@@ -327,7 +327,8 @@ def _hamiltonian(sys, gamma, values):
         out[:, n:, n:] = -np.swapaxes(F, 1, 2)
         return out
     breaks = np.concatenate([M.breakpoints for M in (A, B, C, D)])
-    return PeriodicMatrix._new(T, (2 * n, 2 * n), func=H, breakpoints=breaks)
+    return PeriodicMatrix.from_function(H, T, (2 * n, 2 * n), breakpoints=breaks,
+                                        check=False)
 
 
 def _unit_circle_angles(sys, gamma, grid, values):

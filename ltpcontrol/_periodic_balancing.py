@@ -132,7 +132,8 @@ def truncate(sys, r, nsteps=None):
         warnings.warn(f"the reduced matrices are interpolated with relative errors up to "
                       f"{err:.1e}; increase nsteps", UserWarning, stacklevel=3)
     breaks = np.concatenate([M.breakpoints for M in (sys.A, sys.B, sys.C)])
-    Ar, Br, Cr = (PeriodicMatrix._new(T, v.shape[1:], func=f, breakpoints=breaks)
+    Ar, Br, Cr = (PeriodicMatrix.from_function(f, T, v.shape[1:], breakpoints=breaks,
+                                               check=False)
                   for f, v in zip(interpolants, values))
     # sup of every discarded branch: the bound's terms
     sup = np.max(np.take_along_axis(hsv, order, axis=1)[:, r:], axis=0, initial=0.0)

@@ -127,7 +127,7 @@ class PeriodicMatrix:
         return cls(M[np.newaxis], period)
 
     @classmethod
-    def from_function(cls, func, period, shape=None):
+    def from_function(cls, func, period, shape=None, *, breakpoints=(), check=True):
         """Periodic matrix defined by a smooth callable ``func(t) -> (n, m)``.
 
         Parameters
@@ -142,6 +142,14 @@ class PeriodicMatrix:
             Period T > 0.
         shape : tuple of int, optional
             Expected shape; taken from ``func(0)`` when omitted.
+        breakpoints : array_like, optional
+            Instants in ``[0, T)`` where `func` is not smooth (kinks of an
+            interpolant, for example); integrators and quadratures restart
+            there.
+        check : bool, optional
+            Probe `func` for periodicity (default True).  Pass False only for
+            a function periodic by construction (for example an interpolant
+            of one period's values, wrapped modulo T) to save its calls.
 
         Returns
         -------
@@ -157,10 +165,12 @@ class PeriodicMatrix:
         if not callable(func):
             raise TypeError(f"func must be callable, got {type(func).__name__}")
         period = check_period(period)
+        if not check and shape is not None:
+            return cls._new(period, shape, func=func, breakpoints=breakpoints)
         value = _as_matrix(func(0.0), 'func(0)')
         if shape is not None and tuple(shape) != value.shape:
             raise ValueError(f"func returns shape {value.shape}, expected {tuple(shape)}")
-        probe = np.array([0.123456, 0.5, 0.876543]) * period
+        probe = np.array([0.123456, 0.5, 0.876543]) * period if check else ()
         for t in probe:
             a = _as_matrix(func(t), 'func(t)')
             b = _as_matrix(func(t + period), 'func(t + period)')
@@ -169,7 +179,46 @@ class PeriodicMatrix:
             if not np.allclose(a, b, rtol=1e-8, atol=1e-10 * max(1.0, np.abs(a).max())):
                 raise ValueError(f"func is not periodic with period={period}: "
                                  f"func({t:g}) differs from func({t + period:g})")
-        return cls._new(period, value.shape, func=func)
+        return cls._new(period, value.shape, func=func, breakpoints=breakpoints)
+
+    @classmethod
+    def pointwise(cls, op, operands, shape, *, breakpoints=()):
+        """Periodic matrix ``M(t) = op(P_1(t), ..., P_k(t))`` of periodic matrices.
+
+        Parameters
+        ----------
+        op : callable
+            Maps stacks of values, arrays of shape ``(nt,) + P_i.shape``, to
+            an array of shape ``(nt,) + shape``.
+        operands : sequence of PeriodicMatrix
+            The matrices ``P_i``, all with the same period.
+        shape : tuple of int
+            Shape of ``M(t)``.
+        breakpoints : array_like, optional
+            Instants in ``[0, T)`` where ``M`` is not smooth, besides those
+            of the operands.
+
+        Returns
+        -------
+        PeriodicMatrix
+
+        Examples
+        --------
+        >>> P = ltp.PeriodicMatrix.from_function(
+        ...     lambda t: np.array([[2.0 + np.cos(2 * np.pi * t)]]), period=1.0)
+        >>> Pinv = ltp.PeriodicMatrix.pointwise(np.linalg.inv, [P], (1, 1))
+        >>> float(Pinv(0.25)[0, 0] * P(0.25)[0, 0])
+        1.0
+        """
+        operands = list(operands)
+        if not operands or not all(isinstance(o, PeriodicMatrix) for o in operands):
+            raise TypeError("operands must be a non-empty sequence of PeriodicMatrix")
+        period = operands[0].period
+        if any(not np.isclose(o.period, period, rtol=1e-12) for o in operands):
+            raise ValueError("operands must have the same period")
+        breaks = np.concatenate([np.asarray(breakpoints, float)]
+                                + [o.breakpoints for o in operands])
+        return cls._new(period, shape, combine=(op, operands), breakpoints=breaks)
 
     @classmethod
     def from_samples(cls, samples, period, kind='fourier'):

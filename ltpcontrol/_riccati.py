@@ -161,13 +161,13 @@ def care(A, B, Q, R, S=None, period=None, nsteps=None):
             cache.append(_interpolant(H, grid, Xg))
         return cache[0](t)
 
-    X = PeriodicMatrix._new(period, (n, n), func=solution, breakpoints=grid[:-1])
+    X = PeriodicMatrix.from_function(solution, period, (n, n), breakpoints=grid[:-1],
+                                     check=False)
 
     def gain(b, r, s, x):
         return np.linalg.solve(r, np.swapaxes(b, 1, 2) @ x + np.swapaxes(s, 1, 2))
 
-    G = PeriodicMatrix._new(period, (m, n), combine=(gain, [B, R, S, X]),
-                            breakpoints=np.union1d(breaks, grid[:-1]))
+    G = PeriodicMatrix.pointwise(gain, [B, R, S, X], (m, n), breakpoints=breaks)
     return X, L, G
 
 
@@ -277,9 +277,8 @@ def _hamiltonian(ops, breaks):
         coeffs[:, n:, :n] = -q
         coeffs[:, n:, n:] = -np.swapaxes(a, 1, 2)
         coeffs[K] = hamiltonian(*(M.fourier(0).real for M in ops))[0]
-        return PeriodicMatrix._new(period, (2 * n, 2 * n), coeffs=coeffs)
-    return PeriodicMatrix._new(period, (2 * n, 2 * n), combine=(hamiltonian, list(ops)),
-                               breakpoints=breaks)
+        return PeriodicMatrix(coeffs, period)
+    return PeriodicMatrix.pointwise(hamiltonian, ops, (2 * n, 2 * n), breakpoints=breaks)
 
 
 def _interpolant(H, grid, Xg):

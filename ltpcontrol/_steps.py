@@ -85,7 +85,7 @@ def gram_weight(F, adjoint=False):
         n, op = F.shape[1], lambda f: np.swapaxes(f, 1, 2) @ f
     else:
         n, op = F.shape[0], lambda f: f @ np.swapaxes(f, 1, 2)
-    return PeriodicMatrix._new(F.period, (n, n), combine=(op, [F]), breakpoints=F.breakpoints)
+    return PeriodicMatrix.pointwise(op, [F], (n, n))
 
 
 def step_integrals(A, t0, h, Qf=None, Qa=None):
@@ -134,9 +134,7 @@ def step_integrals(A, t0, h, Qf=None, Qa=None):
             out[:, blk[2], blk[2]] = -np.swapaxes(a, 1, 2)
             out[:, blk[1], blk[2]] = next(q)
         return out
-    M = PeriodicMatrix._new(A.period, (len(keep) * n,) * 2, combine=(generator, [A] + weights),
-                            breakpoints=np.concatenate([A.breakpoints] +
-                                                       [Q.breakpoints for Q in weights]))
+    M = PeriodicMatrix.pointwise(generator, [A] + weights, (len(keep) * n,) * 2)
     Psi, _, _ = step_transitions(M, None, np.asarray(t0, float), np.asarray(h, float))
     Phi = Psi[:, blk[1], blk[1]]
     W = V = S = None

@@ -247,6 +247,25 @@ def test_library_does_not_patch_with_unittest():
     assert users == []
 
 
+def private_periodic_matrix_access(source):
+    """Private `PeriodicMatrix` members (``_new``, ``_coeffs``, ...) used in `source`."""
+    private = {'_new', '_init', '_coeffs', '_func', '_pieces', '_times', '_combine'}
+    return sorted({node.attr for node in ast.walk(ast.parse(source))
+                   if isinstance(node, ast.Attribute) and node.attr in private})
+
+
+def test_periodic_matrix_is_used_through_public_methods():
+    users = {path.stem: found for path in PACKAGE.glob('*.py')
+             if path.stem != '_periodic_matrix'
+             and (found := private_periodic_matrix_access(path.read_text()))}
+    assert users == {}
+
+
+def test_private_periodic_matrix_access_is_found():
+    assert private_periodic_matrix_access("P = PeriodicMatrix._new(1.0, (1, 1))\n"
+                                          "c = P._coeffs") == ['_coeffs', '_new']
+
+
 #
 # The check itself, on synthetic module graphs
 #

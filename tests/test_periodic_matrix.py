@@ -121,3 +121,26 @@ def test_bad_input(call, exc, match):
 def test_bad_shape_is_control_dimension():
     with pytest.raises(ControlDimension, match="coeffs"):
         ltp.PeriodicMatrix(np.ones((3, 2, 2, 2)), 1.0)
+
+
+def test_pointwise_and_unchecked_function_constructors():
+    P = ltp.PeriodicMatrix.from_function(
+        lambda t: np.array([[2.0 + np.cos(2 * np.pi * t), 0.0], [np.sin(2 * np.pi * t), 1.0]]),
+        period=1.0)
+    Q = ltp.PeriodicMatrix.switching([ltp.PeriodicMatrix.constant(np.eye(2), 1.0),
+                                      ltp.PeriodicMatrix.constant(2 * np.eye(2), 1.0)],
+                                     [0.0, 0.5], 1.0)
+    M = ltp.PeriodicMatrix.pointwise(lambda p, q: p @ q, [P, Q], (2, 2), breakpoints=[0.25])
+    for t in (0.1, 0.7):
+        np.testing.assert_allclose(M(t), P(t) @ Q(t), atol=1e-14)
+    assert set(np.round(M.breakpoints, 12)) >= {0.0, 0.25, 0.5}
+    with pytest.raises(ValueError, match="same period"):
+        ltp.PeriodicMatrix.pointwise(np.add, [P, ltp.PeriodicMatrix.constant(np.eye(2), 2.0)],
+                                     (2, 2))
+    with pytest.raises(TypeError, match="operands"):
+        ltp.PeriodicMatrix.pointwise(np.add, [np.eye(2)], (2, 2))
+    # an unchecked function is not probed; a checked one is
+    F = ltp.PeriodicMatrix.from_function(lambda t: np.array([[t]]), 1.0, (1, 1), check=False)
+    assert F(0.5)[0, 0] == 0.5
+    with pytest.raises(ValueError, match="not periodic"):
+        ltp.PeriodicMatrix.from_function(lambda t: np.array([[t]]), 1.0)
