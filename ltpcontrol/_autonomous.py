@@ -26,8 +26,8 @@ import numpy as np
 from control.exception import ControlArgument, ControlDimension
 from scipy.optimize import brentq
 
-from ._hybrid import _central_jacobian, _constant_input, _Flow, _params, _solver_settings
-from ._orbits import PeriodicOrbit, _as_hybrid, _time_mismatch
+from ._hybrid import central_jacobian, constant_input, Flow, plant_params, solver_settings
+from ._orbits import PeriodicOrbit, as_hybrid, time_mismatch
 from ._validation import check_period, check_positive, check_positive_int, real_array
 
 __all__ = ['limit_cycle', 'poincare_map']
@@ -49,7 +49,7 @@ class _Section:
         return float(value.reshape(()))
 
     def gradient(self, x):
-        return _central_jacobian(self, x)[0]
+        return central_jacobian(self, x)[0]
 
 
 def _section(hp, section, direction, mode, anchor, u0, params):
@@ -70,7 +70,7 @@ def _section(hp, section, direction, mode, anchor, u0, params):
 
 def _check_autonomous(hp, x0, u0, params):
     """Raise when a vector field or guard depends explicitly on t."""
-    bad = _time_mismatch(hp, x0, u0, params, [(0.0, t) for t in (0.7312, 3.1416, 17.123)])
+    bad = time_mismatch(hp, x0, u0, params, [(0.0, t) for t in (0.7312, 3.1416, 17.123)])
     if bad is not None:
         label, mode, _, t, _ = bad
         raise ValueError(f"plant is not autonomous: {label} of mode {mode!r} depends on t "
@@ -89,7 +89,7 @@ class _Problem:
         if self.deadline is not None and time.monotonic() > self.deadline:
             raise TimeoutError("the time limit (timeout) was reached")
         u0 = self.u0
-        return _Flow(self.hp, 0.0, duration, x, mode, lambda t: u0, self.params,
+        return Flow(self.hp, 0.0, duration, x, mode, lambda t: u0, self.params,
                      variational=variational, **(options or self.opts))
 
     def f(self, mode, x):
@@ -202,7 +202,7 @@ def poincare_map(plant, x0, section=None, mode0=0, *, direction=1, max_time=None
     >>> bool(np.isclose(t1, 2 * np.pi)), bool(np.allclose(J, [[1, 0], [0, 0]], atol=1e-6))
     (True, True)
     """
-    opts = _solver_settings('poincare_map', rtol, atol, method, max_events)
+    opts = solver_settings('poincare_map', rtol, atol, method, max_events)
     if not isinstance(jacobian, (bool, np.bool_)):
         raise ControlArgument(f"jacobian must be True or False, got {jacobian!r}")
     hp, x0, mode0, u0, params = _prepare(plant, x0, mode0, u0, params, None)
@@ -230,13 +230,13 @@ def _projected(prob, sec, fl):
 
 
 def _prepare(plant, x0, mode0, u0, params, jacobian):
-    hp = _as_hybrid(plant, jacobian)
+    hp = as_hybrid(plant, jacobian)
     x0 = real_array(x0, 'x0', ndim=(0, 1)).reshape(-1)
     if x0.size != hp.nstates:
         raise ControlDimension(f"x0 must have {hp.nstates} entries, got {x0.size}")
     mode0 = hp.mode_index(mode0, 'mode0')
-    u0 = _constant_input(hp, u0, 'u0')
-    params = _params(hp, params)
+    u0 = constant_input(hp, u0, 'u0')
+    params = plant_params(hp, params)
     _check_autonomous(hp, x0, u0, params)
     return hp, x0, mode0, u0, params
 
@@ -341,7 +341,7 @@ def limit_cycle(plant, period, x0, mode0=0, *, section=None, direction=1, u0=Non
     >>> bool(abs(orbit.phase_multiplier - 1) < 1e-8), bool(orbit.stability_multipliers[0] < 1e-3)
     (True, True)
     """
-    opts = _solver_settings('limit_cycle', rtol, atol, method, max_events)
+    opts = solver_settings('limit_cycle', rtol, atol, method, max_events)
     hp, x0, mode0, u0, params = _prepare(plant, x0, mode0, u0, params, jacobian)
     if period is not None:
         period = check_period(period)

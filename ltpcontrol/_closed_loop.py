@@ -35,10 +35,10 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 from tqdm.auto import tqdm
 
-from ._hybrid import (HybridMode, HybridPlant, _central_jacobian, _Flow, _input_function,
-                      _solver_settings)
+from ._hybrid import (HybridMode, HybridPlant, central_jacobian, Flow, input_function,
+                      solver_settings)
 from ._ltpsys import LTPStateSpace
-from ._orbits import PeriodicOrbit, _as_hybrid, _check_orbit_of, periodic_orbit
+from ._orbits import PeriodicOrbit, as_hybrid, check_orbit_of, periodic_orbit
 from ._validation import check_positive_int, real_array, steps_per_period
 
 __all__ = ['ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit']
@@ -48,8 +48,8 @@ class _Loop:
     """Validated plant, controller, orbit and saturation of one feedback loop."""
 
     def __init__(self, plant, controller, orbit, saturation):
-        plant = _as_hybrid(plant, None)
-        _check_orbit_of(orbit, plant, "a controller cannot act on it")
+        plant = as_hybrid(plant, None)
+        check_orbit_of(orbit, plant, "a controller cannot act on it")
         self.plant, self.orbit, self.T = plant, orbit, orbit.period
         self.params, self.u0 = orbit.params, orbit.u0
         self.n, self.m, self.p = plant.nstates, plant.ninputs, plant.noutputs
@@ -73,8 +73,8 @@ class _Loop:
     def _check_algebraic_loop(self):
         # y is evaluated at u0: exact unless both h and the controller pass u through
         t, x = 0.0, self.orbit.x0
-        dh_du = _central_jacobian(lambda u: self.plant._h(t, x, u, self.params), self.u0)
-        dk_de = _central_jacobian(lambda e: self.ctrl_out(t, np.zeros(self.nc), e),
+        dh_du = central_jacobian(lambda u: self.plant._h(t, x, u, self.params), self.u0)
+        dk_de = central_jacobian(lambda e: self.ctrl_out(t, np.zeros(self.nc), e),
                                   np.zeros(self.p))
         if np.any(dh_du != 0) and np.any(dk_de != 0):
             raise ValueError("algebraic loop: the plant output depends on its input and the "
@@ -226,7 +226,7 @@ def _loop_plant(loop):
             # chain rule through e = h(x) + v − ȳ and u = sat(u0 + C_c x_c + D_c e)
             e, u = signals(t, z, v)
             Ac, Bc, Cc, Dc = loop.matrices(t)
-            H = _central_jacobian(lambda x: plant._h(t, x, loop.u0, params), z[:n])
+            H = central_jacobian(lambda x: plant._h(t, x, loop.u0, params), z[:n])
             active = ((u > loop.lower) & (u < loop.upper))[:, None]
             du_dz = active * np.hstack([Dc @ H, Cc])
             top = np.hstack([plant._dfdx(i, t, z[:n], u, params), np.zeros((n, loop.nc))])
@@ -315,14 +315,14 @@ class _Sampled:
         loop, n, nc = self.loop, self.loop.n, self.loop.nc
         s = self.sample(k, z, v)
         t1 = (k + 1) * loop.dt if t_end is None else t_end
-        flow = _Flow(self.held, k * loop.dt, t1, np.concatenate([s[:n], s[n + nc:]]), mode,
+        flow = Flow(self.held, k * loop.dt, t1, np.concatenate([s[:n], s[n + nc:]]), mode,
                      lambda t: np.zeros(0), loop.params, variational=variational, **self.opts)
         z1 = np.concatenate([flow.x_final[:n], s[n:n + nc]])
         if not variational:
             return z1, flow.mode_final, flow, s[n + nc:]
         # ds/dz by central differences (exact for linear controllers), then the
         # flow Jacobian of the plant with held input [x, u]
-        S = _central_jacobian(lambda w: self.sample(k, w, v), z)
+        S = central_jacobian(lambda w: self.sample(k, w, v), z)
         xu = flow.phi @ S[np.r_[0:n, n + nc:n + nc + loop.m]]
         return z1, flow.mode_final, np.vstack([xu[:n], S[n:n + nc]]), s[n + nc:]
 
@@ -493,7 +493,7 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
     >>> resp.states.shape, bool(np.abs(resp.inputs).max() <= 2)
     ((2, 31), True)
     """
-    opts = _solver_settings('closed_loop_response', rtol, atol, method, max_events)
+    opts = solver_settings('closed_loop_response', rtol, atol, method, max_events)
     loop = _Loop(plant, controller, orbit, saturation)
     plant = loop.plant
     timepts = real_array(timepts, 'timepts', ndim=1)
@@ -501,7 +501,7 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
         raise ValueError("timepts must be strictly increasing with at least 2 points")
     z0, mode = _initial(loop, initial_state, controller_state, mode0, timepts[0])
     # the noise has one entry per plant output
-    vfun = _input_function(SimpleNamespace(ninputs=loop.p), 0.0 if noise is None else noise,
+    vfun = input_function(SimpleNamespace(ninputs=loop.p), 0.0 if noise is None else noise,
                            timepts)
     bar = _progress(progress, timepts)
     if loop.dt:
@@ -571,7 +571,7 @@ def _run_continuous(loop, opts, timepts, z, mode, vfun, bar):
     events = []
     edges = _chunks(timepts, loop.T)
     for a, b in zip(edges[:-1], edges[1:]):
-        flow = _Flow(lp, a, b, z, mode, vfun, loop.params, **opts)
+        flow = Flow(lp, a, b, z, mode, vfun, loop.params, **opts)
         inside = (timepts >= a) & (timepts < b)
         states[:, inside], modes[inside] = flow.evaluate(timepts[inside])
         events += [e[0] for e in flow.events]
@@ -638,7 +638,7 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
     >>> cl.is_stable, bool(np.isclose(cl.dominant_multiplier, np.exp(4 * np.pi)))
     (False, True)
     """
-    opts = _solver_settings('closed_loop_orbit', rtol, atol, method, max_events)
+    opts = solver_settings('closed_loop_orbit', rtol, atol, method, max_events)
     loop = _Loop(plant, controller, orbit, saturation)
     z0, mode0 = _initial(loop, orbit.x0, 0.0 if controller_state is None else controller_state,
                          orbit.mode0, 0.0)

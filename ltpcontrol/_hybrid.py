@@ -241,13 +241,13 @@ class HybridPlant:
         jac = self.modes[i].jacobian
         if jac is not None:
             return _matrix(jac(t, x, u, params), (self.nstates, self.nstates), 'jacobian')
-        return _central_jacobian(lambda z: self._f(i, t, z, u, params), x)
+        return central_jacobian(lambda z: self._f(i, t, z, u, params), x)
 
     def _dfdu(self, i, t, x, u, params):
         jac = self.modes[i].input_jacobian
         if jac is not None:
             return _matrix(jac(t, x, u, params), (self.nstates, self.ninputs), 'input_jacobian')
-        return _central_jacobian(lambda v: self._f(i, t, x, v, params), u)
+        return central_jacobian(lambda v: self._f(i, t, x, v, params), u)
 
 
 def _labels(spec, name, prefix, allow_zero=False):
@@ -273,7 +273,7 @@ def _matrix(value, shape, name):
     return arr.reshape(shape)
 
 
-def _central_jacobian(func, x):
+def central_jacobian(func, x):
     """∂func/∂x by central differences, ``(F(x + h e_j) − F(x − h e_j)) / 2h``."""
     x = np.asarray(x, float)
     f0 = np.atleast_1d(func(x))
@@ -359,8 +359,8 @@ def saltation_matrix(plant, mode, t, x, u=None, params=None):
     if x.size != plant.nstates:
         raise ControlDimension(f"x must have {plant.nstates} entries, got {x.size}")
     t = float(real_array(t, 't', ndim=0))
-    u = _constant_input(plant, u, 'u')
-    params = _params(plant, params)
+    u = constant_input(plant, u, 'u')
+    params = plant_params(plant, params)
     return _saltation(plant, i, t, x, u, params, lambda s: u)
 
 
@@ -370,9 +370,9 @@ def _saltation(plant, i, t, x, u, params, ufun):
     f_minus = plant._f(i, t, x, u, params)
     f_plus = plant._f(j, t, xp, u, params)
     # gradient of the guard in x and t (t-dependence includes the input signal)
-    dg_dx = _central_jacobian(lambda z: plant._g(i, t, z, u, params), x)[0]
+    dg_dx = central_jacobian(lambda z: plant._g(i, t, z, u, params), x)[0]
     dg_dt = float(_derivative(lambda s: plant._g(i, s, x, ufun(s), params), t))
-    dr_dx = _central_jacobian(lambda z: plant._r(i, t, z, u, params), x)
+    dr_dx = central_jacobian(lambda z: plant._r(i, t, z, u, params), x)
     dr_dt = _derivative(lambda s: plant._r(i, s, x, ufun(s), params), t)
     rate = dg_dx @ f_minus + dg_dt
     scale = np.linalg.norm(dg_dx) * np.linalg.norm(f_minus) + abs(dg_dt)
@@ -387,7 +387,7 @@ def _saltation(plant, i, t, x, u, params, ufun):
     return dr_dx + np.outer(f_plus - dr_dx @ f_minus - dr_dt, dg_dx) / rate
 
 
-def _params(plant, params):
+def plant_params(plant, params):
     if params is None:
         return dict(plant.params)
     if not isinstance(params, dict):
@@ -395,7 +395,7 @@ def _params(plant, params):
     return {**plant.params, **params}
 
 
-def _constant_input(plant, u, name):
+def constant_input(plant, u, name):
     if u is None:
         return np.zeros(plant.ninputs)
     u = real_array(u, name, ndim=(0, 1)).reshape(-1)
@@ -406,7 +406,7 @@ def _constant_input(plant, u, name):
     return u
 
 
-def _input_function(plant, inputs, timepts):
+def input_function(plant, inputs, timepts):
     """Return ``u(t)`` from a scalar, an array on `timepts` or a callable."""
     m = plant.ninputs
     if callable(inputs):
@@ -427,7 +427,7 @@ def _input_function(plant, inputs, timepts):
     return lambda t: np.array([np.interp(t, timepts, row) for row in arr])
 
 
-class _Flow:
+class Flow:
     """One integration of a hybrid plant over ``[t0, tf]`` with event handling.
 
     With ``variational=True`` the state transition matrix is propagated
@@ -505,8 +505,8 @@ class _Flow:
         return states, modes
 
 
-def _solver_settings(where, rtol=1e-10, atol=1e-12, method='DOP853', max_events=10000):
-    """Checked `solve_ivp` settings of the hybrid integrator (`_Flow`)."""
+def solver_settings(where, rtol=1e-10, atol=1e-12, method='DOP853', max_events=10000):
+    """Checked `solve_ivp` settings of the hybrid integrator (`Flow`)."""
     for value, label in [(rtol, 'rtol'), (atol, 'atol')]:
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) \
                 or not value > 0:
@@ -578,7 +578,7 @@ def simulate_hybrid(plant, timepts, initial_state, mode0=0, inputs=0.0, params=N
     >>> resp.modes[:3], resp.states.shape
     (array([0, 0, 0]), (2, 61))
     """
-    opts = _solver_settings('simulate_hybrid', rtol, atol, method, max_events)
+    opts = solver_settings('simulate_hybrid', rtol, atol, method, max_events)
     if not isinstance(plant, HybridPlant):
         raise ControlArgument(f"plant must be a HybridPlant, got {type(plant).__name__}")
     timepts = real_array(timepts, 'timepts', ndim=1)
@@ -588,9 +588,9 @@ def simulate_hybrid(plant, timepts, initial_state, mode0=0, inputs=0.0, params=N
     if x0.size != plant.nstates:
         raise ControlDimension(f"initial_state must have {plant.nstates} entries, got {x0.size}")
     mode0 = plant.mode_index(mode0, 'mode0')
-    params = _params(plant, params)
-    ufun = _input_function(plant, inputs, timepts)
-    flow = _Flow(plant, timepts[0], timepts[-1], x0, mode0, ufun, params, variational=False,
+    params = plant_params(plant, params)
+    ufun = input_function(plant, inputs, timepts)
+    flow = Flow(plant, timepts[0], timepts[-1], x0, mode0, ufun, params, variational=False,
                  **opts)
     states, modes = flow.evaluate(timepts)
     states[:, -1], modes[-1] = flow.x_final, flow.mode_final

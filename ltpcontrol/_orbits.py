@@ -18,8 +18,8 @@ import numpy as np
 from control import NonlinearIOSystem
 from control.exception import ControlArgument, ControlDimension
 
-from ._hybrid import (HybridMode, HybridPlant, _central_jacobian, _constant_input,
-                      _Flow, _params, _solver_settings)
+from ._hybrid import (HybridMode, HybridPlant, central_jacobian, constant_input,
+                      Flow, plant_params, solver_settings)
 from ._ltpsys import ltpss
 from ._periodic_matrix import PeriodicMatrix
 from ._validation import check_period, check_positive_int, real_array
@@ -158,7 +158,7 @@ def _phase_index(monodromy, multipliers, direction):
     return int(near[np.argmax(align)])
 
 
-def _as_hybrid(plant, jacobian):
+def as_hybrid(plant, jacobian):
     """A `HybridPlant` view of `plant` (a smooth system becomes one mode)."""
     if jacobian is not None and not callable(jacobian):
         raise ControlArgument(f"jacobian must be callable, got {type(jacobian).__name__}")
@@ -180,7 +180,7 @@ def _as_hybrid(plant, jacobian):
                        params=plant.params, name=plant.name)
 
 
-def _time_mismatch(plant, x0, u0, params, pairs):
+def time_mismatch(plant, x0, u0, params, pairs):
     """First vector field or guard that differs between the times of a pair.
 
     Compares at `x0` and a perturbed state; returns ``(label, mode name,
@@ -203,7 +203,7 @@ def _time_mismatch(plant, x0, u0, params, pairs):
 def _check_periodicity(plant, period, x0, u0, params):
     """Raise when a vector field or guard is not T-periodic in t."""
     probes = period * np.array([0.1234567, 0.5, 0.8765432])
-    bad = _time_mismatch(plant, x0, u0, params, [(t, t + period) for t in probes])
+    bad = time_mismatch(plant, x0, u0, params, [(t, t + period) for t in probes])
     if bad is not None:
         label, mode, t, _, diff = bad
         raise ValueError(f"plant is not periodic with period={period:g}: {label} of mode "
@@ -212,14 +212,14 @@ def _check_periodicity(plant, period, x0, u0, params):
 
 
 def _prepare(plant, period, x0, mode0, u0, params, jacobian):
-    hp = _as_hybrid(plant, jacobian)
+    hp = as_hybrid(plant, jacobian)
     period = check_period(period)
     x0 = real_array(x0, 'x0', ndim=(0, 1)).reshape(-1)
     if x0.size != hp.nstates:
         raise ControlDimension(f"x0 must have {hp.nstates} entries, got {x0.size}")
     mode0 = hp.mode_index(mode0, 'mode0')
-    u0 = _constant_input(hp, u0, 'u0')
-    return hp, period, x0, mode0, u0, _params(hp, params)
+    u0 = constant_input(hp, u0, 'u0')
+    return hp, period, x0, mode0, u0, plant_params(hp, params)
 
 
 def period_map(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=False,
@@ -265,11 +265,11 @@ def period_map(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=Fal
     >>> bool(np.isclose(J[0, 0], np.exp(-2 * np.pi)))
     True
     """
-    opts = _solver_settings('period_map', rtol, atol, method, max_events)
+    opts = solver_settings('period_map', rtol, atol, method, max_events)
     if not isinstance(jacobian, (bool, np.bool_)):
         raise ControlArgument(f"jacobian must be True or False, got {jacobian!r}")
     hp, period, x0, mode0, u0, params = _prepare(plant, period, x0, mode0, u0, params, None)
-    flow = _Flow(hp, 0.0, period, x0, mode0, lambda t: u0, params,
+    flow = Flow(hp, 0.0, period, x0, mode0, lambda t: u0, params,
                  variational=bool(jacobian), **opts)
     if jacobian:
         return flow.x_final, flow.mode_final, flow.phi
@@ -355,7 +355,7 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
     >>> bool(np.allclose(orbit.x0, [0.0, 1.0], atol=1e-9)), orbit.is_stable
     (True, True)
     """
-    opts = _solver_settings('periodic_orbit', rtol, atol, method, max_events)
+    opts = solver_settings('periodic_orbit', rtol, atol, method, max_events)
     hp, period, x0, mode0, u0, params = _prepare(plant, period, x0, mode0, u0, params, jacobian)
     tol, max_iter, max_periods, warmup, npoints = _shooting_options(
         tol, max_iter, max_periods, warmup, npoints)
@@ -412,7 +412,7 @@ class _PeriodShooter:
 
     def flow(self, x, mode, variational, options=None):
         u0 = self.u0
-        return _Flow(self.hp, 0.0, self.period, x, mode, lambda t: u0, self.params,
+        return Flow(self.hp, 0.0, self.period, x, mode, lambda t: u0, self.params,
                      variational=variational, **(options or self.opts))
 
     def simulate(self, x, mode, nper):
@@ -483,7 +483,7 @@ def _segment_average(func, a, b):
     return np.einsum('k,kij->ij', weights, func(t)) / 2
 
 
-def _check_orbit_of(orbit, plant, why_inputs):
+def check_orbit_of(orbit, plant, why_inputs):
     """`orbit` is a `PeriodicOrbit` of `plant` (a `HybridPlant` with inputs)."""
     if not isinstance(orbit, PeriodicOrbit):
         raise ControlArgument(f"orbit must be a PeriodicOrbit, got {type(orbit).__name__}")
@@ -539,8 +539,8 @@ def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, na
     ...                  np.sort(np.abs(orbit.multipliers)), rtol=1e-6))
     True
     """
-    hp = _as_hybrid(plant, jacobian)
-    _check_orbit_of(orbit, hp, "an LTP model needs at least one input")
+    hp = as_hybrid(plant, jacobian)
+    check_orbit_of(orbit, hp, "an LTP model needs at least one input")
     if not isinstance(piecewise_constant, (bool, np.bool_)):
         raise ControlArgument(f"piecewise_constant must be True or False, "
                               f"got {piecewise_constant!r}")
@@ -554,8 +554,8 @@ def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, na
     derivatives = {
         'A': lambda i, t, x: hp._dfdx(i, t, x, u0, params),
         'B': lambda i, t, x: hp._dfdu(i, t, x, u0, params),
-        'C': lambda i, t, x: _central_jacobian(lambda z: h_of(t, z, u0), x),
-        'D': lambda i, t, x: _central_jacobian(lambda v: h_of(t, x, v), u0),
+        'C': lambda i, t, x: central_jacobian(lambda z: h_of(t, z, u0), x),
+        'D': lambda i, t, x: central_jacobian(lambda v: h_of(t, x, v), u0),
     }
     times = np.concatenate([[0.0], orbit.switching_times])
     ends = np.append(times[1:], T)
