@@ -30,8 +30,8 @@ import numpy as np
 from control.exception import ControlArgument
 
 from ._floquet import _log_multipliers
-from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix
+from ._validation import as_ltp
 
 __all__ = ['lmi_statefbk', 'LMIDesign']
 
@@ -135,7 +135,7 @@ def lmi_statefbk(sysd, Q=None, R=None, objective='h2', G=None, rate=None, solver
     ('optimal', True)
     """
     import cvxpy as cp
-    if not isinstance(sysd, LTPStateSpace) or not sysd.isdtime(strict=True):
+    if not as_ltp(sysd, 'sysd').isdtime(strict=True):
         raise ControlArgument("sysd must be a discrete-time LTPStateSpace (sample a "
                               "continuous-time plant with sample_system)")
     if objective not in ('h2', 'hinf', 'decay'):

@@ -50,7 +50,7 @@ from ._floquet_fit import _harmonic_data
 from ._htf import HTF, HTFData
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix
-from ._validation import check_kwargs, check_positive_int, real_array, steps_per_period
+from ._validation import as_ltp, check_kwargs, check_positive_int, real_array, steps_per_period
 
 __all__ = ['refine_ltp', 'RefineInfo']
 
@@ -514,9 +514,9 @@ def refine_ltp(sys, data, *, std=None, harmonics=None, weighted=True, stable=Fal
     (True, 'lambda[0]')
     """
     check_kwargs(kwargs, 'refine_ltp')
-    if not isinstance(sys, LTPStateSpace) or sys.isdtime():
-        raise ControlArgument("sys must be a continuous-time LTPStateSpace, got "
-                              f"{type(sys).__name__}")
+    if as_ltp(sys).isdtime():
+        raise ControlArgument("sys must be a continuous-time LTPStateSpace, got a "
+                              "discrete-time one")
     if sys.nstates == 0:
         raise ValueError("sys has no states: nothing to refine")
     Asamp = sys.A.sample(8)

@@ -207,7 +207,7 @@ def test_bad_input():
         ltp.refine_ltp(periodic_a, H)
     with pytest.raises(ValueError, match="repeated eigenvalues"):
         ltp.refine_ltp(ltp.ltpss(-np.eye(2), np.ones((2, 1)), np.ones((1, 2)), 0, 1.0), H)
-    with pytest.raises(ControlArgument, match="continuous-time LTPStateSpace"):
+    with pytest.raises(ControlArgument, match="must be an LTPStateSpace"):
         ltp.refine_ltp(ct.ss(-1, 1, 1, 0), H)
     with pytest.raises(ControlArgument, match="model HTF"):
         ltp.refine_ltp(true, ltp.htf(true, 1))
