@@ -182,7 +182,7 @@ def prediction_errors(H, t, u, y):
     """
     with warnings.catch_warnings():
         warnings.filterwarnings('ignore', message='the input excites HTF components')
-        return np.array([ltp.e_rms(yi, H.predict(t, ui)) for ui, yi in zip(u, y)])
+        return np.array([ltp.e_rms(yi, H.predict(t, ui).outputs) for ui, yi in zip(u, y)])
 
 
 def run(quick=QUICK, n_jobs=2, seed=2017):
@@ -218,8 +218,8 @@ def run(quick=QUICK, n_jobs=2, seed=2017):
     one_hz = np.argmin(np.abs(out['sine_frequencies'] - 1.0))
     out['sine_errors'] = errors[bands[0], nbest]
     out['erms_1hz'] = float(out['sine_errors'][one_hz])
-    out['one_hz'] = (t_sine, y_sine[one_hz], best.predict(t_sine, u_sine[one_hz]))
-    y_step_hat = best.predict(t_step, u_step)
+    out['one_hz'] = (t_sine, y_sine[one_hz], best.predict(t_sine, u_sine[one_hz]).outputs)
+    y_step_hat = best.predict(t_step, u_step).outputs
     out['erms_step'] = ltp.e_rms(y_step, y_step_hat)
     out['step'] = (t_step, y_step, y_step_hat)
 

@@ -229,7 +229,9 @@ class HTF(abc.ABC):
 
         Returns
         -------
-        y : ndarray, shape (ny, L) (or (L,) for SISO input given as 1D)
+        resp : control.TimeResponseData
+            ``resp.outputs`` of shape ``(ny, L)`` (squeezed to ``(L,)`` for
+            a single-input, single-output HTF, as python-control does).
 
         Raises
         ------
@@ -241,7 +243,7 @@ class HTF(abc.ABC):
         --------
         >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
         >>> t = np.arange(400) * 0.01
-        >>> y = ltp.htf(sys, 1).predict(t, np.cos(2 * np.pi * t))
+        >>> y = ltp.htf(sys, 1).predict(t, np.cos(2 * np.pi * t)).outputs
         >>> G = 1 / (2j * np.pi + 1)
         >>> bool(np.allclose(y, abs(G) * np.cos(2 * np.pi * t + np.angle(G))))
         True
@@ -252,7 +254,6 @@ class HTF(abc.ABC):
                              "do not: pass predict(t, u)")
         t = real_array(timepts, 'timepts', ndim=1)
         u = real_array(inputs, 'inputs', ndim=(1, 2))
-        squeeze = u.ndim == 1
         u = np.atleast_2d(u)
         if u.shape != (self.ninputs, len(t)):
             raise ControlDimension(f"inputs must have shape ({self.ninputs}, {len(t)}), "
@@ -289,7 +290,10 @@ class HTF(abc.ABC):
                           "identify; those terms are taken as zero", UserWarning,
                           stacklevel=2)
         y = np.fft.ifft(Y, axis=1).real
-        return y[0] if squeeze and self.noutputs == 1 else y
+        return ct.TimeResponseData(t, y, None, u, issiso=self.ninputs == self.noutputs == 1,
+                                   output_labels=self.output_labels,
+                                   input_labels=self.input_labels,
+                                   title=f"HTF prediction of {self.name}")
 
     def plot(self, *args, **kwargs):
         """Bode plot of selected components; see `ltpcontrol.bode_htf`.

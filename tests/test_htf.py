@@ -113,7 +113,7 @@ def test_predict_equals_simulated_steady_state():
     u = np.cos(2 * np.pi * 0.7 * t) + 0.5 * np.sin(2 * np.pi * 1.3 * t)
     y = ltp.forced_response(sys, t, u).y[0]
     window = t >= 20
-    yp = H.predict(t[window] - 20, u[window])
+    yp = H.predict(t[window] - 20, u[window]).outputs
     # agreement up to the input-hold effect (sinc² ≈ 1 - 2e-4 at 1.3 Hz)
     assert np.abs(yp - y[window]).max() <= 1e-3 * np.abs(y).max()
 
@@ -192,7 +192,8 @@ def test_data_htf_marks_unidentified_components_with_nan():
     low = np.cos(2 * np.pi * 0.5 * t)             # excites only identified terms
     with warnings.catch_warnings():
         warnings.simplefilter('error')
-        np.testing.assert_allclose(data.predict(t, low), model.predict(t, low), atol=1e-12)
+        np.testing.assert_allclose(data.predict(t, low).outputs, model.predict(t, low).outputs,
+                                   atol=1e-12)
     high = np.cos(2 * np.pi * 3.5 * t)            # ω = 22 rad/s needs G_1 there
     with pytest.warns(UserWarning, match="did not identify"):
         data.predict(t, high)
@@ -238,4 +239,5 @@ def test_predict_in_the_old_order_is_refused():
     u = np.cos(2 * np.pi * t)
     with pytest.raises(ValueError, match="order"):
         H.predict(u, t)
-    np.testing.assert_array_equal(H.predict(timepts=t, inputs=u), H.predict(t, u))
+    np.testing.assert_array_equal(H.predict(timepts=t, inputs=u).outputs,
+                                  H.predict(t, u).outputs)

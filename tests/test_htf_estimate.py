@@ -251,7 +251,7 @@ def test_returns_htf_that_predicts_new_inputs(replica_data):
     u = lambda s: 0.5 * np.cos(2 * np.pi * 0.3 * s) + np.sin(2 * np.pi * 0.45 * s)
     yv = system.simulate(u, t)[0]
     keep = t >= 40                                    # 20 periods of T and of u
-    y_hat = H.predict(t[keep], u(t[keep]))
+    y_hat = H.predict(t[keep], u(t[keep])).outputs
     assert e_rms(yv[keep], y_hat) < 0.5
 
 

@@ -193,7 +193,7 @@ def test_htf_predicts_simulated_steady_state(q, amp, phase):
     u = amp * np.cos(np.pi * q * t + phase)  # 2 s (4 periods) hold whole input cycles
     y = ltp.forced_response(sys, t, u).outputs
     window = (t >= 6) & (t < 8 - h / 2)
-    predicted = H.predict(t[window], u[window])
+    predicted = H.predict(t[window], u[window]).outputs
     np.testing.assert_allclose(y[window], predicted, atol=1e-3 * np.abs(predicted).max())
 
 
