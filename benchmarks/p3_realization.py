@@ -72,10 +72,10 @@ def make_model(seed):
     return sysd, ident
 
 
-def exponent_error(res, sysd):
-    if res.sys is None:
+def exponent_error(realization, sysd):
+    if realization is None:
         return np.inf
-    got = np.sort_complex(np.linalg.eigvals(res.sys.A(0.0)))
+    got = np.sort_complex(np.linalg.eigvals(realization.A(0.0)))
     true = np.sort_complex(np.linalg.eigvals(sysd.A(0.0)))
     return float(np.abs(got - true).max())
 
@@ -91,15 +91,15 @@ def run(quick=False, log=print):
     def call(ident, **kw):
         with warnings.catch_warnings():
             warnings.simplefilter('ignore')
-            return fn(ident, K, NSTEPS, progress=False, **kw)
+            return fn(ident, K, NSTEPS, progress=False, return_info=True, **kw)
 
     log(f"P3: 'direct' on {len(models)} models")
     t_direct, d_ok, d_err = [], [], []
     for sysd, ident in models:
-        el, _, res = median_time(lambda: call(ident, method='direct'), cfg['repeats'])
+        el, _, (real, res) = median_time(lambda: call(ident, method='direct'), cfg['repeats'])
         t_direct.append(el)
         d_ok.append(bool(res.success))
-        d_err.append(exponent_error(res, sysd))
+        d_err.append(exponent_error(real, sysd))
     log(f"P3: 'pso' on {cfg['pso_models']} models")
     t_pso, p_ok, p_err, p_dist = [], [], [], []
     for seed, (sysd, ident) in enumerate(models[:cfg['pso_models']]):
@@ -108,10 +108,10 @@ def run(quick=False, log=print):
             opts['pso_options'] = cfg['pso_options']
         if cfg['minimize_options']:
             opts['minimize_options'] = cfg['minimize_options']
-        el, res = timed(call, ident, method='pso', seed=seed, **opts)
+        el, (real, res) = timed(call, ident, method='pso', seed=seed, **opts)
         t_pso.append(el)
         p_ok.append(bool(res.success))
-        p_err.append(exponent_error(res, sysd))
+        p_err.append(exponent_error(real, sysd))
         p_dist.append(float(res.corrected_distance))
     per_direct = float(np.mean(t_direct))
     per_pso = float(np.mean(t_pso))
