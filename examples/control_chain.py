@@ -90,6 +90,22 @@ def push_recovery(plant, orbit, controller, t_push, dv, nstrides, *, npoints=40,
     return opened, closed
 
 
+def push_study(plant, orbit, controller, mode, dv, nstrides, dt, *, progress=False):
+    """Push ``Δv`` mid-`mode` (on a sample instant of `dt`): responses and figures.
+
+    Returns ``t_push, (opened, closed), figures`` with the strides to
+    recover open and closed loop and the closed loop's peak actuator effort.
+    """
+    t_mode = orbit.time[orbit.modes == plant.mode_index(mode)]
+    t_push = round(0.5 * (t_mode[0] + t_mode[-1]) / dt) * dt
+    opened, closed = push_recovery(plant, orbit, controller, t_push, dv, nstrides,
+                                   progress=progress)
+    figures = {'strides open': strides_to_recover(opened, orbit, t_push, nstrides)[0],
+               'strides closed': strides_to_recover(closed, orbit, t_push, nstrides)[0],
+               'effort': float(np.max(np.abs(closed.inputs)))}
+    return t_push, (opened, closed), figures
+
+
 def _simulate_experiment(plant, orbit, exc, row, solver):
     signal = exc.signal
     resp = ltp.simulate_hybrid(plant, exc.time, orbit.x0, orbit.mode0,

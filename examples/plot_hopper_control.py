@@ -41,7 +41,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import ltpcontrol as ltp  # noqa: E402
-from control_chain import output_lqg, push_recovery, record, strides_to_recover  # noqa: E402
+from control_chain import output_lqg, push_study, record  # noqa: E402
 from hopper import PERIOD, hopper_orbit, hopper_plant  # noqa: E402
 
 QUICK = os.environ.get('LTP_EXAMPLES_QUICK', '0') == '1'
@@ -85,14 +85,10 @@ def run(progress=False):
         out[label] = ltp.closed_loop_orbit(plant, ctrl, orbit).dominant_multiplier
 
     # push in the middle of the lossless (falling) phase, on a sample instant
-    lossless = plant.mode_index('lossless')
-    t_fall = orbit.time[orbit.modes == lossless]
-    t_push = round(0.5 * (t_fall[0] + t_fall[-1]) / dt) * dt
-    opened, closed = push_recovery(plant, orbit, designs['identified'], t_push,
-                                   np.array([0.0, PUSH]), NSTRIDES, progress=progress)
-    out['strides open'] = strides_to_recover(opened, orbit, t_push, NSTRIDES)[0]
-    out['strides closed'] = strides_to_recover(closed, orbit, t_push, NSTRIDES)[0]
-    out['effort'] = float(np.max(np.abs(closed.inputs)))
+    t_push, (opened, closed), figures = push_study(
+        plant, orbit, designs['identified'], 'lossless', np.array([0.0, PUSH]), NSTRIDES, dt,
+        progress=progress)
+    out.update(figures)
     out['seconds'] = time.perf_counter() - start
     return out, orbit, (opened, closed), t_push
 

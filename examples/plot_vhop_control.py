@@ -71,8 +71,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import ltpcontrol as ltp  # noqa: E402
-from control_chain import (output_lqg, push_recovery, record_experiments,  # noqa: E402
-                           strides_to_recover)
+from control_chain import output_lqg, push_study, record_experiments  # noqa: E402
 from vhop import PERIOD, vhop_orbit, vhop_plant  # noqa: E402
 
 QUICK = os.environ.get('LTP_EXAMPLES_QUICK', '0') == '1'
@@ -138,15 +137,10 @@ def run(progress=False):
         out[label] = ltp.closed_loop_orbit(plant, ctrl, orbit).dominant_multiplier
 
     # push on the body velocity in the middle of the flight phase, on a sample instant
-    flight = plant.mode_index('flight')
-    t_air = orbit.time[orbit.modes == flight]
-    t_push = round(0.5 * (t_air[0] + t_air[-1]) / dt) * dt
-    opened, closed = push_recovery(plant, orbit, designs['identified'], t_push,
-                                   np.array([0.0, 0.0, PUSH, 0.0]), NSTRIDES,
-                                   progress=progress)
-    out['strides open'] = strides_to_recover(opened, orbit, t_push, NSTRIDES)[0]
-    out['strides closed'] = strides_to_recover(closed, orbit, t_push, NSTRIDES)[0]
-    out['effort'] = float(np.max(np.abs(closed.inputs)))
+    t_push, (opened, closed), figures = push_study(
+        plant, orbit, designs['identified'], 'flight', np.array([0.0, 0.0, PUSH, 0.0]),
+        NSTRIDES, dt, progress=progress)
+    out.update(figures)
     out['seconds'] = time.perf_counter() - start
     return out, orbit, (opened, closed), t_push
 

@@ -388,6 +388,7 @@ def _saltation(plant, i, t, x, u, params, ufun):
 
 
 def plant_params(plant, params):
+    """The plant's parameters updated by `params` (a dict or None)."""
     if params is None:
         return dict(plant.params)
     if not isinstance(params, dict):
@@ -396,6 +397,7 @@ def plant_params(plant, params):
 
 
 def constant_input(plant, u, name):
+    """Constant input vector of `plant` from None (zero), a scalar or one entry per input."""
     if u is None:
         return np.zeros(plant.ninputs)
     u = real_array(u, name, ndim=(0, 1)).reshape(-1)
