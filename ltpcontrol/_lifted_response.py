@@ -25,6 +25,7 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 from tqdm.auto import tqdm
 
+from ._htf import HTF, HTFData
 from ._lifting import _harmonic_labels, _real_basis
 from ._validation import (check_kwargs, check_period, check_positive, check_positive_int,
                           real_array, steps_per_period, time_record)
@@ -61,16 +62,22 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     separate the inputs (`sine_experiments` and `multisine` with
     ``ninputs``); the response is their least-squares solution per line.
 
+    A data HTF (`estimate_htf`, e.g. from chirps) gives the same response
+    on its own grid: ``G_n(jΩ)`` is its component n at the output frequency
+    ``Ω + nω_p`` (see Notes).
+
     Parameters
     ----------
-    response : control.TimeResponseData or tuple
+    response : control.TimeResponseData, tuple or HTFData
         The experiments: a response of `ltpcontrol.forced_response` with
         several traces, or a tuple ``(timepts, inputs, outputs)`` with
         ``inputs`` of shape ``(nexp, L)`` (single input) or ``(ninputs,
         nexp, L)`` and ``outputs`` of shape ``(nexp, L)`` (single output)
         or ``(noutputs, nexp, L)``.  ``timepts`` (length L, uniform step
         ``Ts``) are absolute times: ``t = 0`` is the phase reference of the
-        period.
+        period.  Or a data HTF (`ltpcontrol.estimate_htf`); the record
+        options (`frequencies`, `transient`, `input_hold`, `hold_step`,
+        `batch_size`) then do not apply.
     period : float
         Period T of the system; ``N = T/Ts`` must be an integer.
     nharmonics : int
@@ -162,6 +169,15 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     experiments exciting Ω give ``G_n`` by least squares, each weighted by
     ``1/‖U^{(e)}‖²`` (Conventions page, multi-input identification).
 
+    *From an HTF estimate.*  The lines are the frequencies ``Ω > 0`` of the
+    HTF's grid, except multiples of ``ω_p/2``, at which all 2K+1 values
+    ``G_n(jΩ)`` (component n at ``Ω + nω_p``; for ``Ω + nω_p < 0``
+    ``conj G_{-n}`` at ``-(Ω + nω_p)``) are known, i.e. the input
+    frequencies the estimate's data excited.  The grid of `estimate_htf`
+    holds every ``Ω + nω_p`` of its points.  The sampling step of the
+    result is ``Ts = T/N`` with N the smallest even number above ``2K+1``
+    and ``2Ω_max/ω_p`` (every line below the Nyquist frequency).
+
     Examples
     --------
     Two unit cosines through a static gain ``1 + cos(ω_p t)``:
@@ -193,6 +209,9 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     """
     check_kwargs(kwargs, 'lifted_frequency_response')
     period = check_period(period)
+    if isinstance(response, HTF):
+        K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
+        return _htf_lifted(response, period, K, real, name)
     t, dt, u, y, ylabels, ulabels = _parse_response(response)
     N = steps_per_period(period, dt, 'the time step of timepts')
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
@@ -327,6 +346,38 @@ def _solve_lines(omega, U, Y, window):
     # G gram = rhs  <=>  gram^T G^T = rhs^T (gram Hermitian)
     G = np.linalg.solve(gram.conj(), rhs.transpose(0, 2, 1)).transpose(0, 2, 1)
     return lines, G
+
+
+def _htf_lifted(H, period, K, real, name):
+    """Lifted response (see Notes) on the grid of the data HTF `H`."""
+    if not isinstance(H, HTFData):
+        raise ControlArgument("response must be a data HTF (estimate_htf), got a model HTF")
+    if not np.isclose(H.period, period, rtol=1e-9, atol=0):
+        raise ValueError(f"the HTF's period {H.period} differs from period={period}")
+    if K > H.nharmonics:
+        raise ValueError(f"nharmonics={K} exceeds the HTF's {H.nharmonics} harmonics")
+    om, (_, G) = H.omega, H.components()
+    wp, Kh = 2 * np.pi / period, H.nharmonics
+    tol = 1e-6 * np.min(np.diff(om), initial=wp)
+    half = np.abs(2 * om / wp - np.round(2 * om / wp)) * wp / 2 <= tol
+    cand = np.nonzero((om > tol) & ~half)[0]
+    n = np.arange(-K, K + 1)
+    w = om[cand, None] + n[None, :] * wp                   # output frequencies (lines, n)
+    pos = np.searchsorted(om, np.abs(w) - tol).clip(0, om.size - 1)
+    ongrid = np.abs(om[pos] - np.abs(w)) <= tol
+    # G_n(jΩ) = component n at Ω + nω_p, or conj G_{-n} at -(Ω + nω_p)
+    comp = np.where(w >= 0, Kh + n, Kh - n)
+    vals = G[comp, :, :, pos]                                # (lines, 2K+1, ny, nu)
+    vals = np.where((w < 0)[..., None, None], np.conj(vals), vals)
+    keep = ongrid.all(axis=1) & np.all(np.isfinite(vals), axis=(1, 2, 3))
+    if not keep.any():
+        raise ValueError(f"no frequency of the HTF has all {2 * K + 1} components "
+                         "G_n(jΩ) known: use fewer harmonics")
+    omega, vals = om[cand[keep]], vals[keep]
+    N = 2 * int(max(K + 1, np.floor(omega.max() / wp) + 1))
+    ny, nu = vals.shape[2:]
+    return _lifted_frd(vals.reshape(omega.size, -1, nu), omega, period / N, K, N, real,
+                       list(H.output_labels), list(H.input_labels), name or H.name)
 
 
 def _lifted_frd(G, omega, dt, K, N, real, ylabels, ulabels, name):

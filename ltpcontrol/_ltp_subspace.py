@@ -31,6 +31,7 @@ from control.exception import ControlArgument
 from ._discretize import d2c
 from ._fdsubspace import fdsubspace, FDSubspaceInfo
 from ._floquet_fit import _harmonic_data, _harmonic_response, fit_floquet
+from ._htf import HTF
 from ._lifted_response import lifted_frequency_response
 from ._realization import FloquetRealization, floquet_realization
 from ._refine import refine_ltp
@@ -113,11 +114,12 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
 
     Parameters
     ----------
-    data : control.FrequencyResponseData, control.TimeResponseData or tuple
+    data : control.FrequencyResponseData, control.TimeResponseData, tuple or HTFData
         Either the real lifted response of `lifted_frequency_response`
-        (with ``2K+1`` harmonics per output, one column per input) or the
+        (with ``2K+1`` harmonics per output, one column per input), the
         experiments themselves (anything `lifted_frequency_response`
-        accepts, single- or multi-input).
+        accepts, single- or multi-input), or a data HTF of `estimate_htf`
+        (e.g. from chirps), whose lifted response is taken on its grid.
     period : float
         Period T of the system.
     nstates : int
@@ -169,7 +171,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     refine : {None, 'ml'}, optional
         'ml': finish with `ltpcontrol.refine_ltp` on the lifted data (the
         maximum-likelihood fit of the Floquet-form model, equal weights
-        unless ``refine_options`` gives ``std``); default None.
+        unless ``refine_options`` gives ``std``), or, when `data` is an
+        HTF, on all its components weighted by its ``std``; default None.
     refine_options : dict, optional
         Keywords of `ltpcontrol.refine_ltp` (``std``, ``stable``,
         ``harmonics``, ...).
@@ -301,7 +304,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     # 6. optional maximum-likelihood refinement weighted by the data's uncertainty
     ml = None
     if refine == 'ml':
-        sysc, ml = refine_ltp(sysc, G, return_info=True, **(refine_options or {}))
+        sysc, ml = refine_ltp(sysc, data if isinstance(data, HTF) else G, return_info=True,
+                              **(refine_options or {}))
         nfev += ml.nfev
     Kc = K if conversion == 'refit' else min(K, Kr)
     Gk = Gc if Kc == K else _harmonic_data(G.frdata, Kc, N, ny)
@@ -320,10 +324,12 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
 def _lifted_data(data, period, K, progress, options):
     """Step 1: the real lifted response, given or computed from time records."""
     given = {key: val for key, val in options.items() if val is not None}
-    if isinstance(data, ct.FrequencyResponseData):
+    if isinstance(data, (ct.FrequencyResponseData, HTF)):
         if given:
             raise TypeError(f"identify_ltp: {sorted(given)} only apply to time "
                             "records, not to frequency-response data")
+        if isinstance(data, HTF):
+            return lifted_frequency_response(data, period, K)
         return data
     return lifted_frequency_response(data, period, K, progress=progress,
                                      unusable='skip', **given)

@@ -105,6 +105,10 @@ class RefineInfo:
         Floquet exponents (eigenvalues of A) of the refined model.
     active : bool
         True when the stability constraint holds some exponent at its bound.
+    realize : callable
+        ``realize(x)`` is the model at the parameters `x` (same basis and
+        labels as the returned one), e.g. for parameters drawn from
+        ``N(x, cov)`` to propagate the covariance to a prediction.
 
     Examples
     --------
@@ -127,6 +131,21 @@ class RefineInfo:
     dof: int
     exponents: np.ndarray
     active: bool
+    realize: object = field(default=None, repr=False, compare=False)
+
+
+class _Realizer:
+    """Parameters θ → refined model (picklable; `RefineInfo.realize`)."""
+
+    def __init__(self, par, kinds, period, labels):
+        self.par, self.kinds, self.period, self.labels = par, kinds, period, labels
+
+    def __call__(self, x):
+        x = real_array(x, 'x', ndim=1)
+        if x.size != self.par.theta0.size:
+            raise ControlDimension(f"x must have {self.par.theta0.size} parameters, "
+                                   f"got {x.size}")
+        return _real_modal(*self.par.unpack(x), self.kinds, self.period, **self.labels)
 
 
 # ------------------------------------------------------------------ data
@@ -550,6 +569,10 @@ def refine_ltp(sys, data, *, std=None, harmonics=None, weighted=True, stable=Fal
     _normalise(Bt, Ct, kinds)
     par = _Parametrisation(lam, Bt, Ct, sys.D.fourier(KD), kinds, refine_a, estimate_d)
 
+    # only the points (k, Ω) with some known entry enter the model evaluations
+    given = np.isfinite(vals).any(axis=(1, 2))
+    k, Om, vals = k[given], Om[given], vals[given]
+    std = None if std is None else std[given]
     mask = np.isfinite(vals)
     if weighted and std is not None:
         bad = mask & ~(np.isfinite(std) & (std > 0))
@@ -626,14 +649,15 @@ def refine_ltp(sys, data, *, std=None, harmonics=None, weighted=True, stable=Fal
         warnings.warn("the stability constraint is active at the solution: the data favour "
                       "a less stable model; the covariance ignores the bound", UserWarning,
                       stacklevel=2)
-    lam_t, Bt_t, Ct_t, D_t = par.unpack(theta)
-    model = _real_modal(lam_t, Bt_t, Ct_t, D_t, kinds, period,
-                        name=sys.name if name is None else name,
-                        inputs=sys.input_labels, outputs=sys.output_labels)
+    realize = _Realizer(par, kinds, period, dict(name=sys.name if name is None else name,
+                                                 inputs=sys.input_labels,
+                                                 outputs=sys.output_labels))
+    model = realize(theta)
     if not return_info:
         return model
     info = RefineInfo(success=success, message=message, nfev=nfev, njev=njev, x=theta,
                       cov=cov, std=np.sqrt(np.diag(cov)), fisher=fisher, names=par.names,
                       cost=0.5 * float(f @ f), initial_cost=0.5 * float(f0 @ f0),
-                      noise_scale=scale, dof=dof, exponents=lam_t, active=active)
+                      noise_scale=scale, dof=dof, exponents=par.unpack(theta)[0],
+                      active=active, realize=realize)
     return model, info
