@@ -147,3 +147,31 @@ def test_vhop_noise_study_lowers_error_at_1hz():
     # components dominates; the significant ones, smoothed, predict better
     assert np.all(res['reduced_smooth'] < 0.7 * res['thesis'])
     assert np.all(res['reduced_gcv'] < res['thesis'])
+
+
+@pytest.mark.slow
+def test_vhop_ml_refinement_beats_subspace_at_1hz():
+    # truth: an LTP plant with the VHOP's matrices; quick chirps, input and output
+    # noise at SNR 12.5, one seeded draw
+    plant = _vhop_like_plant()
+    exc = ltp.chirp_replicas(vh.PERIOD, dt=vh.DT, **vh.QUICK_DESIGN)
+    y = ltp.forced_response(plant, exc.time, exc.inputs).outputs
+    u_noisy, y_noisy = vh.add_noise(exc, y, vh.SNR, np.random.default_rng(3))
+    best, sub, ml, info = vh.ltp_models(exc, u_noisy, y_noisy, 5.0, 3)
+    assert best[0] in vh.LTP_STATES and best[1] == 3
+    nper = int(round(vh.PERIOD / vh.DT))
+    n = vh.NPERIODS * nper
+    t = np.arange(vh.SETTLE * nper + n) * vh.DT
+    u = 0.1 * np.cos(2 * np.pi * round(n * vh.DT) / (n * vh.DT) * t)
+    y_sine = ltp.forced_response(plant, t, u).outputs[-n:]
+    t, u = t[-n:], u[-n:]
+    errors = [ltp.e_rms(y_sine, vh.model_prediction(m, t, u)) for m in (sub, ml)]
+    assert errors[1] < errors[0]
+    assert errors[1] < 15.0
+    # the weighted residual per degree of freedom is at most that of the data's std
+    # (0.45 here: the pooled noise variance is conservative for this plant), so the
+    # reported covariance (inverse Fisher information) is not optimistic
+    assert 0.3 < info.noise_scale < 1.6
+    assert np.allclose(info.cov, info.cov.T) and np.all(np.linalg.eigvalsh(info.cov) > -1e-12)
+    spread = vh.crb_spread(info, t, u, y_sine, np.random.default_rng(0), 10)
+    assert 0.0 < spread < errors[1] + 5.0
