@@ -64,6 +64,9 @@ hopping limit cycle, ``y = h − h_lc``.
    spread an efficient estimator shows over noise draws; it is
    compared with the observed spread over the draws and with the error of
    the same model structure on noise-free data (its bias).
+   Four draws: E_rms at 1 Hz 24 ± 4 % (21 HTFs), 856 ± 586 % (subspace;
+   9 ± 2 % with its checked harmonics), 5.0 ± 1.6 % (ML, n_p = 2, K = 3-4);
+   Cramér-Rao spread 1.7 %, observed spread 4.3 %, noise-free 1.7 %.
 
 Set ``LTP_EXAMPLES_QUICK=1`` for a reduced run (shorter chirps, fewer
 sines, fewer harmonic counts).
