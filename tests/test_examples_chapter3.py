@@ -105,6 +105,11 @@ def test_vhop_prediction():
     assert res['gcv_alpha'] > 0
     study = res['noise_study']
     assert study['reduced_smooth'].mean() < study['thesis'].mean()
+    # the ML-refined LTP model of the same draws predicts the 1 Hz sine best
+    ltps = res['ltp_study']
+    assert ltps['ml'][:, -1].mean() < min(ltps['htf'][:, -1].mean(),
+                                          ltps['subspace_k'][:, -1].mean())
+    assert np.all(ltps['crb'] > 0) and np.all(ltps['noise_scale'] < 2)
     # the step response is captured qualitatively only (thesis: 68 %)
     assert 0.0 < res['erms_step'] < 150.0
 
