@@ -100,7 +100,7 @@ class LTPSubspaceInfo:
 
 def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
                  realization='direct', realization_options=None, refit_a=True,
-                 refit_harmonics=None, refine=None, refine_options=None,
+                 refit_harmonics='auto', refine=None, refine_options=None,
                  estimate_d=True, frequencies=None, transient=None, input_hold=None,
                  hold_step=None, batch_size=None, seed=None, progress=False,
                  return_info=False, name=None, **kwargs):
@@ -273,8 +273,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
     if conversion not in _CONVERSIONS:
         raise ValueError(f"conversion must be one of {_CONVERSIONS}, got {conversion!r}")
-    H = K if refit_harmonics is None else check_positive_int(
-        refit_harmonics, 'refit_harmonics', minimum=K)
+    if refit_harmonics != 'auto':
+        refit_harmonics = check_positive_int(refit_harmonics, 'refit_harmonics', minimum=K)
     if refine not in (None, 'ml'):
         raise ValueError(f"refine must be None or 'ml', got {refine!r}")
     # 1. lifted frequency response
@@ -293,8 +293,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     # 5. structured refinement: the Floquet-form model fitted to the harmonic data
     nfev, converged = 0, True
     if conversion == 'refit':
-        sysc, _, converged, nfev = fit_floquet(sysc, Gc, G.omega, K, harmonics=H,
-                                               estimate_d=estimate_d, fit_a=refit_a, **labels)
+        sysc, converged, nfev = _refit(sysc, Gc, G.omega, K, refit_harmonics, estimate_d,
+                                       refit_a, labels)
         if not converged:
             warnings.warn("the least-squares refit did not converge", UserWarning,
                           stacklevel=2)
@@ -385,6 +385,25 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
     if best is None:
         raise ValueError(f"the Floquet realization failed: {real.message}")
     return best[1:]
+
+
+def _refit(sys, Gc, omega, K, harmonics, estimate_d, fit_a, labels):
+    """Step 5: the refit with ``H = harmonics`` harmonics in B, or for 'auto' with
+    H = K, then H = K + 1 (started there) kept if the BIC prefers it."""
+    H = K if harmonics == 'auto' else harmonics
+    start = sys
+    sys, res, converged, nfev = fit_floquet(start, Gc, omega, K, harmonics=H,
+                                            estimate_d=estimate_d, fit_a=fit_a, **labels)
+    if harmonics == 'auto':
+        wide, res1, conv1, nfev1 = fit_floquet(start, Gc, omega, K, harmonics=K + 1,
+                                               estimate_d=estimate_d, fit_a=fit_a, **labels)
+        nfev += nfev1
+        # BIC = N log(SSE / N) + p log N: N real residuals, B_{±(K+1)} add 2 n_p m parameters
+        nres, extra = 2 * Gc.size, 2 * sys.nstates * Gc.shape[0]
+        tiny = np.finfo(float).tiny
+        if nres * np.log(max(res1, tiny) ** 2 / max(res, tiny) ** 2) + extra * np.log(nres) < 0:
+            sys, converged = wide, conv1
+    return sys, converged, nfev
 
 
 def _quality(real, Kr, K, conversion, relres, converged, ml, options):
