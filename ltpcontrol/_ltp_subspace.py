@@ -141,8 +141,9 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
           inverting a zero-order hold (`ltpcontrol.d2c` with 'log');
         * 'refit' (default): the 'log' ``A`` and a Gauss-Newton
           least-squares refit of the Fourier coefficients of ``B(t)``
-          (harmonics -K..K), ``C(t)`` (-2K..2K) and ``D(t)`` (-K..K) to the
-          continuous harmonic response (see Notes), started from 'log'.
+          (harmonics -H..H, see `refit_harmonics`), ``C(t)`` (-2K..2K) and
+          ``D(t)`` (-K..K) to the continuous harmonic response (see Notes),
+          started from 'log'.
 
         'refit' is the default because it is the most accurate on the
         thesis example (see the Mathieu gallery example): inverse Tustin
@@ -157,17 +158,21 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         ``B``, ``C``, ``D`` (default True, which makes the result independent
         of `q`); False keeps the 'log' ``A`` and refits ``B``, ``C``, ``D``
         given ``A`` only.
-    refit_harmonics : int, optional
+    refit_harmonics : int or 'auto', optional
         With ``conversion='refit'``, number H >= K of harmonics of ``B(t)``
-        in the refitted model (``C(t)`` gets K + H, ``D(t)`` K); default K.
-        A plant whose A(t) is periodic has infinitely many harmonics in
-        Floquet form; H = K + 1 lets the model carry the input harmonics
-        just beyond the data's, which removes most of the truncation bias
-        of the Floquet exponents (see the identification guide).  It is no
-        default: for a plant whose B(t), C(t) have at most K harmonics in
-        Floquet form (the thesis's Mathieu example) the data do not
-        determine the extra harmonics, and the HTF away from the data
-        degrades (there from 3e-7 to 2e-2).
+        in the refitted model (``C(t)`` has 2K, ``D(t)`` K).  'auto'
+        (default) refits with H = K and with H = K + 1 and keeps K + 1 only
+        if it earns its place: it must lower the Bayesian information
+        criterion ``N log(SSE/N) + p log N`` (N real residuals, p
+        parameters; ``B_{±(K+1)}`` add ``2 n_p m``) and be determined by the
+        data (see Notes).  A plant whose A(t) is periodic has infinitely
+        many harmonics in Floquet form; the input harmonics K + 1 remove
+        most of the truncation bias of the exponents.  On 60 random plants
+        with periodic A, B, C (identification guide) 'auto' chooses K + 1
+        and, at K = 3, brings every exponent within 1e-3 (with H = K: 25 of
+        30 single-input plants), at 1.5 to 1.8 times the run time of H = K;
+        on the thesis's Mathieu example (B, C with one harmonic, K = 1) it
+        keeps H = K and its result.
     refine : {None, 'ml'}, optional
         'ml': finish with `ltpcontrol.refine_ltp` on the lifted data (the
         maximum-likelihood fit of the Floquet-form model, equal weights
@@ -246,6 +251,19 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     truncation error of a K-harmonic model decays quickly with K (see the
     identification guide).
 
+    The harmonic ``B_{±(K+1)}`` of ``refit_harmonics='auto'`` is
+    determined by the data when its terms ``C_{n-m} R_m B_m``, ``m =
+    ±(K+1)``, are seen in the measured harmonics ``|n| <= K`` through the
+    harmonics of C.  Where C(t) has none (a plant with at most K harmonics in
+    Floquet form and a constant C), ``B_{±(K+1)}`` can fit errors of the data
+    through a vanishing ``C_{±l}`` and become arbitrarily large, yet it
+    drives the unmeasured harmonics ``G_{±(K+1)} ∋ C_0 R_{±(K+1)} B_{±(K+1)}``
+    that the model predicts.  H = K + 1 is therefore kept only if these
+    terms are at most 1000 times larger in ``G_{±(K+1)}`` than in the
+    measured harmonics (measured: at most 10.4 on the random plants, 10 on
+    the Mathieu example, above 6e5 for a constant-C plant identified from
+    time records).
+
     The identified model and the true system are related by a periodic
     change of state: compare them with `ltpcontrol.compare_ltp` (HTFs and
     Floquet exponents modulo ``jω_p``).  `ltpcontrol.to_canonical` removes
@@ -275,7 +293,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
     if conversion not in _CONVERSIONS:
         raise ValueError(f"conversion must be one of {_CONVERSIONS}, got {conversion!r}")
-    if refit_harmonics != 'auto':
+    if not (isinstance(refit_harmonics, str) and refit_harmonics == 'auto'):
         refit_harmonics = check_positive_int(refit_harmonics, 'refit_harmonics', minimum=K)
     if refine not in (None, 'ml'):
         raise ValueError(f"refine must be None or 'ml', got {refine!r}")
