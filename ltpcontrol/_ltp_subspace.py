@@ -170,7 +170,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         most of the truncation bias of the exponents.  On 60 random plants
         with periodic A, B, C (identification guide) 'auto' chooses K + 1
         and, at K = 3, brings every exponent within 1e-3 (with H = K: 25 of
-        30 single-input plants), at 1.5 to 1.8 times the run time of H = K;
+        30 single-input plants), at 1.5 to 2 times the run time of H = K;
         on the thesis's Mathieu example (B, C with one harmonic, K = 1) it
         keeps H = K and its result.
     refine : {None, 'ml'}, optional

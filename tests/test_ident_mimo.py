@@ -117,17 +117,6 @@ def _check(plant, K, **kw):
 
 
 @pytest.mark.slow
-def test_random_mimo_plants():
-    """Three random 2 x 2 plants (n_p = 2-4, periodic A, B, C), K = 3: HTF error at
-    unseen frequencies and Floquet exponents within 1e-3 (measured <= 1.2e-4; all
-    30 plants in examples/generic_identification_study.py)."""
-    for seed in range(3):
-        info, cmp = _check(_mimo(seed), 3)
-        assert info.success
-        assert cmp.htf_error <= 1e-3 and cmp.exponent_error <= 1e-3
-
-
-@pytest.mark.slow
 def test_thirty_random_mimo_plants():
     """30 random 2 x 2 plants (n_p = 2-4, periodic A, B, C), K = 3, default
     settings: a model for every one, HTF error at unseen frequencies and Floquet
