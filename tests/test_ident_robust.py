@@ -173,13 +173,13 @@ def test_refit_harmonics_remove_exponent_bias(seed, n, ny):
     """The five of the 30 plants whose K = 3 exponents miss by more than 1e-3
     with B(t) of K harmonics (weakly observable modes; measured 1.1e-3 to
     4.9e-3): the default refit gives B(t) K + 1 harmonics, which brings them
-    within 1e-5 and lowers the HTF error."""
+    within 2e-5 (measured <= 1.0e-5) and lowers the HTF error."""
     plant = random_ltp(seed, n, ny)
     base = ltp.compare_ltp(_identify(plant, 3, refit_harmonics=3)[0], plant, UNSEEN)
     model, _ = _identify(plant, 3)
     assert model.B.nharmonics == 4 and model.C.nharmonics <= 6
     wide = ltp.compare_ltp(model, plant, UNSEEN)
-    assert base.exponent_error > 1e-3 and wide.exponent_error <= 1e-5
+    assert base.exponent_error > 1e-3 and wide.exponent_error <= 2e-5
     assert wide.htf_error <= 1e-5 and wide.htf_error < base.htf_error
 
 
