@@ -35,7 +35,7 @@ from ._lifted_response import lifted_frequency_response
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix
 from ._realization import FloquetRealization, floquet_realization
-from ._refine import refine_ltp
+from ._refine import _harmonics, refine_ltp
 from ._validation import check_kwargs, check_period, check_positive_int, steps_per_period
 
 __all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
@@ -172,7 +172,9 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         and, at K = 3, brings every exponent within 1e-3 (with H = K: 25 of
         30 single-input plants), at 1.5 to 2 times the run time of H = K;
         on the thesis's Mathieu example (B, C with one harmonic, K = 1) it
-        keeps H = K and its result.
+        keeps H = K and its result.  With ``refine='ml'`` and the
+        harmonics of B given in `refine_options`, 'auto' takes those (at
+        least K).
     refine : {None, 'ml'}, optional
         'ml': finish with `ltpcontrol.refine_ltp` on the lifted data (the
         maximum-likelihood fit of the Floquet-form model, equal weights
@@ -293,10 +295,13 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
     if conversion not in _CONVERSIONS:
         raise ValueError(f"conversion must be one of {_CONVERSIONS}, got {conversion!r}")
-    if not (isinstance(refit_harmonics, str) and refit_harmonics == 'auto'):
-        refit_harmonics = check_positive_int(refit_harmonics, 'refit_harmonics', minimum=K)
     if refine not in (None, 'ml'):
         raise ValueError(f"refine must be None or 'ml', got {refine!r}")
+    if not (isinstance(refit_harmonics, str) and refit_harmonics == 'auto'):
+        refit_harmonics = check_positive_int(refit_harmonics, 'refit_harmonics', minimum=K)
+    elif refine == 'ml' and (refine_options or {}).get('harmonics') is not None:
+        # the refinement fixes the harmonics of B: the refit starts it with them
+        refit_harmonics = max(K, _harmonics(refine_options['harmonics'], None, K)[0])
     # 1. lifted frequency response
     record_options = dict(frequencies=frequencies, transient=transient,
                           input_hold=input_hold, hold_step=hold_step, batch_size=batch_size)
