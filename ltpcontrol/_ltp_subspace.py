@@ -170,7 +170,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         most of the truncation bias of the exponents.  On 60 random plants
         with periodic A, B, C (identification guide) 'auto' chooses K + 1
         and, at K = 3, brings every exponent within 1e-3 (with H = K: 25 of
-        30 single-input plants), at 1.5 to 2 times the run time of H = K;
+        30 single-input plants), at 1.5 to 2.1 times the run time of H = K;
         on the thesis's Mathieu example (B, C with one harmonic, K = 1) it
         keeps H = K and its result.  With ``refine='ml'`` and the
         harmonics of B given in `refine_options`, 'auto' takes those (at
@@ -418,7 +418,7 @@ def _refit(sys, Gc, omega, K, harmonics, estimate_d, fit_a, labels):
     fit = dict(estimate_d=estimate_d, fit_a=fit_a, **labels)
     model, res, converged, nfev = fit_floquet(sys, Gc, omega, K, harmonics=(
         K if harmonics == 'auto' else harmonics), **fit)
-    if harmonics == 'auto':
+    if harmonics == 'auto' and K > 0:            # K = 0: B_{±1} would meet no C harmonic
         wide, res1, conv1, nfev1 = fit_floquet(sys, Gc, omega, K, harmonics=K + 1, **fit)
         nfev += nfev1
         # BIC = N log(SSE / N) + p log N: N real residuals, B_{±(K+1)} add 2 n_p m parameters
@@ -431,7 +431,7 @@ def _refit(sys, Gc, omega, K, harmonics, estimate_d, fit_a, labels):
 
 
 #: largest ratio of the effect of B_{±(K+1)} on the unmeasured harmonics ±(K+1) to
-#: that on the measured ones (<= 10.4 on 60 random plants, > 6e5 where undetermined)
+#: that on the measured ones (<= 10.4 on the random plants at K = 3, > 6e5 where undetermined)
 _MAX_VISIBILITY = 1e3
 
 
