@@ -178,7 +178,10 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     frequencies, transient, input_hold, hold_step, batch_size : optional
         Time records only: passed to `lifted_frequency_response` (defaults
         there: lines detected, no transient, no hold, ``Ts``, 64).  Lines at
-        multiples of ``ω_p/2`` are skipped with a warning.
+        multiples of ``ω_p/2`` are skipped with a warning.  With an
+        `input_hold` and 'refit', the data are recomputed with the fitted
+        ``D(t)`` as their `feedthrough` and refitted once, which removes
+        the hold's bias on the direct term.
     seed : int, optional
         Seed of the 'pso' realization search (reproducibility).
     progress : bool, optional
@@ -295,6 +298,16 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     if conversion == 'refit':
         sysc, _, converged, nfev = fit_floquet(sysc, Gc, G.omega, K, harmonics=H,
                                                estimate_d=estimate_d, fit_a=refit_a, **labels)
+        if estimate_d and input_hold is not None and not isinstance(
+                data, ct.FrequencyResponseData):
+            # the direct term sees the samples, not the held input: redo the
+            # hold correction with the fitted D(t) and refit once more
+            record_options['feedthrough'] = sysc.D
+            G = _lifted_data(data, period, K, False, record_options)
+            Gc = _harmonic_data(G.frdata, K, N, ny)
+            sysc, _, converged, more = fit_floquet(sysc, Gc, G.omega, K, harmonics=H,
+                                                   estimate_d=True, fit_a=refit_a, **labels)
+            nfev += more
         if not converged:
             warnings.warn("the least-squares refit did not converge", UserWarning,
                           stacklevel=2)
