@@ -284,7 +284,7 @@ CATALOGUE = [
     ('forced-method', _call(ltp.forced_response, SYS, [0, 1], method='euler'), VE, 'method'),
     ('forced-input-hold', _call(ltp.forced_response, SYS, [0, 1], input_hold='cubic'), VE,
      'input_hold'),
-    ('forced-unknown-keyword', _call(ltp.forced_response, SYS, [0, 1], U=1.0), TE, 'U'),
+    ('forced-unknown-keyword', _call(ltp.forced_response, SYS, [0, 1], V=1.0), TE, 'V'),
     ('forced-rtol-negative', _call(ltp.forced_response, SYS, [0, 0.5, 1], rtol=-1.0), VE,
      'rtol'),
     ('forced-rtol-str', _call(ltp.forced_response, SYS, [0, 0.5, 1], rtol='tight'), TE, 'rtol'),
