@@ -173,3 +173,33 @@ def test_lti_limit_default_grids_and_initial_response(lti_pair, dt):
         assert np.allclose(mine.outputs, ref.outputs, atol=1e-9)
         assert (mine.inputs is None) == (ref.inputs is None)
         assert mine.trace_types == ref.trace_types and mine.title == ref.title
+
+
+#
+# Discretization with a first-order hold
+#
+
+def test_sample_system_foh_lti_limit_equals_python_control():
+    G = ct.ss([[-1.0, 2.0], [-2.0, -0.5]], [[1.0, 0.0], [0.5, 1.0]], [[1.0, 0.0]],
+              [[0.3, -0.2]])
+    Pd = ct.sample_system(ltp.ltpss(G, 0.6), 0.1, 'foh')
+    Gd = ct.sample_system(G, 0.1, 'foh')
+    for mine, ref in zip((Pd.A(0.0), Pd.B(0.0), Pd.C(0.0), Pd.D(0.0)),
+                         (Gd.A, Gd.B, Gd.C, Gd.D)):
+        assert np.allclose(mine, ref, rtol=1e-11, atol=1e-12)
+    assert Pd.is_lti and Pd.name == Gd.name
+
+
+@pytest.mark.parametrize('N', [1, 3, 8])
+def test_sample_system_foh_periodic_matches_foh_simulation(N):
+    """y_d[k] = y(k Ts) for the continuous system driven by the linear interpolant."""
+    sys = _oscillator(D_PERIODIC)
+    sys = ltp.ltpss(sys.A, lambda t: np.array([[0.2], [1 + 0.5 * np.cos(WP * t)]]), sys.C,
+                    sys.D, T)
+    Ts = T / N
+    sysd = ltp.sample_system(sys, Ts, 'foh')
+    t = Ts * np.arange(6 * N + 5)
+    u = np.sin(1.3 * t) * np.exp(-0.1 * t)                     # u[0] = 0: ξ_0 = x_0
+    yd = ltp.forced_response(sysd, t, u, [0.3, -0.1]).outputs
+    yc = ltp.forced_response(sys, t, u, [0.3, -0.1], input_hold='foh').outputs
+    assert np.abs(yd - yc).max() < 1e-10
