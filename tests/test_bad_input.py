@@ -382,7 +382,7 @@ CATALOGUE = [
     ('sample-Ts-not-dividing', _call(ltp.sample_system, SYS, 0.3), VE, 'Ts'),
     ('sample-Ts-negative', _call(ltp.sample_system, SYS, -0.1), VE, 'Ts'),
     ('sample-Ts-str', _call(ltp.sample_system, SYS, 'fast'), CA, 'Ts'),
-    ('sample-method', _call(ltp.sample_system, SYS, 0.1, method='foh'), VE, 'method'),
+    ('sample-method', _call(ltp.sample_system, SYS, 0.1, method='gbt'), VE, 'method'),
     ('sample-discrete', _call(ltp.sample_system, SYSD, 0.1), VE, 'continuous-time'),
     ('sample-lti', _call(ltp.sample_system, ct.rss(1, 1, 1), 0.1), CA, 'sys'),
     ('sample-unknown-keyword', _call(ltp.sample_system, SYS, 0.1, metod='zoh'), TE, 'metod'),
