@@ -203,3 +203,22 @@ def test_sample_system_foh_periodic_matches_foh_simulation(N):
     yd = ltp.forced_response(sysd, t, u, [0.3, -0.1]).outputs
     yc = ltp.forced_response(sys, t, u, [0.3, -0.1], input_hold='foh').outputs
     assert np.abs(yd - yc).max() < 1e-10
+
+
+#
+# Block-diagram algebra in the LTI limit
+#
+
+def test_scalar_arithmetic_matches_python_control_non_square():
+    """A scalar is added to every entry of D and multiplies every channel, as
+    python-control does (also for non-square systems)."""
+    G = ct.ss([[-1.0, 0.5], [0.0, -2.0]], [[1.0, 0.0, 1.0], [0.0, 1.0, 2.0]],
+              [[1.0, 0.0], [0.3, 1.0]], [[0.1, 0.2, 0.3], [0.4, 0.5, 0.6]])
+    P = ltp.ltpss(G, 1.0)
+    for mine, ref in [(P + 2, G + 2), (2 + P, 2 + G), (P - 2, G - 2), (2 - P, 2 - G),
+                      (P * 2, G * 2), (2 * P, 2 * G), (P * 2.5 - 1, G * 2.5 - 1)]:
+        assert mine.shape == ref.shape
+        s = np.array([0.3j, 1.0 + 2j])
+        Hm = np.stack([mine.to_ss()(x) for x in s])
+        Hr = np.stack([ref(x) for x in s])
+        assert np.allclose(Hm, Hr, rtol=1e-12, atol=1e-12)
