@@ -31,9 +31,9 @@ __all__ = ['HTF', 'HTFModel', 'HTFData', 'htf']
 class HTF(abc.ABC):
     """Harmonic transfer function: the interface of `HTFModel` and `HTFData`.
 
-    An abstract class, not instantiated itself (``HTF(...)`` raises a
-    `ControlArgument` pointing here): `htf` builds the HTF of a system
-    (`HTFModel`), `HTFData` holds components sampled on a frequency grid.
+    An abstract class, not instantiated itself: `htf` builds the HTF of a
+    system (`HTFModel`), `HTFData` holds components sampled on a frequency
+    grid, and ``HTF(...)`` raises a `control.ControlArgument` naming both.
     Both are evaluated, plotted and converted through the methods below.
 
     Attributes
