@@ -9,6 +9,7 @@
 """
 
 import numpy as np
+import pytest
 from hypothesis import given, settings, strategies as st
 from scipy.integrate import solve_ivp
 
@@ -41,6 +42,7 @@ def _random_ltp(rng, n, m, p, scale_d=1.0, functions=False):
     return (sys, mats) if functions else sys
 
 
+@pytest.mark.slow
 @FAST
 @given(seed=seeds, sign=st.sampled_from([-1, 1]))
 def test_feedback_matches_coupled_integration(seed, sign):
@@ -72,6 +74,7 @@ def test_feedback_matches_coupled_integration(seed, sign):
     assert np.abs(resp.states - xs).max() < 1e-8 * (1 + np.abs(xs).max())
 
 
+@pytest.mark.slow
 @FAST
 @given(seed=seeds, amp=st.floats(0.05, 0.4))
 def test_periodic_change_of_state_is_invisible(seed, amp):
