@@ -187,7 +187,10 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     frequencies, transient, input_hold, hold_step, batch_size : optional
         Time records only: passed to `lifted_frequency_response` (defaults
         there: lines detected, no transient, no hold, ``Ts``, 64).  Lines at
-        multiples of ``ω_p/2`` are skipped with a warning.
+        multiples of ``ω_p/2`` are skipped with a warning.  With an
+        `input_hold` and 'refit', the data are recomputed with the fitted
+        ``D(t)`` as their `feedthrough` and refitted once, which removes
+        the hold's bias on the direct term.
     seed : int, optional
         Seed of the 'pso' realization search (reproducibility).
     progress : bool, optional
@@ -320,6 +323,16 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     if conversion == 'refit':
         sysc, converged, nfev = _refit(sysc, Gc, G.omega, K, refit_harmonics, estimate_d,
                                        refit_a, labels)
+        if estimate_d and input_hold is not None and not isinstance(
+                data, ct.FrequencyResponseData):
+            # the direct term sees the samples, not the held input: redo the
+            # hold correction with the fitted D(t) and refit once more
+            record_options['feedthrough'] = sysc.D
+            G = _lifted_data(data, period, K, False, record_options)
+            Gc = _harmonic_data(G.frdata, K, N, ny)
+            sysc, converged, more = _refit(sysc, Gc, G.omega, K, refit_harmonics, True,
+                                           refit_a, labels)
+            nfev += more
         if not converged:
             warnings.warn("the least-squares refit did not converge", UserWarning,
                           stacklevel=2)
