@@ -18,6 +18,7 @@ reversal keeps the Floquet multipliers (``Φ̃(T, 0) = Φ(T, 0)ᵀ``).
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
+from ._floquet import lti_representatives
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix, as_periodic
 from ._riccati import _check_weights, care, dare
@@ -169,7 +170,10 @@ def lqe(sys, QN, RN, NN=None, nsteps=None):
     X, E, Gd = care(_reverse(sys.A, True), _reverse(sys.C, True),
                     _reverse(G @ QN @ G.T, False), _reverse(RN, False),
                     _reverse(G @ NN, False), period=T, nsteps=nsteps)
-    return _reverse(Gd, True), _reverse(X, False), E
+    L = _reverse(Gd, True)
+    if all(M.is_constant for M in (sys.A, G, sys.C, QN, RN, NN)):   # LTI data
+        E = lti_representatives(E, sys.A(0.0) - L(0.0) @ sys.C(0.0), period=T)
+    return L, _reverse(X, False), E
 
 
 def dlqe(sys, QN, RN, NN=None):

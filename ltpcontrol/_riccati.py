@@ -50,7 +50,7 @@ import numpy as np
 import scipy.linalg as la
 from control.exception import ControlArgument, ControlDimension
 
-from ._floquet import _log_multipliers, chebyshev_nodes, piecewise_chebyshev
+from ._floquet import _log_multipliers, chebyshev_nodes, lti_representatives, piecewise_chebyshev
 from ._periodic_matrix import PeriodicMatrix, as_periodic
 from ._steps import step_grid
 from ._transition import step_transitions
@@ -168,6 +168,8 @@ def care(A, B, Q, R, S=None, period=None, nsteps=None):
         return np.linalg.solve(r, np.swapaxes(b, 1, 2) @ x + np.swapaxes(s, 1, 2))
 
     G = PeriodicMatrix.pointwise(gain, [B, R, S, X], (m, n), breakpoints=breaks)
+    if all(M.is_constant for M in ops):          # LTI data: the eigenvalues of A - BG
+        L = lti_representatives(L, A(0.0) - B(0.0) @ G(0.0), period=period)
     return X, L, G
 
 
@@ -241,6 +243,8 @@ def dare(A, B, Q, R, S=None):
     Xn = np.roll(X, -1, axis=0)
     G = np.linalg.solve(R + Bt @ Xn @ B, Bt @ Xn @ A + np.swapaxes(S, 1, 2))
     L = _exponents(factors, nper=N)
+    if all(np.all(M == M[0]) for M in (A, B, Q, R, S)):   # LTI data
+        L = lti_representatives(L, A[0] - B[0] @ G[0], nper=N)
     return X, L, G
 
 
