@@ -64,6 +64,9 @@ _RESIDUAL_WARN = 1e-8
 _CHEB_DEG = 16
 # multipliers within this distance of the unit circle count as on it
 _CIRCLE_TOL = 1e-10
+# closed-loop log|μ| above -first: not stabilizing; above -second: doubtful
+# (a defective unit-circle pair splits by about sqrt(eps))
+_CLOSED_LOOP_TOL = (1e-9, 1e-6)
 
 
 def care(A, B, Q, R, S=None, period=None, nsteps=None):
@@ -383,8 +386,22 @@ def _flow(H, t0, h):
 
 
 def _exponents(factors, period=None, nper=None):
-    """Floquet exponents (continuous) or per-step exponents (discrete) of factors."""
+    """Floquet exponents (continuous) or per-step exponents (discrete) of the
+    closed-loop factors; raises unless every multiplier is inside the unit
+    circle (a Hamiltonian multiplier pair on the circle, split by round-off,
+    can pass the count of stable multipliers and give a non-stabilizing X)."""
     logmod, arg = _log_multipliers(None, None, grid=None, factors=factors)
+    worst = logmod.max() if logmod.size else -np.inf
+    if not worst < -_CLOSED_LOOP_TOL[0]:
+        raise ValueError(
+            "no stabilizing periodic solution exists: the closed loop keeps a Floquet "
+            f"multiplier on the unit circle (log|mu| = {worst:.1e}); check that (A, B) "
+            "is stabilizable and that Q penalizes every mode on the stability boundary")
+    if worst >= -_CLOSED_LOOP_TOL[1]:
+        warnings.warn(
+            f"the closed loop has a Floquet multiplier with log|mu| = {worst:.1e}: at "
+            "this precision a Hamiltonian multiplier pair on the unit circle looks the "
+            "same, so the solution may not be stabilizing", UserWarning, stacklevel=3)
     if nper is not None:
         with np.errstate(under='ignore', over='ignore'):
             return np.exp((logmod + 1j * arg) / nper)

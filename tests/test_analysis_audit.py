@@ -92,3 +92,25 @@ def test_matrix_functions_name_the_ltp_way_for_periodic_matrices(call):
         call(sys.A, sys.B)
     # the same functions on plain arrays are python-control's
     assert np.allclose(ct.ctrb(_A, _B), np.hstack([_B, _A @ _B]))
+
+
+def test_riccati_refuses_a_closed_loop_left_on_the_unit_circle():
+    # (A, B) = (0, ones) is not stabilizable: two Hamiltonian multiplier pairs
+    # sit on the unit circle, split by round-off; python-control refuses too
+    A, B = np.zeros((3, 3)), np.ones((3, 1))
+    with pytest.raises(Exception):
+        ct.care(A, B, np.eye(3), [[1.0]])
+    with pytest.raises(ValueError, match="stabilizing"):
+        ltp.care(A, B, np.eye(3), [[1.0]], period=1.0)
+    sys = ltp.ltpss(A, B, np.eye(3), 0, period=1.0)
+    with pytest.raises(ValueError, match="stabilizing"):
+        ltp.lqr(sys, np.eye(3), [[1.0]])
+    # a defective pair on the circle (A = -1, B = R = 1, Q = -1: X = -1 double)
+    # is indistinguishable from a slow closed loop: a warning, never silence
+    with pytest.warns(UserWarning, match="may not be stabilizing"):
+        ltp.care(-np.eye(2), np.eye(2), -np.eye(2), np.eye(2), period=1.0)
+    # a genuinely slow, well-posed closed loop passes silently
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        X, L, _ = ltp.care([[-1e-5]], [[0.0]], [[1.0]], [[1.0]], period=1.0)
+    assert np.isclose(X(0.0)[0, 0], ct.care([[-1e-5]], [[0.0]], [[1.0]], [[1.0]])[0][0, 0])
