@@ -162,10 +162,10 @@ def floquet_exponents(sys, nsteps=None):
     if sys.dt:
         nper = steps_per_period(sys.period, sys.dt)
         with np.errstate(under='ignore', over='ignore'):
-            rho = np.exp((logmod + 1j * arg) / nper)
+            rho = np.exp(logmod / nper) * np.exp(1j * arg / nper)   # log|μ| may be -inf
         A = sys.A.sample(nper)
         return lti_representatives(rho, A[0], nper=nper) if np.all(A == A[0]) else rho
-    lam = (logmod + 1j * arg) / sys.period
+    lam = logmod / sys.period + 1j * (arg / sys.period)
     return lti_representatives(lam, sys.A(0.0), period=sys.period) \
         if sys.A.is_constant else lam
 

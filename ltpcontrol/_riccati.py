@@ -404,8 +404,8 @@ def _exponents(factors, period=None, nper=None):
             "same, so the solution may not be stabilizing", UserWarning, stacklevel=3)
     if nper is not None:
         with np.errstate(under='ignore', over='ignore'):
-            return np.exp((logmod + 1j * arg) / nper)
-    return (logmod + 1j * arg) / period
+            return np.exp(logmod / nper) * np.exp(1j * arg / nper)   # log|μ| may be -inf
+    return logmod / period + 1j * (arg / period)
 
 
 def _refine(X0, sweep, passes=2):

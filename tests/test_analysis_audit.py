@@ -114,3 +114,15 @@ def test_riccati_refuses_a_closed_loop_left_on_the_unit_circle():
         warnings.simplefilter('error')
         X, L, _ = ltp.care([[-1e-5]], [[0.0]], [[1.0]], [[1.0]], period=1.0)
     assert np.isclose(X(0.0)[0, 0], ct.care([[-1e-5]], [[0.0]], [[1.0]], [[1.0]])[0][0, 0])
+
+
+def test_singular_monodromy_gives_zero_exponents_without_warnings():
+    # A_0 singular: a multiplier exactly 0 (log|μ| = -inf) is the exponent 0
+    A = np.array([[[0.5, 0.0], [0.0, 0.0]], [[1.0, 0.3], [0.0, 1.0]]])
+    sys = ltp.ltpss(A, np.eye(2), np.eye(2), 0, period=2.0, dt=1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        rho = ltp.floquet_exponents(sys)
+        X, L, G = ltp.dare(A, np.eye(2), np.eye(2), np.eye(2))
+    assert np.allclose(np.sort(np.abs(rho)), [0.0, np.sqrt(0.5)], atol=1e-15)
+    assert np.count_nonzero(L == 0) == 1 and np.all(np.isfinite(L))
