@@ -126,3 +126,27 @@ def test_singular_monodromy_gives_zero_exponents_without_warnings():
         X, L, G = ltp.dare(A, np.eye(2), np.eye(2), np.eye(2))
     assert np.allclose(np.sort(np.abs(rho)), [0.0, np.sqrt(0.5)], atol=1e-15)
     assert np.count_nonzero(L == 0) == 1 and np.all(np.isfinite(L))
+
+
+def test_python_control_keywords_are_accepted():
+    # ct.norm(sys, 2.0, method=...) and ct.lqr(..., method=...) are valid
+    # python-control calls; on an LTP system they give the periodic answer
+    G = ct.ss(_A, _B, _C, 0)
+    sys = ltp.ltpss(G, period=1.0)
+    assert np.isclose(ct.norm(sys, 2.0, method='scipy'), ct.norm(G, 2.0, method='scipy'))
+    K, _, _ = ct.lqr(sys, np.eye(2), [[1.0]], method='scipy')
+    assert np.allclose(K(0.0), ct.lqr(G, np.eye(2), [[1.0]], method='scipy')[0])
+    L, _, _ = ct.lqe(sys, [[1.0]], [[1.0]], method='scipy')
+    assert np.allclose(L(0.0), ct.lqe(G, [[1.0]], [[1.0]], method='scipy')[0])
+    sysd = ltp.sample_system(sys, 0.25)
+    Gd = ct.c2d(G, 0.25)
+    assert np.allclose(ct.dlqr(sysd, np.eye(2), 1.0, method='slycot')[0](0.0),
+                       ct.dlqr(Gd, np.eye(2), 1.0)[0])
+    assert np.allclose(ct.dlqe(sysd, 1.0, 1.0, method='slycot')[0](0.0),
+                       ct.dlqe(Gd, 1.0, 1.0)[0])
+    with pytest.raises(ControlArgument, match="method"):
+        ltp.lqr(sys, np.eye(2), [[1.0]], method='fast')
+    with pytest.raises(ControlArgument, match="method"):
+        ltp.norm(sys, 2, method='fast')
+    with pytest.raises(ValueError, match="p must be"):
+        ltp.norm(sys, 2.5)
