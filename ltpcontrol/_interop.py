@@ -171,6 +171,24 @@ REFUSED = {
 }
 
 
+#: python-control functions of matrices -> the ltpcontrol way when a matrix is
+#: a `PeriodicMatrix` (or, for those not hooked above, the system an LTPStateSpace)
+MATRIX_REFUSED = {
+    'lyap': "ltp.lyap(A, Q) for the periodic Lyapunov equation",
+    'dlyap': "ltp.dlyap(A, Q) with the step matrices stacked, shape (N, n, n)",
+    'care': "ltp.care(A, B, Q, R) for the periodic Riccati equation",
+    'dare': "ltp.dare(A, B, Q, R) with the step matrices stacked, shape (N, ., .)",
+    'lqr': "ltp.lqr(sys, Q, R) with the plant as an LTPStateSpace",
+    'dlqr': "ltp.dlqr(sys, Q, R) with the plant as an LTPStateSpace",
+    'lqe': "ltp.lqe(sys, QN, RN) with the plant as an LTPStateSpace",
+    'dlqe': "ltp.dlqe(sys, QN, RN) with the plant as an LTPStateSpace",
+    'place': "ltp.place(sys, p) with the plant as an LTPStateSpace",
+    'acker': "ltp.place(sys, p) with the plant as an LTPStateSpace",
+    'ctrb': "ltp.lift(sys) (the lifted LTI system's controllability)",
+    'obsv': "ltp.lift(sys) (the lifted LTI system's observability)",
+}
+
+
 def refusal(name):
     """The error for python-control's `name` (function or method) on an LTP system."""
     return _refusal(name, REFUSED[name])
@@ -203,12 +221,21 @@ def _routes():
     table = dict(ROUTES)
     table.update({name: _hook(name, target) for name, target in HOOKS.items()})
     table.update({name: _refuse(name, hint) for name, hint in REFUSED.items()})
+    table.update({name: _refuse(name, hint) for name, hint in MATRIX_REFUSED.items()
+                  if name not in table})
     return table
 
 
-def _wrap(orig, route):
+def _periodic_matrix(args, kwargs):
+    return any(isinstance(a, PeriodicMatrix) for a in (*args, *kwargs.values()))
+
+
+def _wrap(orig, route, matrix_hint=None, name=None):
     @functools.wraps(orig)
     def dispatcher(*args, **kwargs):
+        if matrix_hint and _periodic_matrix(args, kwargs):
+            raise ControlArgument(f"{name} does not apply to a time-periodic matrix "
+                                  f"(PeriodicMatrix): use {matrix_hint}")
         if _involves_ltp(args, kwargs):
             return route(orig, *args, **kwargs)
         return orig(*args, **kwargs)
@@ -229,7 +256,7 @@ def install():
         orig = getattr(ct, name, None)
         if orig is None or hasattr(orig, '_ltp_route'):
             continue
-        wrapped = _wrap(orig, route)
+        wrapped = _wrap(orig, route, MATRIX_REFUSED.get(name), name)
         for mod in modules:
             for attr, value in list(vars(mod).items()):
                 if value is orig:
