@@ -142,6 +142,10 @@ _HTF = ("ltp.htf(sys, nharmonics) (or ltp.harmonic_ss) for the harmonic transfer
 _LTI = ("sys.to_ss() for constant matrices, sys.average(), sys.linearize(t=...) or "
         "ltp.lift(sys) for an LTI view")
 
+_STEADY = ("the periodic steady state (ltp.forced_response over enough periods, or "
+           "ltp.limit_cycle for an orbit of a nonlinear system): a forced periodic "
+           "system has periodic orbits, not equilibria")
+
 #: python-control names that have no LTP meaning as called -> what to use instead
 REFUSED = {
     'frequency_response': _HTF,
@@ -168,6 +172,7 @@ REFUSED = {
     'tf': _LTI,
     'ss2tf': _LTI,
     'mixsyn': "ltpcontrol's synthesis functions",
+    'find_operating_point': _STEADY,
 }
 
 
@@ -199,7 +204,14 @@ def _refusal(what, hint):
                            f"(LTPStateSpace): use {hint}")
 
 
+#: python-control's return convention where it differs from the ltpcontrol
+#: function's: one vector of Hankel singular values for constant matrices
+_ADAPT = {'hankel_singular_values': lambda hsv: hsv[0] if len(hsv) == 1 else hsv}
+
+
 def _hook(name, target):
+    adapt = _ADAPT.get(name, lambda result: result)
+
     def route(orig, *args, **kwargs):
         fn = _ltp_function(target)
         if fn is None:
@@ -207,7 +219,7 @@ def _hook(name, target):
                 f"{name} does not apply to a linear time-periodic system "
                 f"(LTPStateSpace) and its periodic counterpart ltp.{target} is not "
                 "available in this version of ltpcontrol")
-        return fn(*args, **kwargs)
+        return adapt(fn(*args, **kwargs))
     return route
 
 
