@@ -18,15 +18,16 @@ reversal keeps the Floquet multipliers (``Φ̃(T, 0) = Φ(T, 0)ᵀ``).
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
+from ._floquet import lti_representatives
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix, as_periodic
 from ._riccati import _check_weights, care, dare
-from ._validation import as_ltp, real_array
+from ._validation import as_ltp, check_method, real_array
 
 __all__ = ['lqr', 'dlqr', 'lqe', 'dlqe', 'lqg']
 
 
-def lqr(sys, Q, R, N=None, nsteps=None):
+def lqr(sys, Q, R, N=None, nsteps=None, *, method=None):
     """Periodic linear quadratic regulator, as `control.lqr`.
 
     Minimizes ``∫ (xᵀQx + uᵀRu + 2xᵀNu) dt`` for ``ẋ = A(t)x + B(t)u``
@@ -44,6 +45,9 @@ def lqr(sys, Q, R, N=None, nsteps=None):
     nsteps : int, optional
         Continuous time: steps per period of the Riccati solver (see
         `ltpcontrol.care`).
+    method : {None, 'slycot', 'scipy'}, optional
+        python-control's choice of LTI solver, accepted so that the same
+        call works; the periodic algorithm is always used.
 
     Returns
     -------
@@ -70,13 +74,14 @@ def lqr(sys, Q, R, N=None, nsteps=None):
     >>> K.shape, bool(np.all(E.real < 0))
     ((1, 2), True)
     """
+    check_method(method)
     if _discrete(sys, nsteps):
         return dlqr(sys, Q, R, N)
     X, E, K = care(sys.A, sys.B, Q, R, N, period=sys.period, nsteps=nsteps)
     return K, X, E
 
 
-def dlqr(sys, Q, R, N=None):
+def dlqr(sys, Q, R, N=None, *, method=None):
     """Periodic discrete-time linear quadratic regulator, as `control.dlqr`.
 
     Minimizes ``Σ_k (x_kᵀQ_kx_k + u_kᵀR_ku_k + 2x_kᵀN_ku_k)`` for
@@ -90,6 +95,9 @@ def dlqr(sys, Q, R, N=None):
         Weights: a 2D array (the same at every step), an array of shape
         (N, rows, cols) (one matrix per step), or a periodic matrix sampled
         at ``t = k dt``.  N (cross weight) is zero by default.
+    method : {None, 'slycot', 'scipy'}, optional
+        python-control's choice of LTI solver, accepted so that the same
+        call works; the periodic algorithm is always used.
 
     Returns
     -------
@@ -109,6 +117,7 @@ def dlqr(sys, Q, R, N=None):
     >>> K(0.0).shape, K(1.0).shape, bool(np.all(np.abs(E) < 1))
     ((1, 2), (1, 2), True)
     """
+    check_method(method)
     sys = as_ltp(sys)
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqr: sys must be a discrete-time system (use lqr)")
@@ -119,7 +128,7 @@ def dlqr(sys, Q, R, N=None):
     return _held(K, sys), _held(X, sys), E
 
 
-def lqe(sys, QN, RN, NN=None, nsteps=None):
+def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None):
     """Periodic Kalman(-Bucy) filter gain, as `control.lqe`.
 
     For ``ẋ = A(t)x + B(t)u + G(t)w``, ``y = C(t)x + v`` with white noises
@@ -138,6 +147,9 @@ def lqe(sys, QN, RN, NN=None, nsteps=None):
         Cross intensity (m, p).
     nsteps : int, optional
         Steps per period of the Riccati solver.
+    method : {None, 'slycot', 'scipy'}, optional
+        python-control's choice of LTI solver, accepted so that the same
+        call works; the periodic algorithm is always used.
 
     Returns
     -------
@@ -156,6 +168,7 @@ def lqe(sys, QN, RN, NN=None, nsteps=None):
     >>> L.shape, bool(np.all(E.real < 0))
     ((2, 1), True)
     """
+    check_method(method)
     if _discrete(sys, nsteps):
         return dlqe(sys, QN, RN, NN)
     T = sys.period
@@ -169,10 +182,13 @@ def lqe(sys, QN, RN, NN=None, nsteps=None):
     X, E, Gd = care(_reverse(sys.A, True), _reverse(sys.C, True),
                     _reverse(G @ QN @ G.T, False), _reverse(RN, False),
                     _reverse(G @ NN, False), period=T, nsteps=nsteps)
-    return _reverse(Gd, True), _reverse(X, False), E
+    L = _reverse(Gd, True)
+    if all(M.is_constant for M in (sys.A, G, sys.C, QN, RN, NN)):   # LTI data
+        E = lti_representatives(E, sys.A(0.0) - L(0.0) @ sys.C(0.0), period=T)
+    return L, _reverse(X, False), E
 
 
-def dlqe(sys, QN, RN, NN=None):
+def dlqe(sys, QN, RN, NN=None, *, method=None):
     """Periodic discrete-time Kalman filter gain (predictor form), as `control.dlqe`.
 
     For ``x_{k+1} = A_kx_k + B_ku_k + G_kw_k``, ``y_k = C_kx_k + v_k``, the
@@ -187,6 +203,9 @@ def dlqe(sys, QN, RN, NN=None):
     QN, RN, NN : array_like, PeriodicMatrix or callable
         Noise covariances per step (2D: the same at every step; (N, ., .):
         one per step); NN (cross covariance) is zero by default.
+    method : {None, 'slycot', 'scipy'}, optional
+        python-control's choice of LTI solver, accepted so that the same
+        call works; the periodic algorithm is always used.
 
     Returns
     -------
@@ -205,6 +224,7 @@ def dlqe(sys, QN, RN, NN=None):
     >>> L(0.0).shape, bool(np.all(np.abs(E) < 1))
     ((2, 1), True)
     """
+    check_method(method)
     sys = as_ltp(sys)
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqe: sys must be a discrete-time system (use lqe)")

@@ -126,15 +126,15 @@ def floquet_exponents(sys, nsteps=None):
     j arg μ)/T``, imaginary parts in the strip ``(-ω_p/2, ω_p/2]``
     (exponents are defined modulo ``j k ω_p``).  The real parts are sums
     of logarithms of the periodic Schur diagonals, so they stay accurate
-    when the multipliers span hundreds of orders of magnitude.  An LTI
-    system gives the eigenvalues of A (when their imaginary parts lie in
-    the strip).
+    when the multipliers span hundreds of orders of magnitude.  A system
+    with constant A gives the eigenvalues of A (each the representative of
+    its exponent, also outside the strip), as `control.poles`.
 
     Discrete time: the per-step z-plane exponents ``ρ = μ^{1/N}``
     (principal root, ``arg ρ`` in ``(-π/N, π/N]``), i.e. the eigenvalues
     of the constant matrix of the Floquet form ``z[k+1] = A_F z[k]``.
-    They are defined up to a factor ``e^{j2πk/N}``; an LTI system gives
-    the eigenvalues of A when their arguments lie in that sector.
+    They are defined up to a factor ``e^{j2πk/N}``; a system with the same
+    A at every step gives the eigenvalues of A.
 
     Parameters
     ----------
@@ -162,8 +162,37 @@ def floquet_exponents(sys, nsteps=None):
     if sys.dt:
         nper = steps_per_period(sys.period, sys.dt)
         with np.errstate(under='ignore', over='ignore'):
-            return np.exp((logmod + 1j * arg) / nper)
-    return (logmod + 1j * arg) / sys.period
+            rho = np.exp(logmod / nper) * np.exp(1j * arg / nper)   # log|μ| may be -inf
+        A = sys.A.sample(nper)
+        return lti_representatives(rho, A[0], nper=nper) if np.all(A == A[0]) else rho
+    lam = logmod / sys.period + 1j * (arg / sys.period)
+    return lti_representatives(lam, sys.A(0.0), period=sys.period) \
+        if sys.A.is_constant else lam
+
+
+def lti_representatives(values, A, *, period=None, nper=None):
+    """The eigenvalues of a constant matrix A standing for exponents `values`.
+
+    Exponents are defined modulo ``jω_p`` (continuous, `period`) or a factor
+    ``e^{j2π/N}`` (discrete, `nper`); when the dynamics are those of one
+    constant matrix, its eigenvalues are the natural representatives (those
+    of python-control).  Each value is replaced by the eigenvalue equal to
+    it modulo that ambiguity, in the order of `values`.
+    """
+    ev = list(np.linalg.eigvals(np.asarray(A, float)).astype(complex))
+    if period is not None:
+        log, wrap = (lambda z: z), 2 * np.pi / period
+    else:
+        with np.errstate(divide='ignore'):
+            log = (lambda z: np.log(np.maximum(np.abs(z), 1e-300)) + 1j * np.angle(z))
+        wrap = 2 * np.pi / nper
+    out = []
+    for x in np.atleast_1d(values):
+        d = log(np.array(ev)) - log(x)
+        gap = np.abs(d.real) + np.abs(np.angle(np.exp(2j * np.pi * d.imag / wrap))) \
+            * wrap / (2 * np.pi)
+        out.append(ev.pop(int(np.argmin(gap))))
+    return np.array(out, complex)
 
 
 def is_stable(sys, tol=1e-10, nsteps=None, *, autonomous=False):

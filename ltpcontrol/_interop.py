@@ -142,6 +142,10 @@ _HTF = ("ltp.htf(sys, nharmonics) (or ltp.harmonic_ss) for the harmonic transfer
 _LTI = ("sys.to_ss() for constant matrices, sys.average(), sys.linearize(t=...) or "
         "ltp.lift(sys) for an LTI view")
 
+_STEADY = ("the periodic steady state (ltp.forced_response over enough periods, or "
+           "ltp.limit_cycle for an orbit of a nonlinear system): a forced periodic "
+           "system has periodic orbits, not equilibria")
+
 #: python-control names that have no LTP meaning as called -> what to use instead
 REFUSED = {
     'frequency_response': _HTF,
@@ -168,6 +172,25 @@ REFUSED = {
     'tf': _LTI,
     'ss2tf': _LTI,
     'mixsyn': "ltpcontrol's synthesis functions",
+    'find_operating_point': _STEADY,
+}
+
+
+#: python-control functions of matrices -> the ltpcontrol way when a matrix is
+#: a `PeriodicMatrix` (or, for those not hooked above, the system an LTPStateSpace)
+MATRIX_REFUSED = {
+    'lyap': "ltp.lyap(A, Q) for the periodic Lyapunov equation",
+    'dlyap': "ltp.dlyap(A, Q) with the step matrices stacked, shape (N, n, n)",
+    'care': "ltp.care(A, B, Q, R) for the periodic Riccati equation",
+    'dare': "ltp.dare(A, B, Q, R) with the step matrices stacked, shape (N, ., .)",
+    'lqr': "ltp.lqr(sys, Q, R) with the plant as an LTPStateSpace",
+    'dlqr': "ltp.dlqr(sys, Q, R) with the plant as an LTPStateSpace",
+    'lqe': "ltp.lqe(sys, QN, RN) with the plant as an LTPStateSpace",
+    'dlqe': "ltp.dlqe(sys, QN, RN) with the plant as an LTPStateSpace",
+    'place': "ltp.place(sys, p) with the plant as an LTPStateSpace",
+    'acker': "ltp.place(sys, p) with the plant as an LTPStateSpace",
+    'ctrb': "ltp.lift(sys) (the lifted LTI system's controllability)",
+    'obsv': "ltp.lift(sys) (the lifted LTI system's observability)",
 }
 
 
@@ -181,7 +204,14 @@ def _refusal(what, hint):
                            f"(LTPStateSpace): use {hint}")
 
 
+#: python-control's return convention where it differs from the ltpcontrol
+#: function's: one vector of Hankel singular values for constant matrices
+_ADAPT = {'hankel_singular_values': lambda hsv: hsv[0] if len(hsv) == 1 else hsv}
+
+
 def _hook(name, target):
+    adapt = _ADAPT.get(name, lambda result: result)
+
     def route(orig, *args, **kwargs):
         fn = _ltp_function(target)
         if fn is None:
@@ -189,7 +219,7 @@ def _hook(name, target):
                 f"{name} does not apply to a linear time-periodic system "
                 f"(LTPStateSpace) and its periodic counterpart ltp.{target} is not "
                 "available in this version of ltpcontrol")
-        return fn(*args, **kwargs)
+        return adapt(fn(*args, **kwargs))
     return route
 
 
@@ -203,12 +233,21 @@ def _routes():
     table = dict(ROUTES)
     table.update({name: _hook(name, target) for name, target in HOOKS.items()})
     table.update({name: _refuse(name, hint) for name, hint in REFUSED.items()})
+    table.update({name: _refuse(name, hint) for name, hint in MATRIX_REFUSED.items()
+                  if name not in table})
     return table
 
 
-def _wrap(orig, route):
+def _periodic_matrix(args, kwargs):
+    return any(isinstance(a, PeriodicMatrix) for a in (*args, *kwargs.values()))
+
+
+def _wrap(orig, route, matrix_hint=None, name=None):
     @functools.wraps(orig)
     def dispatcher(*args, **kwargs):
+        if matrix_hint and _periodic_matrix(args, kwargs):
+            raise ControlArgument(f"{name} does not apply to a time-periodic matrix "
+                                  f"(PeriodicMatrix): use {matrix_hint}")
         if _involves_ltp(args, kwargs):
             return route(orig, *args, **kwargs)
         return orig(*args, **kwargs)
@@ -229,7 +268,7 @@ def install():
         orig = getattr(ct, name, None)
         if orig is None or hasattr(orig, '_ltp_route'):
             continue
-        wrapped = _wrap(orig, route)
+        wrapped = _wrap(orig, route, MATRIX_REFUSED.get(name), name)
         for mod in modules:
             for attr, value in list(vars(mod).items()):
                 if value is orig:

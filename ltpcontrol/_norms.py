@@ -36,7 +36,7 @@ from ._lyapunov import cyclic_lyap, periodic_solution
 from ._periodic_matrix import PeriodicMatrix
 from ._steps import gram_weight, step_grid, step_integrals
 from ._transition import step_transitions
-from ._validation import as_ltp
+from ._validation import as_ltp, check_method
 
 __all__ = ['norm']
 
@@ -44,8 +44,8 @@ __all__ = ['norm']
 _UNIT = 1e-7
 
 
-def norm(sys, p=2, tol=1e-6, print_warning=True, *, return_frequency=False,
-         nsteps=None):
+def norm(sys, p=2, tol=1e-6, print_warning=True, method=None, *,
+         return_frequency=False, nsteps=None):
     """Input/output norm of an LTP system (python-control's `norm`).
 
     Parameters
@@ -60,8 +60,12 @@ def norm(sys, p=2, tol=1e-6, print_warning=True, *, return_frequency=False,
         Relative accuracy of the L∞ norm (bisection between certified
         bounds); ignored for the other norms, which are exact.
     print_warning : bool, optional
-        Warn when the L∞ norm of an unstable system is returned as inf, or
-        the H2 norm of a continuous system with feedthrough.
+        Warn when the H2 or L∞ norm of an unstable system is returned as
+        inf (as python-control does), or the H2 norm of a continuous system
+        with feedthrough.
+    method : {None, 'slycot', 'scipy'}, optional
+        python-control's choice of LTI solver, accepted so that the same
+        call works; the periodic algorithm is always used.
     return_frequency : bool, optional
         L∞ only: also return the peak frequency in rad/s, folded into
         ``[0, ω_p/2]`` (the HTF at ω and ω + ω_p describes the same
@@ -78,7 +82,7 @@ def norm(sys, p=2, tol=1e-6, print_warning=True, *, return_frequency=False,
     ------
     ValueError
         For `p` outside the documented set, or an unstable system with
-        ``p=2`` or ``'hankel'``.
+        ``p='hankel'``.
 
     Notes
     -----
@@ -97,10 +101,11 @@ def norm(sys, p=2, tol=1e-6, print_warning=True, *, return_frequency=False,
     True
     """
     sys = as_ltp(sys)
+    check_method(method)
     if isinstance(p, str) and p in ('inf', 'hankel'):
         pass
-    elif not isinstance(p, (bool, np.bool_, str)) and isinstance(p, (int, np.integer)) \
-            and p == 2:
+    elif not isinstance(p, (bool, np.bool_, str)) and isinstance(
+            p, (int, np.integer, float, np.floating)) and p == 2:
         p = 2
     else:
         raise ValueError(f"p must be 2, 'inf' or 'hankel', got {p!r}")
@@ -117,6 +122,10 @@ def norm(sys, p=2, tol=1e-6, print_warning=True, *, return_frequency=False,
                        else _linf_continuous(sys, tol, nsteps))
         return (value, freq) if return_frequency else value
     if p == 2:
+        if not sys.is_stable():                  # python-control: inf, with a warning
+            if print_warning:
+                warnings.warn("System is unstable!", UserWarning, stacklevel=2)
+            return float('inf')
         return _h2(sys, nsteps, print_warning)
     return _hankel(sys, nsteps)
 
@@ -135,9 +144,6 @@ def _h2(sys, nsteps, print_warning):
         total = np.einsum('kij,kji->', Bt @ np.roll(Xo, -1, axis=0), B) + np.sum(D * D)
         return float(np.sqrt(max(total, 0.0) / N))
     if sys.nstates and _has_feedthrough(sys):
-        if not sys.is_stable():
-            raise ValueError("norm(p=2): the system is unstable; the H2 norm needs a "
-                             "stable system")
         if print_warning:
             warnings.warn("System has a direct feedthrough term!", UserWarning, stacklevel=3)
         return float('inf')

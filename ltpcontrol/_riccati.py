@@ -50,7 +50,7 @@ import numpy as np
 import scipy.linalg as la
 from control.exception import ControlArgument, ControlDimension
 
-from ._floquet import _log_multipliers, chebyshev_nodes, piecewise_chebyshev
+from ._floquet import _log_multipliers, chebyshev_nodes, lti_representatives, piecewise_chebyshev
 from ._periodic_matrix import PeriodicMatrix, as_periodic
 from ._steps import step_grid
 from ._transition import step_transitions
@@ -64,6 +64,9 @@ _RESIDUAL_WARN = 1e-8
 _CHEB_DEG = 16
 # multipliers within this distance of the unit circle count as on it
 _CIRCLE_TOL = 1e-10
+# closed-loop log|μ| above -first: not stabilizing; above -second: doubtful
+# (a defective unit-circle pair splits by about sqrt(eps))
+_CLOSED_LOOP_TOL = (1e-9, 1e-6)
 
 
 def care(A, B, Q, R, S=None, period=None, nsteps=None):
@@ -168,6 +171,8 @@ def care(A, B, Q, R, S=None, period=None, nsteps=None):
         return np.linalg.solve(r, np.swapaxes(b, 1, 2) @ x + np.swapaxes(s, 1, 2))
 
     G = PeriodicMatrix.pointwise(gain, [B, R, S, X], (m, n), breakpoints=breaks)
+    if all(M.is_constant for M in ops):          # LTI data: the eigenvalues of A - BG
+        L = lti_representatives(L, A(0.0) - B(0.0) @ G(0.0), period=period)
     return X, L, G
 
 
@@ -241,6 +246,8 @@ def dare(A, B, Q, R, S=None):
     Xn = np.roll(X, -1, axis=0)
     G = np.linalg.solve(R + Bt @ Xn @ B, Bt @ Xn @ A + np.swapaxes(S, 1, 2))
     L = _exponents(factors, nper=N)
+    if all(np.all(M == M[0]) for M in (A, B, Q, R, S)):   # LTI data
+        L = lti_representatives(L, A[0] - B[0] @ G[0], nper=N)
     return X, L, G
 
 
@@ -379,12 +386,26 @@ def _flow(H, t0, h):
 
 
 def _exponents(factors, period=None, nper=None):
-    """Floquet exponents (continuous) or per-step exponents (discrete) of factors."""
+    """Floquet exponents (continuous) or per-step exponents (discrete) of the
+    closed-loop factors; raises unless every multiplier is inside the unit
+    circle (a Hamiltonian multiplier pair on the circle, split by round-off,
+    can pass the count of stable multipliers and give a non-stabilizing X)."""
     logmod, arg = _log_multipliers(None, None, grid=None, factors=factors)
+    worst = logmod.max() if logmod.size else -np.inf
+    if not worst < -_CLOSED_LOOP_TOL[0]:
+        raise ValueError(
+            "no stabilizing periodic solution exists: the closed loop keeps a Floquet "
+            f"multiplier on the unit circle (log|mu| = {worst:.1e}); check that (A, B) "
+            "is stabilizable and that Q penalizes every mode on the stability boundary")
+    if worst >= -_CLOSED_LOOP_TOL[1]:
+        warnings.warn(
+            f"the closed loop has a Floquet multiplier with log|mu| = {worst:.1e}: at "
+            "this precision a Hamiltonian multiplier pair on the unit circle looks the "
+            "same, so the solution may not be stabilizing", UserWarning, stacklevel=3)
     if nper is not None:
         with np.errstate(under='ignore', over='ignore'):
-            return np.exp((logmod + 1j * arg) / nper)
-    return (logmod + 1j * arg) / period
+            return np.exp(logmod / nper) * np.exp(1j * arg / nper)   # log|μ| may be -inf
+    return logmod / period + 1j * (arg / period)
 
 
 def _refine(X0, sweep, passes=2):

@@ -120,6 +120,24 @@ def check_positive(value, name, below=None):
     return value
 
 
+def check_method(method):
+    """python-control's `method` keyword of its LTI solvers ('slycot' or
+    'scipy'): accepted for the same calls to work; the periodic algorithms
+    have no such choice.
+
+    Examples
+    --------
+    >>> from ltpcontrol._validation import check_method
+    >>> check_method('scipy')
+    >>> check_method('fast')
+    Traceback (most recent call last):
+    ...
+    control.exception.ControlArgument: method must be None, 'slycot' or 'scipy', got 'fast'
+    """
+    if method is not None and not (isinstance(method, str) and method in ('slycot', 'scipy')):
+        raise ControlArgument(f"method must be None, 'slycot' or 'scipy', got {method!r}")
+
+
 def check_period(period, name="period"):
     """Return the period `period` as a positive finite float.
 

@@ -48,8 +48,9 @@ def zeros(sys, nharmonics=None, *, rtol=1e-8):
     ndarray of complex
         Continuous time: the zeros in the strip ``−ω_p/2 < Im <= ω_p/2``
         (zeros are defined modulo ``jω_p``).  Discrete time: per-step
-        values ``μ^{1/N}``.  Sorted by real part.  For an LTI system the
-        zeros of `control.zeros` (in the strip / sector).
+        values ``μ^{1/N}``.  Sorted by real part.  An LTI system (constant
+        matrices, or the same matrices at every step) gives the zeros of
+        `control.zeros`, also outside the strip.
 
     Raises
     ------
@@ -77,12 +78,14 @@ def zeros(sys, nharmonics=None, *, rtol=1e-8):
                                f"outputs and {sys.ninputs} inputs")
     if not (isinstance(rtol, (int, float, np.floating)) and 0 < rtol < 1):
         raise ValueError(f"rtol must be a number in (0, 1), got {rtol!r}")
+    if nharmonics is not None:
+        K = check_positive_int(nharmonics, 'nharmonics', minimum=1)
     if sys.isdtime():
         return _discrete(sys)
+    if sys.is_lti:                   # the zeros of the constant matrices, unfolded
+        return _sorted(_pencil_zeros(*(M(0.0) for M in (sys.A, sys.B, sys.C, sys.D))))
     if nharmonics is None:
         K = min(40, 12 + 4 * max(_bandwidth(M) for M in (sys.A, sys.B, sys.C, sys.D)))
-    else:
-        K = check_positive_int(nharmonics, 'nharmonics', minimum=1)
     z1 = _harmonic_zeros(sys, K)
     z2 = _harmonic_zeros(sys, K + max(8, K // 2))
     keep = [z for z in z1 if z2.size and
@@ -117,17 +120,25 @@ def _harmonic_zeros(sys, K):
 
 
 def _discrete(sys):
+    N = sys.nsteps
+    steps = [M.sample(N) for M in (sys.A, sys.B, sys.C, sys.D)]
+    if all(np.all(M == M[0]) for M in steps):    # the same matrices at every step
+        return _sorted(_pencil_zeros(*(M[0] for M in steps)))
     L = lift(sys, method='time')
-    n = L.nstates
-    pencil = np.block([[L.A, L.B], [L.C, L.D]])
-    E = la.block_diag(np.eye(n), np.zeros_like(L.D))
+    return _sorted(_pencil_zeros(L.A, L.B, L.C, L.D) ** (1.0 / N))
+
+
+def _pencil_zeros(A, B, C, D):
+    """Finite generalized eigenvalues of the Rosenbrock pencil of (A, B, C, D)."""
+    n = A.shape[0]
+    pencil = np.block([[A, B], [C, D]])
+    E = la.block_diag(np.eye(n), np.zeros_like(D))
     alpha, beta = la.eig(pencil, E, right=False, homogeneous_eigvals=True)
     scale = max(1.0, np.abs(pencil).max())
     finite = np.abs(beta) > 1e-12 * scale * np.maximum(np.abs(alpha), 1e-300) \
         / np.maximum(np.abs(alpha), 1.0)
-    mu = alpha[finite] / beta[finite]
-    mu = mu[np.abs(mu) < 1e12 * scale]
-    return _sorted(mu.astype(complex) ** (1.0 / sys.nsteps))
+    z = alpha[finite] / beta[finite]
+    return z[np.abs(z) < 1e12 * scale].astype(complex)
 
 
 def _sorted(z):

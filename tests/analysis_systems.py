@@ -1,6 +1,7 @@
 """Systems with independently known analysis results (LTI references)."""
 
 import numpy as np
+import scipy.linalg as la
 import control as ct
 
 import ltpcontrol as ltp
@@ -70,3 +71,28 @@ def zhou_hagiwara_A():
         out[:, 1, 1] = -1 - np.cos(2 * t) ** 2
         return out[0] if scalar else out
     return ltp.PeriodicMatrix.from_function(A, np.pi)
+
+
+def lifted(A, B, C, D):
+    """Time-lifted LTI system of a discrete periodic system, built here."""
+    N, n = A.shape[0], A.shape[1]
+    m, p = B.shape[2], C.shape[1]
+    trans = lambda i, k: np.linalg.multi_dot([np.eye(n)] + [A[j] for j in range(i - 1, k, -1)]
+                                             + [np.eye(n)])          # A_{i-1}...A_{k+1}
+    Phi = trans(N, -1)
+    Bl = np.hstack([trans(N, k) @ B[k] for k in range(N)])
+    Cl = np.vstack([C[i] @ trans(i, -1) for i in range(N)])
+    Dl = np.zeros((N * p, N * m))
+    for i in range(N):
+        Dl[i * p:(i + 1) * p, i * m:(i + 1) * m] = D[i]
+        for k in range(i):
+            Dl[i * p:(i + 1) * p, k * m:(k + 1) * m] = C[i] @ trans(i, k) @ B[k]
+    return ct.ss(Phi, Bl, Cl, Dl, True)
+
+
+def pencil_zeros(G):
+    """Finite zeros of an LTI system from its Rosenbrock pencil."""
+    P = np.block([[G.A, G.B], [G.C, G.D]])
+    E = la.block_diag(np.eye(G.nstates), np.zeros_like(G.D))
+    z = la.eigvals(P, E)
+    return np.sort_complex(z[np.isfinite(z) & (np.abs(z) < 1e8)])

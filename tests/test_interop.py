@@ -119,6 +119,13 @@ def test_lists_of_systems_mix_lti_and_ltp():
     np.testing.assert_allclose(out[1].outputs, ltp.step_response(Ps, t).outputs, atol=1e-10)
 
 
+def test_hankel_singular_values_of_lti_written_as_periodic_equal_python_control():
+    G = ct.rss(4, 2, 3, strictly_proper=True)
+    hsv = ct.hankel_singular_values(ltp.ltpss(G, T))
+    assert hsv.shape == (4,)
+    np.testing.assert_allclose(hsv, ct.hankel_singular_values(G), rtol=1e-9)
+
+
 def test_time_response_arguments_without_meaning_are_refused():
     with pytest.raises(ControlArgument, match="params"):
         ct.forced_response(P, t, U, params={'a': 1})
@@ -254,6 +261,7 @@ REFUSED_CALLS = {
     'tf': lambda: ct.tf(P),
     'ss2tf': lambda: ct.ss2tf(P),
     'mixsyn': lambda: ct.mixsyn(P),
+    'find_operating_point': lambda: ct.find_operating_point(P, np.zeros(3)),
 }
 
 
@@ -265,6 +273,11 @@ def test_every_refused_entry_point_is_tested():
 def test_refused_entry_points_name_the_ltp_way(name):
     with pytest.raises(ControlArgument, match=rf"^{name} does not apply.*: use \S"):
         REFUSED_CALLS[name]()
+
+
+def test_aliases_are_refused_under_their_function_name():
+    with pytest.raises(ControlArgument, match="find_operating_point does not apply"):
+        ct.find_eqpt(P, np.zeros(3))
 
 
 def test_methods_python_control_calls_give_the_same_errors():
