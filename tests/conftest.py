@@ -1,8 +1,13 @@
 """Shared test set-up."""
+import pathlib
+import sys
 import zlib
 
 import numpy as np
 import pytest
+
+# the gallery's example plants (examples/*.py) are importable from every test
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / 'examples'))
 
 
 @pytest.fixture(autouse=True)
