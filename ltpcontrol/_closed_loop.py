@@ -73,7 +73,7 @@ class _Loop:
     def _check_algebraic_loop(self):
         # y is evaluated at u0: exact unless both h and the controller pass u through
         t, x = 0.0, self.orbit.x0
-        dh_du = central_jacobian(lambda u: self.plant._h(t, x, u, self.params), self.u0)
+        dh_du = central_jacobian(lambda u: self.plant.output(t, x, u, self.params), self.u0)
         dk_de = central_jacobian(lambda e: self.ctrl_out(t, np.zeros(self.nc), e),
                                   np.zeros(self.p))
         if np.any(dh_du != 0) and np.any(dk_de != 0):
@@ -109,7 +109,7 @@ class _Loop:
         return self._ybar(t)
 
     def error(self, t, x, v):
-        return self.plant._h(t, x, self.u0, self.params) + v - self.ybar(t)
+        return self.plant.output(t, x, self.u0, self.params) + v - self.ybar(t)
 
     def actuate(self, w):
         return np.clip(self.u0 + w, self.lower, self.upper)
@@ -130,7 +130,7 @@ def _output_interpolant(plant, orbit, tol=1e-11):
     breaks = np.concatenate([[0.0], orbit.switching_times, [T]])
 
     def ybar_exact(t):
-        return np.column_stack([plant._h(tk, x, u0, params)
+        return np.column_stack([plant.output(tk, x, u0, params)
                                 for tk, x in zip(t, orbit(t).T)])
 
     pieces = []
@@ -220,34 +220,37 @@ def _loop_plant(loop):
 
         def updfcn(t, z, v, p):
             e, u = signals(t, z, v)
-            return np.concatenate([plant._f(i, t, z[:n], u, params), loop.ctrl_rhs(t, z[n:], e)])
+            return np.concatenate([plant.dynamics(t, z[:n], u, params, mode=i),
+                                   loop.ctrl_rhs(t, z[n:], e)])
 
         def jacobian(t, z, v, p):
             # chain rule through e = h(x) + v − ȳ and u = sat(u0 + C_c x_c + D_c e)
             e, u = signals(t, z, v)
             Ac, Bc, Cc, Dc = loop.matrices(t)
-            H = central_jacobian(lambda x: plant._h(t, x, loop.u0, params), z[:n])
+            H = central_jacobian(lambda x: plant.output(t, x, loop.u0, params), z[:n])
             active = ((u > loop.lower) & (u < loop.upper))[:, None]
             du_dz = active * np.hstack([Dc @ H, Cc])
-            top = np.hstack([plant._dfdx(i, t, z[:n], u, params), np.zeros((n, loop.nc))])
-            top += plant._dfdu(i, t, z[:n], u, params) @ du_dz
+            top = np.hstack([plant.state_jacobian(t, z[:n], u, params, mode=i),
+                             np.zeros((n, loop.nc))])
+            top += plant.input_jacobian(t, z[:n], u, params, mode=i) @ du_dz
             return np.vstack([top, np.hstack([Bc @ H, Ac])])
 
         guard = reset = None
         if src.guard is not None:
             def guard(t, z, v, p):
-                return plant._g(i, t, z[:n], signals(t, z, v)[1], params)
+                return plant.guard(t, z[:n], signals(t, z, v)[1], params, mode=i)
 
             def reset(t, z, v, p):
-                return np.concatenate([plant._r(i, t, z[:n], signals(t, z, v)[1], params),
+                return np.concatenate([plant.reset(t, z[:n], signals(t, z, v)[1], params, mode=i),
                                        z[n:]])
         return HybridMode(updfcn, guard=guard, reset=reset, name=plant.mode_names[i],
-                          target=plant._targets[i], jacobian=jacobian if loop.linear else None)
+                          target=plant.mode_targets[i], jacobian=jacobian if loop.linear else None)
 
-    return HybridPlant([mode(i) for i in range(len(plant.modes))],
-                       lambda t, z, v, p: np.concatenate([plant._h(t, z[:n], signals(t, z, v)[1],
-                                                                   params),
-                                                          signals(t, z, v)[1]]),
+    def output(t, z, v, p):
+        u = signals(t, z, v)[1]
+        return np.concatenate([plant.output(t, z[:n], u, params), u])
+
+    return HybridPlant([mode(i) for i in range(len(plant.modes))], output,
                        states=plant.state_labels + ctrl.state_labels,
                        inputs=[f'v[{k}]' for k in range(loop.p)],
                        outputs=plant.output_labels + plant.input_labels,
@@ -267,19 +270,21 @@ def _held_plant(loop):
         guard = reset = None
         if src.guard is not None:
             def guard(t, z, _, p):
-                return plant._g(i, t, z[:n], z[n:], params)
+                return plant.guard(t, z[:n], z[n:], params, mode=i)
 
             def reset(t, z, _, p):
-                return np.concatenate([plant._r(i, t, z[:n], z[n:], params), z[n:]])
+                return np.concatenate([plant.reset(t, z[:n], z[n:], params, mode=i), z[n:]])
 
         def jacobian(t, z, _, p):
             J = np.zeros((n + loop.m, n + loop.m))
-            J[:n, :n] = plant._dfdx(i, t, z[:n], z[n:], params)
-            J[:n, n:] = plant._dfdu(i, t, z[:n], z[n:], params)
+            J[:n, :n] = plant.state_jacobian(t, z[:n], z[n:], params, mode=i)
+            J[:n, n:] = plant.input_jacobian(t, z[:n], z[n:], params, mode=i)
             return J
-        return HybridMode(lambda t, z, _, p: np.concatenate([plant._f(i, t, z[:n], z[n:], params),
-                                                             np.zeros(loop.m)]),
-                          guard=guard, reset=reset, target=plant._targets[i],
+        def updfcn(t, z, _, p):
+            return np.concatenate([plant.dynamics(t, z[:n], z[n:], params, mode=i),
+                                   np.zeros(loop.m)])
+        return HybridMode(updfcn,
+                          guard=guard, reset=reset, target=plant.mode_targets[i],
                           name=plant.mode_names[i], jacobian=jacobian)
 
     return HybridPlant([mode(i) for i in range(len(plant.modes))],
@@ -511,7 +516,7 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
     bar.close()
     n = loop.n
     v = np.array([vfun(t) for t in timepts]).reshape(len(timepts), loop.p).T
-    y = np.column_stack([plant._h(t, states[:n, k], loop.u0, loop.params)
+    y = np.column_stack([plant.output(t, states[:n, k], loop.u0, loop.params)
                          for k, t in enumerate(timepts)])
     resp = ct.TimeResponseData(
         timepts, y, states, u, issiso=loop.m == 1 and loop.p == 1,
@@ -578,7 +583,7 @@ def _run_continuous(loop, opts, timepts, z, mode, vfun, bar):
         z, mode = flow.x_final, flow.mode_final
         bar.update(b - a)
     states[:, -1], modes[-1] = z, mode
-    u = np.column_stack([lp._h(t, states[:, j], vfun(t), loop.params)[loop.p:]
+    u = np.column_stack([lp.output(t, states[:, j], vfun(t), loop.params)[loop.p:]
                          for j, t in enumerate(timepts)])
     return states, modes, events, u
 

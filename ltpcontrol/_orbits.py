@@ -188,9 +188,9 @@ def time_mismatch(plant, x0, u0, params, pairs):
     """
     bumps = np.linspace(-1.0, 1.0, plant.nstates) * 0.1 * (1 + np.abs(x0))
     for i, mode in enumerate(plant.modes):
-        checks = [('updfcn', lambda t, x: plant._f(i, t, x, u0, params))]
+        checks = [('updfcn', lambda t, x: plant.dynamics(t, x, u0, params, mode=i))]
         if mode.guard is not None:
-            checks.append(('guard', lambda t, x: plant._g(i, t, x, u0, params)))
+            checks.append(('guard', lambda t, x: plant.guard(t, x, u0, params, mode=i)))
         for label, func in checks:
             for ta, tb in pairs:
                 for x in (x0, x0 + bumps):
@@ -549,11 +549,11 @@ def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, na
     params, u0, T = orbit.params, orbit.u0, orbit.period
 
     def h_of(t, x, u):
-        return hp._h(t, x, u, params)
+        return hp.output(t, x, u, params)
 
     derivatives = {
-        'A': lambda i, t, x: hp._dfdx(i, t, x, u0, params),
-        'B': lambda i, t, x: hp._dfdu(i, t, x, u0, params),
+        'A': lambda i, t, x: hp.state_jacobian(t, x, u0, params, mode=i),
+        'B': lambda i, t, x: hp.input_jacobian(t, x, u0, params, mode=i),
         'C': lambda i, t, x: central_jacobian(lambda z: h_of(t, z, u0), x),
         'D': lambda i, t, x: central_jacobian(lambda v: h_of(t, x, v), u0),
     }
