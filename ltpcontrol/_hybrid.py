@@ -496,6 +496,12 @@ def input_function(plant, inputs, timepts):
     return lambda t: np.array([np.interp(t, timepts, row) for row in arr])
 
 
+class IntegrationError(RuntimeError):
+    """The hybrid integrator could not continue: solver failure, a state that
+    is no longer finite, or more events than allowed (a diverging or Zeno
+    trajectory)."""
+
+
 class Flow:
     """One integration of a hybrid plant over ``[t0, tf]`` with event handling.
 
@@ -511,6 +517,9 @@ class Flow:
         t, x, i = t0, np.array(x0, float), mode
         phi = np.eye(n)
         while True:
+            if not (np.all(np.isfinite(x)) and np.all(np.isfinite(phi))):
+                raise IntegrationError(f"the state is no longer finite at t={t:.6g} "
+                                       f"(mode {plant.mode_names[i]!r}): the trajectory diverges")
             rhs, z0 = self._system(plant, i, ufun, params, x, phi, variational)
             events = None
             if plant.modes[i].guard is not None:
@@ -521,8 +530,8 @@ class Flow:
             sol = solve_ivp(rhs, (t, tf), z0, method=method, rtol=rtol, atol=atol,
                             events=events, dense_output=True)
             if sol.status == -1:
-                raise RuntimeError(f"integration failed in mode {plant.mode_names[i]!r} "
-                                   f"at t={sol.t[-1]:.6g}: {sol.message}")
+                raise IntegrationError(f"integration failed in mode {plant.mode_names[i]!r} "
+                                       f"at t={sol.t[-1]:.6g}: {sol.message}")
             t_end, z_end = sol.t[-1], sol.y[:, -1]
             self.segments.append((t, t_end, i, sol.sol))
             x = z_end[:n]
@@ -541,8 +550,8 @@ class Flow:
             self.events.append((t_end, i, j, x.copy(), x_plus.copy()))
             x, i, t = x_plus, j, t_end
             if len(self.events) > max_events:
-                raise RuntimeError(f"more than max_events={max_events} events before "
-                                   f"t={t:.6g} (Zeno or chattering behaviour?)")
+                raise IntegrationError(f"more than max_events={max_events} events before "
+                                       f"t={t:.6g} (Zeno or chattering behaviour?)")
         self.x_final, self.mode_final, self.phi = x, i, phi
         self.nstates = n
 

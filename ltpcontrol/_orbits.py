@@ -19,7 +19,7 @@ from control import NonlinearIOSystem
 from control.exception import ControlArgument, ControlDimension
 
 from ._hybrid import (HybridMode, HybridPlant, central_jacobian, constant_input,
-                      Flow, plant_params, solver_settings)
+                      Flow, IntegrationError, plant_params, solver_settings)
 from ._ltpsys import ltpss
 from ._periodic_matrix import PeriodicMatrix
 from ._validation import check_period, check_positive_int, real_array
@@ -377,7 +377,11 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
             break
         # fall back to forward simulation towards an attracting orbit
         nper = min(10, warmup + max_periods - periods)
-        sim_x, sim_mode, res = shooter.simulate(sim_x, sim_mode, nper)
+        try:
+            sim_x, sim_mode, res = shooter.simulate(sim_x, sim_mode, nper)
+        except IntegrationError as err:
+            tried.append(f"forward simulation from t={periods}T: {err}")
+            break
         x, mode, periods = sim_x, sim_mode, periods + nper
         tried.append(f"forward simulation to t={periods}T: residual {res:.3g}")
     raise RuntimeError("periodic_orbit did not converge to a T-periodic orbit "
@@ -429,7 +433,11 @@ class _PeriodShooter:
         names, n = self.hp.mode_names, self.hp.nstates
         last, stalled = np.inf, 0
         for it in range(max_iter + 1):
-            fl = self.flow(x, mode, True)
+            try:
+                fl = self.flow(x, mode, True)
+            except IntegrationError as err:
+                tried.append(f"{where}: {err}")
+                return None
             if fl.mode_final != mode:
                 tried.append(f"{where}: the period ends in mode {names[fl.mode_final]!r}, "
                              f"not {names[mode]!r}")
