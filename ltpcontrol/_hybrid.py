@@ -122,8 +122,8 @@ class HybridPlant:
 
     Notes
     -----
-    The methods `dynamics`, `guard`, `reset`, `output`, `state_jacobian`
-    and `input_jacobian` evaluate the charts with validated shapes, as
+    The methods ``dynamics``, ``guard``, ``reset``, ``output``,
+    ``state_jacobian`` and ``input_jacobian`` evaluate the charts with validated shapes, as
     python-control's ``sys.dynamics(t, x, u, params)`` and
     ``sys.output(t, x, u, params)`` do; the mode is the keyword ``mode``.
 
