@@ -16,7 +16,8 @@ inverse (thesis eq. 4.104) is, per step,
     A_k = c (I + A_d[k])^{-1} (A_d[k] - I),   B_k = √(2c) (I + A_d[k])^{-1} B_d[k],
     C_k = √(2c) C_d[k] (I + A_d[k])^{-1},      D_k = D_d[k] - C_d[k] (I + A_d[k])^{-1} B_d[k].
 
-Zero-order hold is exact: ``x[k+1] = Φ(t_{k+1}, t_k) x[k] + ∫ Φ(t_{k+1}, τ) B(τ) dτ u[k]``.
+Zero-order hold is exact: ``x[k+1] = Φ(t_{k+1}, t_k) x[k] + ∫ Φ(t_{k+1}, τ) B(τ) dτ u[k]``;
+so is first-order hold (inputs linear between samples, see `_foh`).
 """
 
 import warnings
@@ -52,9 +53,10 @@ def sample_system(sys, Ts, method='zoh', alpha=None, prewarp_frequency=None,
     Ts : float
         Sampling time; ``N = T/Ts`` must be an integer (the period of the
         result in steps).
-    method : {'zoh', 'tustin', 'bilinear'}
+    method : {'zoh', 'foh', 'tustin', 'bilinear'}
         'zoh' (default): exact discretization for inputs held constant over
-        each step.  'tustin' or 'bilinear': the balanced bilinear rule of
+        each step.  'foh': exact for inputs linear between samples, with
+        python-control's state ``x[k] - Γ1 u[k]`` (so ``D_d ≠ D``).  'tustin' or 'bilinear': the balanced bilinear rule of
         thesis eqs. (4.46)-(4.53) (see Notes).
     alpha : None
         Accepted for compatibility with `control.sample_system`; it only
@@ -117,8 +119,9 @@ def sample_system(sys, Ts, method='zoh', alpha=None, prewarp_frequency=None,
     sys = as_ltp(sys, discrete=False, lti_hint='control.sample_system')
     Ts = check_positive(Ts, 'Ts')
     N = steps_per_period(sys.period, Ts, 'Ts')
-    if method not in _TUSTIN + ('zoh',):
-        raise ValueError(f"method must be 'zoh', 'tustin' or 'bilinear', got {method!r}")
+    if method not in _TUSTIN + ('zoh', 'foh'):
+        raise ValueError(f"method must be 'zoh', 'foh', 'tustin' or 'bilinear', got "
+                         f"{method!r}")
     if alpha is not None:
         warnings.warn("alpha only applies to the 'gbt' method, which is not available "
                       "for LTP systems; alpha is ignored", UserWarning, stacklevel=2)
@@ -127,6 +130,9 @@ def sample_system(sys, Ts, method='zoh', alpha=None, prewarp_frequency=None,
     if method == 'zoh':
         mats = _zoh(sys, N)
         consts = [consts[0], consts[0] and consts[1], consts[2], consts[3]]
+    elif method == 'foh':
+        mats = _foh(sys, N)
+        consts = [consts[0], consts[0] and consts[1], consts[2], all(consts)]
     else:
         mats = _tustin(*(M.sample(N) for M in (sys.A, sys.B, sys.C, sys.D)), c)
         consts = _bilinear_constants(consts)
@@ -290,6 +296,21 @@ def _zoh(sys, N):
     else:
         Phi, Gamma0, _ = step_transitions(sys.A, sys.B, h * np.arange(N), h)
     return Phi, Gamma0, sys.C.sample(N), sys.D.sample(N)
+
+
+def _foh(sys, N):
+    """Exact FOH (inputs linear between samples), in python-control's state.
+
+    With ``x_{k+1} = Φ_k x_k + (Γ0_k - Γ1_k) u_k + Γ1_k u_{k+1}`` (``_transition``)
+    and the state ``ξ_k = x_k - Γ1_{k-1} u_k``:  ``A_d[k] = Φ_k``,
+    ``B_d[k] = Γ0_k - Γ1_k + Φ_k Γ1_{k-1}``, ``C_d[k] = C_k``,
+    ``D_d[k] = D_k + C_k Γ1_{k-1}`` (scipy's 'foh' when A, B are constant).
+    """
+    h = sys.period / N
+    Phi, G0, G1 = step_transitions(sys.A, sys.B, h * np.arange(N), h)
+    G1prev = np.roll(G1, 1, axis=0)
+    C = sys.C.sample(N)
+    return Phi, G0 - G1 + Phi @ G1prev, C, sys.D.sample(N) + C @ G1prev
 
 
 def _inverse_zoh(Ad, Bd, Cd, Dd, Ts, constant):

@@ -8,9 +8,14 @@ harmonic 0 (an ``ny x nu`` matrix for ``nu`` inputs)
     G_n(jΩ) = Σ_{m=-H..H} C_{n-m} R_m(Ω) B_m + D_n,        n = -K..K,
 
 truncated to the input harmonics ``|m| <= H`` of a model whose B has H >= K
-harmonics (C then has K + H, D has K; H = K by default).  A plant whose A(t)
-is periodic has B_m for all m in Floquet form: the terms ``|m| > K`` omitted
-by H = K bias the fitted exponents, H = K + 1 captures most of them.  It is
+harmonics, C has 2K and D has K (``C_l = 0`` for ``|l| > 2K``).  A plant
+whose A(t) is periodic has B_m for all m in Floquet form: the terms
+``|m| > K`` omitted by H = K bias the fitted exponents, H = K + 1 captures
+most of them.  C stops at 2K for every H: a ``C_l`` with ``|l| > 2K`` meets
+the data only in products with a ``B_m``, ``|m| > K``, so where those
+vanish (a plant with at most K harmonics in Floquet form) it is not
+determined by the data, yet it enters the harmonics ``|n| > K`` the model
+predicts.  It is
 linear in D, linear in B for fixed (A, C) and in C for fixed (A, B), and
 ``dR_m = R_m dA R_m``.  The parameters are real: ``Re P_0, Re P_h, Im P_h``
 (h > 0) of every coefficient series, so that ``P_{-h} = conj P_h`` and the
@@ -98,17 +103,19 @@ class _FloquetFit:
     def __init__(self, nx, ny, nu, K, H, period, estimate_d, fit_a):
         self.nx, self.ny, self.nu, self.K, self.H = nx, ny, nu, K, H
         self.wp, self.fit_a = 2 * np.pi / period, fit_a
-        Tb, Tc, Td = _conj_map(H, nx * nu), _conj_map(K + H, ny * nx), _conj_map(K, ny * nu)
+        Tb, Tc, Td = _conj_map(H, nx * nu), _conj_map(2 * K, ny * nx), _conj_map(K, ny * nu)
         self.nb, self.nc, self.nd = Tb.shape[0], Tc.shape[0], Td.shape[0]
         T = np.zeros((self.nb + self.nc + self.nd,) * 2, complex)
         nb, nc = self.nb, self.nc
         T[:nb, :nb], T[nb:nb + nc, nb:nb + nc], T[nb + nc:, nb + nc:] = Tb, Tc, Td
         self.T = T if estimate_d else T[:, :nb + nc]
         self.ncoef = self.T.shape[1]
+        self.cpad = ((H - K, H - K), (0, 0), (0, 0))          # C_l = 0 for 2K < |l| <= K+H
 
     def pack(self, sys):
-        Bc, Cc, Dc = _coefficients(sys, self.K, self.H)
-        c = np.concatenate([Bc.ravel(), Cc.ravel(), Dc.ravel()])
+        K, H = self.K, self.H
+        Bc, Cc, Dc = _coefficients(sys, K, H)
+        c = np.concatenate([Bc.ravel(), Cc[H - K:H + 3 * K + 1].ravel(), Dc.ravel()])
         theta = np.linalg.lstsq(self.T, c, rcond=None)[0].real
         return np.concatenate([theta, sys.A(0.0).ravel()]) if self.fit_a else theta
 
@@ -118,7 +125,7 @@ class _FloquetFit:
         if self.fit_a:
             A = theta[self.ncoef:].reshape(nx, nx)
         return (A, c[:nb].reshape(2 * H + 1, nx, nu),
-                c[nb:nb + nc].reshape(2 * (K + H) + 1, ny, nx),
+                np.pad(c[nb:nb + nc].reshape(4 * K + 1, ny, nx), self.cpad),
                 c[nb + nc:].reshape(2 * K + 1, ny, nu))
 
     def response_and_jacobian(self, theta, omega, A=None, jac=True):
@@ -139,7 +146,7 @@ class _FloquetFit:
         Xsel = np.zeros((2 * K + 1, 2 * (K + H) + 1, M, nx, nu), complex)
         for a, n in enumerate(range(-K, K + 1)):
             Xsel[a, n - m + K + H] = X.transpose(1, 0, 2, 3)
-        JC = np.einsum('oz,nlwiq->qnowlzi', ey, Xsel)
+        JC = np.einsum('oz,nlwiq->qnowlzi', ey, Xsel[:, H - K:H + 3 * K + 1])
         JD = np.einsum('qr,na,oz,w->qnowazr', eu, np.eye(2 * K + 1), ey, np.ones(M))
         J = np.hstack([Jx.reshape(G.size, -1) for Jx in (JB, JC, JD)]) @ self.T
         if self.fit_a:
@@ -152,7 +159,7 @@ class _FloquetFit:
 def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=True,
                 maxiter=50, rtol=1e-8, **labels):
     """Least-squares Floquet-form model fitted to ``G_n(jΩ)``, n = -K..K, with
-    `harmonics` H >= K harmonics in B (default K), K + H in C, K in D.
+    `harmonics` H >= K harmonics in B (default K), 2K in C, K in D.
 
     `Gc` has the shape (nu, 2K+1, ny, M) of `_harmonic_response`.
 
@@ -214,6 +221,7 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
         r, J = cost(theta, True)
     A, Bc, Cc, Dc = fit.unpack(theta, A0)
     period = sys.period
+    Cc = Cc[H - K:H + 3 * K + 1]                                  # harmonics -2K..2K
     model = LTPStateSpace(A, PeriodicMatrix(Bc, period), PeriodicMatrix(Cc, period),
                           PeriodicMatrix(Dc, period), period, states=sys.state_labels,
                           **labels)

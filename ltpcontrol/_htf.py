@@ -33,7 +33,7 @@ class HTF(abc.ABC):
 
     An abstract class, not instantiated itself: `htf` builds the HTF of a
     system (`HTFModel`), `HTFData` holds components sampled on a frequency
-    grid.
+    grid, and ``HTF(...)`` raises a `control.ControlArgument` naming both.
     Both are evaluated, plotted and converted through the methods below.
 
     Attributes
@@ -60,6 +60,14 @@ class HTF(abc.ABC):
     >>> isinstance(H, ltp.HTF), isinstance(D, ltp.HTF), type(D).__name__
     (True, True, 'HTFData')
     """
+
+    def __new__(cls, *args, **kwargs):
+        if cls is HTF:
+            raise ControlArgument(
+                "HTF is the common interface of HTFModel and HTFData and is not created "
+                "directly: use ltp.htf(sys, nharmonics) for the HTF of a system, or "
+                "ltp.HTFData(components, omega, period) for components on a grid")
+        return super().__new__(cls)
 
     def _set_signals(self, period, nharmonics, noutputs, ninputs, dt, name, inputs,
                      outputs):

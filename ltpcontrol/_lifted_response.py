@@ -26,6 +26,7 @@ from control.exception import ControlArgument, ControlDimension
 from tqdm.auto import tqdm
 
 from ._lifting import _harmonic_labels, _real_basis
+from ._periodic_matrix import PeriodicMatrix, as_periodic
 from ._validation import (check_kwargs, check_period, check_positive, check_positive_int,
                           real_array, steps_per_period, time_record)
 
@@ -44,9 +45,9 @@ _HOLDS = (None, 'foh', 'zoh')
 
 
 def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
-                              transient=0.0, input_hold=None, hold_step=None, real=True,
-                              unusable='raise', batch_size=64, progress=False, name=None,
-                              **kwargs):
+                              transient=0.0, input_hold=None, hold_step=None,
+                              feedthrough=None, real=True, unusable='raise', batch_size=64,
+                              progress=False, name=None, **kwargs):
     r"""Lifted frequency response of an LTP system from sine experiments.
 
     Each experiment applies real sinusoids (single sines) or sums of
@@ -97,6 +98,15 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
         Step (s) of the input hold; default the step ``Ts`` of `timepts`.
         Give it when the records were decimated from a finer simulation
         (for example ``Ts/4``) or the input is updated faster than sampled.
+    feedthrough : array_like, PeriodicMatrix or callable, optional
+        The system's direct term ``D(t)`` (period `period`, shape
+        ``(noutputs, ninputs)``; the scalar 0 for a strictly proper
+        system), when known.  With `input_hold`, the sampled output
+        ``y(t_k) = C x(t_k) + D(t_k) u_k`` sees the samples ``u_k``, not the
+        held signal: the hold correction applies to ``y - D u`` only, and
+        the direct term is added back exactly.  Without it, a system with
+        ``D ≠ 0`` gets a bias ``(1/h(Ω) - 1) D_n`` (h the hold gain above);
+        ignored when `input_hold` is None.
     real : bool, optional
         True (default): real lifted coordinates ``V^H G`` with output
         labels ``'<y>_c0', '<y>_c1', '<y>_s1', ...`` as in `ltpcontrol.lift`.
@@ -211,12 +221,32 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
         raise ValueError(f"transient must be >= 0, got {transient}")
 
     tw, uw, yw = _analysis_window(t, u, y, dt, N, transient)
+    direct = input_hold is not None and feedthrough is not None
+    if direct:
+        # y = y_dyn + D(t_k) u_k: analyse both parts, the direct one without the hold
+        D = _feedthrough(feedthrough, period, (yw.shape[0], uw.shape[0]))
+        yd = np.einsum('koj,jek->oek', D(tw), uw)
+        yw = np.concatenate([yw - yd, yd])
     window = tw.size * dt
     lines = _lines(uw, frequencies, window, dt, period, unusable == 'skip')
     omega, U, Y = _line_spectra(tw, uw, yw, lines, N, K, period, batch_size, progress)
-    U = U * _hold_factor(omega, hold_step, input_hold)[:, None]
-    omega, G = _solve_lines(omega, U, Y, window)
-    return _lifted_frd(G, omega, dt, K, N, real, ylabels, ulabels, name)
+    hold = _hold_factor(omega, hold_step, input_hold)[:, None]
+    if direct:
+        # harmonic-major rows of Y: (2K+1) blocks of [dynamic outputs, direct outputs]
+        Y = Y.reshape(Y.shape[0], 2 * K + 1, 2, -1)
+        lines, G = _solve_lines(omega, U * hold, Y[:, :, 0].reshape(Y.shape[0], -1), window)
+        G = G + _solve_lines(omega, U, Y[:, :, 1].reshape(Y.shape[0], -1), window)[1]
+    else:
+        lines, G = _solve_lines(omega, U * hold, Y, window)
+    return _lifted_frd(G, lines, dt, K, N, real, ylabels, ulabels, name)
+
+
+def _feedthrough(value, period, shape):
+    """The direct term D(t) as a PeriodicMatrix of the given shape (scalar 0: zeros)."""
+    if not isinstance(value, PeriodicMatrix) and not callable(value) \
+            and np.ndim(value) == 0 and real_array(value, 'feedthrough', ndim=0) == 0:
+        value = np.zeros(shape)
+    return as_periodic(value, period, 'feedthrough', shape)
 
 
 def _parse_response(response):

@@ -311,28 +311,28 @@ class LTPStateSpace(NonlinearIOSystem):
         return negate(self)
 
     def __add__(self, other):
-        other = _to_ltp_or_none(other, self)
+        other = _to_ltp_or_none(other, self, 'add')
         return NotImplemented if other is None else _parallel(self, other)
 
     def __radd__(self, other):
-        other = _to_ltp_or_none(other, self)
+        other = _to_ltp_or_none(other, self, 'add')
         return NotImplemented if other is None else _parallel(other, self)
 
     def __sub__(self, other):
-        other = _to_ltp_or_none(other, self)
+        other = _to_ltp_or_none(other, self, 'add')
         return NotImplemented if other is None else _parallel(self, negate(other))
 
     def __rsub__(self, other):
-        other = _to_ltp_or_none(other, self)
+        other = _to_ltp_or_none(other, self, 'add')
         return NotImplemented if other is None else _parallel(other, negate(self))
 
     def __mul__(self, other):
         # sys * other: other acts first (python-control convention)
-        other = _to_ltp_or_none(other, self)
+        other = _to_ltp_or_none(other, self, 'input')
         return NotImplemented if other is None else _series(other, self)
 
     def __rmul__(self, other):
-        other = _to_ltp_or_none(other, self)
+        other = _to_ltp_or_none(other, self, 'output')
         return NotImplemented if other is None else _series(self, other)
 
     def feedback(self, other=1, sign=-1, params=None):
@@ -726,13 +726,18 @@ def _to_ltp(obj, period, dt):
                          np.zeros((gain.shape[0], 0)), gain, period, dt=dt)
 
 
-def _to_ltp_or_none(obj, ref):
-    """Operand of an arithmetic operator as an LTP system, or None if unsupported."""
+def _to_ltp_or_none(obj, ref, role):
+    """Operand of an arithmetic operator as an LTP system, or None if unsupported.
+
+    A scalar is, as in python-control, added to every entry of D (`role`
+    'add') or a gain on every input ('input') or output ('output') channel.
+    """
     if isinstance(obj, LTPStateSpace):
         return obj
     if isinstance(obj, (int, float, np.number)) and not isinstance(obj, bool):
-        # a scalar acts on every channel, as in python-control
-        return _to_ltp(float(obj) * np.eye(ref.noutputs), ref.period, ref.dt)
+        gain = (np.full(ref.shape, float(obj)) if role == 'add' else
+                float(obj) * np.eye(ref.ninputs if role == 'input' else ref.noutputs))
+        return _to_ltp(gain, ref.period, ref.dt)
     if isinstance(obj, PeriodicMatrix):
         return _to_ltp(obj, _merge_period(ref.period, obj.period), ref.dt)
     if isinstance(obj, (ct.StateSpace, ct.TransferFunction, np.ndarray, list)):

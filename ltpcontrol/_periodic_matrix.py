@@ -334,8 +334,8 @@ class PeriodicMatrix:
         for i, m in enumerate(mats):
             if m.shape != shape:
                 raise ValueError(f"pieces[{i}] has shape {m.shape}, expected {shape}")
-        if len(mats) == 1:
-            return mats[0].with_period(period) if mats[0]._func is None else mats[0]
+        if len(mats) == 1 and mats[0]._func is None:
+            return mats[0].with_period(period)
         return cls._new(period, shape, pieces=mats, times=times,
                         breakpoints=times)
 
@@ -420,10 +420,12 @@ class PeriodicMatrix:
             tau[tau >= self.period - eps] -= self.period
             idx = np.maximum(np.searchsorted(self._times, tau + eps, side='right') - 1, 0)
             out = np.empty((len(t),) + self.shape)
+            tau = np.maximum(tau, 0.0)
             for i, piece in enumerate(self._pieces):
                 mask = idx == i
                 if np.any(mask):
-                    out[mask] = piece._eval(t[mask])
+                    # a callable piece sees the time within the period
+                    out[mask] = piece._eval(tau[mask])
             return out
         op, operands = self._combine
         return op(*[o._eval(t) for o in operands])

@@ -6,10 +6,10 @@ lines of the training set (all lines but every `holdout`-th) and scored on
 * the held-out lines: ``e_val = ‖Ĝ - G‖ / ‖G‖`` over the harmonics
   ``|n| <= K_max`` of the data (a K-harmonic model predicts them all),
 * an information criterion on the training lines, ``AIC = M_r log(SSE/M_r)
-  + 2 d`` with ``M_r`` real residuals and ``d = (2K+1) n_p m + (4K+1) p n_p +
+  + 2 d`` with ``M_r`` real residuals and ``d = (2H+1) n_p m + (4K+1) p n_p +
   (2K+1) p m`` free parameters (B, C, D harmonics for m inputs and p
-  outputs; A is fixed by the similarity up to its ``n_p`` exponents, which
-  are added).
+  outputs, H = K or K + 1 the harmonics of the refitted B; A is fixed by the
+  similarity up to its ``n_p`` exponents, which are added).
 
 The singular values of the subspace step at the largest candidate order
 show the lifted order ``(2K+1) n_p`` as a gap.  A plant whose A(t) is
@@ -219,7 +219,8 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
             val[i, j] = np.linalg.norm(err[..., held]) / np.linalg.norm(Gc[..., held])
             sse = np.sum(np.abs(err[..., ~held]) ** 2)
             mr = 2 * err[..., ~held].size
-            d = (2 * K + 1) * n * nu + (4 * K + 1) * ny * n + (2 * K + 1) * ny * nu + n
+            Hb = max(K, model.B.nharmonics or 0)                  # K or K + 1 (refit)
+            d = (2 * Hb + 1) * n * nu + (4 * K + 1) * ny * n + (2 * K + 1) * ny * nu + n
             aic[i, j] = mr * np.log(max(sse, np.finfo(float).tiny) / mr) + 2 * d
             bar.update(1)
     bar.close()

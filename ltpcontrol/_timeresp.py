@@ -12,11 +12,14 @@ A reference path (``method='solve_ivp'``) integrates with
 `scipy.integrate.solve_ivp` between switching instants.
 """
 
+import functools
 import warnings
 
 import numpy as np
 import control as ct
+from control.config import _process_kwargs
 from control.exception import ControlDimension
+from control.timeresp import _default_time_vector, _timeresp_aliases
 from scipy.integrate import solve_ivp
 
 from ._march import periodic_march
@@ -26,6 +29,17 @@ from ._validation import as_ltp, check_kwargs, check_positive, real_array
 __all__ = ['forced_response', 'step_response', 'initial_response', 'impulse_response']
 
 
+def _aliases(func):
+    """Accept python-control's keyword aliases (``T``, ``U``, ``X0``, ``return_x``,
+    ``input``, ``output``) as `control.forced_response` and its siblings do."""
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        _process_kwargs(kwargs, _timeresp_aliases)
+        return func(*args, **kwargs)
+    return wrapper
+
+
+@_aliases
 def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
                     method='transition', input_hold='foh', rtol=1e-12,
                     return_states=False, squeeze=None, transpose=False, **kwargs):
@@ -90,6 +104,7 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
         sysname=sys.name, plot_inputs=True)
 
 
+@_aliases
 def step_response(sys, timepts=None, initial_state=0.0, input_indices=None,
                   output_indices=None, *, method='transition', input_hold='foh',
                   rtol=1e-12, return_states=False, squeeze=None, transpose=False,
@@ -104,8 +119,11 @@ def step_response(sys, timepts=None, initial_state=0.0, input_indices=None,
     sys : LTPStateSpace
         System to simulate.
     timepts : array_like or float, optional
-        Time points; default five periods or the settling time of the
-        slowest Floquet exponent, whichever is longer.
+        Time points, or a final time.  Default: five periods or the
+        settling time of the slowest Floquet exponent, whichever is
+        longer; a final time gives 50 samples per period (one per step in
+        discrete time).  A system with constant matrices gets python-control's
+        default grids (`control.step_response`).
     initial_state : array_like or float
         Initial state.
     input_indices, output_indices : int or list of int, optional
@@ -129,7 +147,7 @@ def step_response(sys, timepts=None, initial_state=0.0, input_indices=None,
     """
     check_kwargs(kwargs, 'step_response')
     sys = as_ltp(sys, lti_hint='control.step_response')
-    t = _time_vector(sys, timepts)
+    t = _time_vector(sys, timepts, is_step=True)
     ins = _indices(input_indices, sys.ninputs, 'input_indices')
     outs = _indices(output_indices, sys.noutputs, 'output_indices')
     u = np.zeros((sys.ninputs, len(ins), len(t)))
@@ -141,6 +159,7 @@ def step_response(sys, timepts=None, initial_state=0.0, input_indices=None,
                            return_states, squeeze, transpose)
 
 
+@_aliases
 def initial_response(sys, timepts=None, initial_state=0.0, output_indices=None, *,
                      method='transition', input_hold='foh', rtol=1e-12,
                      return_states=False, squeeze=None, transpose=False, **kwargs):
@@ -174,21 +193,20 @@ def initial_response(sys, timepts=None, initial_state=0.0, output_indices=None, 
     """
     check_kwargs(kwargs, 'initial_response')
     sys = as_ltp(sys, lti_hint='control.initial_response')
-    t = _time_vector(sys, timepts)
+    t = _time_vector(sys, timepts, is_step=False)
     outs = _indices(output_indices, sys.noutputs, 'output_indices')
-    resp = forced_response(sys, t, np.zeros((sys.ninputs, len(t))), initial_state,
-                           return_states=return_states, squeeze=squeeze,
-                           transpose=transpose, method=method, input_hold=input_hold,
-                           rtol=rtol)
-    if len(outs) == sys.noutputs:
-        return resp
+    u = np.zeros((sys.ninputs, 1, len(t)))
+    x, y = _simulate(sys, t, u, _initial_state(sys, initial_state, 1), method, input_hold, rtol)
+    # as control.initial_response: no inputs, SISO when one output is selected
     return ct.TimeResponseData(
-        resp.t, resp.y[outs], resp.x, resp.u, issiso=len(outs) == 1 and sys.ninputs == 1,
-        output_labels=[sys.output_labels[i] for i in outs], input_labels=sys.input_labels,
-        state_labels=sys.state_labels, title=resp.title, transpose=transpose,
-        return_x=return_states, squeeze=squeeze, sysname=sys.name)
+        t, y[outs, 0], x[:, 0], None, issiso=sys.issiso() or output_indices is not None,
+        output_labels=[sys.output_labels[i] for i in outs], input_labels=None,
+        state_labels=sys.state_labels, title="Initial response for " + sys.name,
+        trace_types=['initial'], transpose=transpose, return_x=return_states,
+        squeeze=squeeze, sysname=sys.name)
 
 
+@_aliases
 def impulse_response(sys, timepts=None, input_indices=None, output_indices=None, *,
                      method='transition', input_hold='foh', rtol=1e-12,
                      return_states=False, squeeze=None, transpose=False, **kwargs):
@@ -225,7 +243,7 @@ def impulse_response(sys, timepts=None, input_indices=None, output_indices=None,
     """
     check_kwargs(kwargs, 'impulse_response')
     sys = as_ltp(sys, lti_hint='control.impulse_response')
-    t = _time_vector(sys, timepts)
+    t = _time_vector(sys, timepts, is_step=False)
     ins = _indices(input_indices, sys.ninputs, 'input_indices')
     outs = _indices(output_indices, sys.noutputs, 'output_indices')
     u = np.zeros((sys.ninputs, len(ins), len(t)))
@@ -345,7 +363,12 @@ def _outputs(sys, t, x, u):
 # Argument processing
 #
 
-def _time_vector(sys, timepts):
+def _time_vector(sys, timepts, is_step=None):
+    if is_step is not None and sys.is_lti and np.ndim(timepts) == 0:
+        # an LTI system written as periodic: python-control's default grid
+        if timepts is not None:
+            timepts = check_positive(float(real_array(timepts, 'timepts', ndim=0)), 'timepts')
+        return _default_time_vector(sys.to_ss(), tfinal=timepts, is_step=is_step)
     if timepts is None:
         timepts = _default_final_time(sys)
     t = real_array(timepts, 'timepts', ndim=(0, 1))
@@ -421,10 +444,12 @@ def _indices(spec, count, name):
 
 def _trace_response(sys, t, u, x, y, ins, outs, trace_type, title, return_states,
                     squeeze, transpose):
-    y = y[outs]
+    # as python-control: the inputs and outputs of the selected channels only
+    y, u = y[outs], u[ins]
     return ct.TimeResponseData(
         t, y, x, u, issiso=len(outs) == 1 and len(ins) == 1,
-        output_labels=[sys.output_labels[i] for i in outs], input_labels=sys.input_labels,
+        output_labels=[sys.output_labels[i] for i in outs],
+        input_labels=[sys.input_labels[i] for i in ins],
         state_labels=sys.state_labels, title=f"{title} for {sys.name}",
         transpose=transpose, return_x=return_states, squeeze=squeeze, multi_trace=True,
         trace_labels=[f"From {sys.input_labels[i]}" for i in ins],

@@ -176,9 +176,14 @@ def _public_callables():
     return out
 
 
+# abstract interfaces: calling them raises a pointer to their factories
+_ABSTRACT = {'HTF'}
+
+
 def test_kwarg_table_covers_every_var_keyword_callable():
     missing = [name for name, func in _public_callables()
-               if _accepts_var_keyword(func) and name not in KWARG_CALLS]
+               if _accepts_var_keyword(func) and name not in KWARG_CALLS
+               and name not in _ABSTRACT]
     assert not missing, f"add a minimal call to KWARG_CALLS for {missing}"
     stale = [name for name in KWARG_CALLS
              if name not in dict(_public_callables())]

@@ -163,7 +163,7 @@ def test_bad_inputs():
     with pytest.raises(ControlArgument, match="sys"):
         sample_system(ct.rss(2), 0.1)
     with pytest.raises(ValueError, match="method"):
-        sample_system(sys, 0.1, 'foh')
+        sample_system(sys, 0.1, 'gbt')
     with pytest.raises(TypeError, match="bogus"):
         sample_system(sys, 0.1, bogus=1)
     with pytest.raises(ValueError, match="prewarp_frequency"):

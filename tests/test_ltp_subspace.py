@@ -171,6 +171,21 @@ def test_tustin_route_has_sampling_bias(truth, frd, table42_inputs):
         assert value <= THESIS_NRMSE[key]
 
 
+def test_refit_harmonics_keep_thesis_result(truth, frd):
+    """B, C of one harmonic: the default refit keeps B(t) at K = 1 harmonic (the
+    BIC rejects K + 1), so the thesis result stands; B(t) of K + 1 harmonics
+    given explicitly no longer spoils the unseen HTF (C(t) stops at 2K;
+    measured 3.1e-7 and 3.4e-7, 1.6e-2 when C had K + H harmonics)."""
+    unseen = (np.arange(37) + 0.61) * 2 * (2 * np.pi / T) / 37
+    fixed = identify_ltp(frd, T, 2, 1, q=50, refit_harmonics=1)
+    model = identify_ltp(frd, T, 2, 1, q=50)
+    wide = identify_ltp(frd, T, 2, 1, q=50, refit_harmonics=2)
+    assert model.B.nharmonics == 1 and np.array_equal(model.A(0.0), fixed.A(0.0))
+    assert wide.B.nharmonics == 2 and wide.C.nharmonics == 2
+    for sys in (model, wide):
+        assert ltp.compare_ltp(sys, truth, unseen).htf_error < 1e-6
+
+
 def test_refit_given_a_keeps_a(frd):
     """refit_a=False refits B, C, D only (errata); the fit improves on 'log'."""
     fixed, i_fixed = identify_ltp(frd, T, 2, 1, q=50, refit_a=False, return_info=True)
