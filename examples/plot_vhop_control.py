@@ -50,10 +50,17 @@ saltation matrices included).
 With noise on the recorded input and output at SNR 12.5 the identified
 multipliers stay right (within 0.005) but the model misses its data by
 about 16 % (the noise), and the same design on it only moves the closed
-loop's multiplier from 0.848 to about 0.66 on the hybrid plant; with other
-noise draws it can even destabilise the loop.  These weights are aggressive
-(Bryson's 1 mm against 3 N); a design for noisy models needs robustness
-margins that LQG does not give.
+loop's multiplier from 0.848 to about 0.66 on the hybrid plant.  Other
+noise draws do no better: 0.66 and 0.78, and a draw whose identified model
+is unstable; four times longer records (the noise on the lifted response
+halved) give 1.03, 1.07 and again an unstable model, and a
+stability-constrained refinement only replaces the unstable model (0.84).
+The harmonics n >= 4 of the noisy
+model's response are wrong by 37-124 % (they lie below the noise), and
+these Bryson weights (1 mm against 3 N) make the design depend on them:
+even on noise-free data, models of 3 or 4 harmonics, or the same data
+refined from another start, give multipliers between 0.18 and 1.6.  A
+design for noisy models needs robustness margins that LQG does not give.
 
 Set ``LTP_EXAMPLES_QUICK=1`` for a shorter push simulation (the records
 are the same: shorter ones identify a model whose design is much worse).

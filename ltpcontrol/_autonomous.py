@@ -57,7 +57,7 @@ def _section(hp, section, direction, mode, anchor, u0, params):
     if direction not in (1, -1):
         raise ValueError(f"direction must be 1 or -1, got {direction!r}")
     if section is None:
-        normal = hp._f(mode, 0.0, anchor, u0, params)
+        normal = hp.dynamics(0.0, anchor, u0, params, mode=mode)
         if not np.linalg.norm(normal) > 0:
             raise ValueError("x0 is an equilibrium of the plant (f(x0) = 0): it lies on no "
                              "periodic orbit and defines no section; start elsewhere")
@@ -93,7 +93,7 @@ class _Problem:
                      variational=variational, **(options or self.opts))
 
     def f(self, mode, x):
-        return self.hp._f(mode, 0.0, x, self.u0, self.params)
+        return self.hp.dynamics(0.0, x, self.u0, self.params, mode=mode)
 
     def first_crossing(self, x, mode, section, max_time, chunk=None, skip=0.0):
         """Time of the first crossing of `section` after `skip`, or None before `max_time`.

@@ -26,6 +26,7 @@ samples, with the Jacobian composed alike.
 """
 
 import numbers
+import warnings
 from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Optional
@@ -36,7 +37,7 @@ from control.exception import ControlArgument, ControlDimension
 from tqdm.auto import tqdm
 
 from ._hybrid import (HybridMode, HybridPlant, central_jacobian, Flow, input_function,
-                      solver_settings)
+                      IntegrationError, solver_settings)
 from ._ltpsys import LTPStateSpace
 from ._orbits import PeriodicOrbit, as_hybrid, check_orbit_of, periodic_orbit
 from ._validation import check_positive_int, real_array, steps_per_period
@@ -73,7 +74,7 @@ class _Loop:
     def _check_algebraic_loop(self):
         # y is evaluated at u0: exact unless both h and the controller pass u through
         t, x = 0.0, self.orbit.x0
-        dh_du = central_jacobian(lambda u: self.plant._h(t, x, u, self.params), self.u0)
+        dh_du = central_jacobian(lambda u: self.plant.output(t, x, u, self.params), self.u0)
         dk_de = central_jacobian(lambda e: self.ctrl_out(t, np.zeros(self.nc), e),
                                   np.zeros(self.p))
         if np.any(dh_du != 0) and np.any(dk_de != 0):
@@ -109,7 +110,7 @@ class _Loop:
         return self._ybar(t)
 
     def error(self, t, x, v):
-        return self.plant._h(t, x, self.u0, self.params) + v - self.ybar(t)
+        return self.plant.output(t, x, self.u0, self.params) + v - self.ybar(t)
 
     def actuate(self, w):
         return np.clip(self.u0 + w, self.lower, self.upper)
@@ -130,7 +131,7 @@ def _output_interpolant(plant, orbit, tol=1e-11):
     breaks = np.concatenate([[0.0], orbit.switching_times, [T]])
 
     def ybar_exact(t):
-        return np.column_stack([plant._h(tk, x, u0, params)
+        return np.column_stack([plant.output(tk, x, u0, params)
                                 for tk, x in zip(t, orbit(t).T)])
 
     pieces = []
@@ -220,34 +221,37 @@ def _loop_plant(loop):
 
         def updfcn(t, z, v, p):
             e, u = signals(t, z, v)
-            return np.concatenate([plant._f(i, t, z[:n], u, params), loop.ctrl_rhs(t, z[n:], e)])
+            return np.concatenate([plant.dynamics(t, z[:n], u, params, mode=i),
+                                   loop.ctrl_rhs(t, z[n:], e)])
 
         def jacobian(t, z, v, p):
             # chain rule through e = h(x) + v − ȳ and u = sat(u0 + C_c x_c + D_c e)
             e, u = signals(t, z, v)
             Ac, Bc, Cc, Dc = loop.matrices(t)
-            H = central_jacobian(lambda x: plant._h(t, x, loop.u0, params), z[:n])
+            H = central_jacobian(lambda x: plant.output(t, x, loop.u0, params), z[:n])
             active = ((u > loop.lower) & (u < loop.upper))[:, None]
             du_dz = active * np.hstack([Dc @ H, Cc])
-            top = np.hstack([plant._dfdx(i, t, z[:n], u, params), np.zeros((n, loop.nc))])
-            top += plant._dfdu(i, t, z[:n], u, params) @ du_dz
+            top = np.hstack([plant.state_jacobian(t, z[:n], u, params, mode=i),
+                             np.zeros((n, loop.nc))])
+            top += plant.input_jacobian(t, z[:n], u, params, mode=i) @ du_dz
             return np.vstack([top, np.hstack([Bc @ H, Ac])])
 
         guard = reset = None
         if src.guard is not None:
             def guard(t, z, v, p):
-                return plant._g(i, t, z[:n], signals(t, z, v)[1], params)
+                return plant.guard(t, z[:n], signals(t, z, v)[1], params, mode=i)
 
             def reset(t, z, v, p):
-                return np.concatenate([plant._r(i, t, z[:n], signals(t, z, v)[1], params),
+                return np.concatenate([plant.reset(t, z[:n], signals(t, z, v)[1], params, mode=i),
                                        z[n:]])
         return HybridMode(updfcn, guard=guard, reset=reset, name=plant.mode_names[i],
-                          target=plant._targets[i], jacobian=jacobian if loop.linear else None)
+                          target=plant.mode_targets[i], jacobian=jacobian if loop.linear else None)
 
-    return HybridPlant([mode(i) for i in range(len(plant.modes))],
-                       lambda t, z, v, p: np.concatenate([plant._h(t, z[:n], signals(t, z, v)[1],
-                                                                   params),
-                                                          signals(t, z, v)[1]]),
+    def output(t, z, v, p):
+        u = signals(t, z, v)[1]
+        return np.concatenate([plant.output(t, z[:n], u, params), u])
+
+    return HybridPlant([mode(i) for i in range(len(plant.modes))], output,
                        states=plant.state_labels + ctrl.state_labels,
                        inputs=[f'v[{k}]' for k in range(loop.p)],
                        outputs=plant.output_labels + plant.input_labels,
@@ -267,19 +271,21 @@ def _held_plant(loop):
         guard = reset = None
         if src.guard is not None:
             def guard(t, z, _, p):
-                return plant._g(i, t, z[:n], z[n:], params)
+                return plant.guard(t, z[:n], z[n:], params, mode=i)
 
             def reset(t, z, _, p):
-                return np.concatenate([plant._r(i, t, z[:n], z[n:], params), z[n:]])
+                return np.concatenate([plant.reset(t, z[:n], z[n:], params, mode=i), z[n:]])
 
         def jacobian(t, z, _, p):
             J = np.zeros((n + loop.m, n + loop.m))
-            J[:n, :n] = plant._dfdx(i, t, z[:n], z[n:], params)
-            J[:n, n:] = plant._dfdu(i, t, z[:n], z[n:], params)
+            J[:n, :n] = plant.state_jacobian(t, z[:n], z[n:], params, mode=i)
+            J[:n, n:] = plant.input_jacobian(t, z[:n], z[n:], params, mode=i)
             return J
-        return HybridMode(lambda t, z, _, p: np.concatenate([plant._f(i, t, z[:n], z[n:], params),
-                                                             np.zeros(loop.m)]),
-                          guard=guard, reset=reset, target=plant._targets[i],
+        def updfcn(t, z, _, p):
+            return np.concatenate([plant.dynamics(t, z[:n], z[n:], params, mode=i),
+                                   np.zeros(loop.m)])
+        return HybridMode(updfcn,
+                          guard=guard, reset=reset, target=plant.mode_targets[i],
                           name=plant.mode_names[i], jacobian=jacobian)
 
     return HybridPlant([mode(i) for i in range(len(plant.modes))],
@@ -367,6 +373,12 @@ class ClosedLoopOrbit:
         discrete controller.
     residual : float
         Relative fixed-point residual of the period map.
+    converged : bool
+        True when the orbit search converged.  False when it diverged
+        because the loop is unstable: the other fields then describe the
+        period map at the starting point (see `closed_loop_orbit`).
+    message : str
+        Outcome of the orbit search.
 
     Examples
     --------
@@ -389,19 +401,29 @@ class ClosedLoopOrbit:
     is_stable: bool
     orbit: Optional[PeriodicOrbit]
     residual: float
+    converged: bool = True
+    message: str = "the closed-loop orbit converged"
 
     def __repr__(self):
+        diverged = "" if self.converged else ", diverges"
         return (f"<ClosedLoopOrbit period={self.period:g}, dominant |multiplier|="
-                f"{self.dominant_multiplier:.4g}, stable={self.is_stable}>")
+                f"{self.dominant_multiplier:.4g}, stable={self.is_stable}{diverged}>")
 
 
-def _result(period, z0, n, mode0, monodromy, orbit, residual):
-    """`ClosedLoopOrbit` with the multipliers sorted by decreasing magnitude."""
+def _multipliers(monodromy):
+    """Eigenvalues by decreasing magnitude (all infinite if the matrix overflowed)."""
+    if not np.all(np.isfinite(monodromy)):
+        return np.full(len(monodromy), np.inf + 0j)
     mult = np.linalg.eigvals(monodromy)
-    mult = mult[np.argsort(-np.abs(mult), kind='stable')]
+    return mult[np.argsort(-np.abs(mult), kind='stable')]
+
+
+def _result(period, z0, n, mode0, monodromy, orbit, residual, **outcome):
+    """`ClosedLoopOrbit` with the multipliers sorted by decreasing magnitude."""
+    mult = _multipliers(monodromy)
     dominant = float(np.abs(mult[0]))
     return ClosedLoopOrbit(period, np.array(z0[:n]), np.array(z0[n:]), mode0, monodromy, mult,
-                           dominant, bool(dominant < 1), orbit, residual)
+                           dominant, bool(dominant < 1), orbit, residual, **outcome)
 
 
 def _initial(loop, initial_state, controller_state, mode0, t0):
@@ -424,8 +446,8 @@ def _initial(loop, initial_state, controller_state, mode0, t0):
 
 def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
                          controller_state=0.0, *, mode0=None, noise=None, saturation=None,
-                         progress=False, rtol=1e-10, atol=1e-12, method='DOP853',
-                         max_events=10000):
+                         progress=False, max_deviation=1e3, rtol=1e-10, atol=1e-12,
+                         method='DOP853', max_events=10000):
     """Simulate a hybrid plant with a controller in the loop.
 
     The controller sees the measured output deviation ``e = y + v − ȳ(t)``
@@ -463,6 +485,11 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
         Bounds of the plant input ``u`` (scalars or one per input).
     progress : bool, optional
         Show a progress bar over the periods simulated (default False).
+    max_deviation : float, optional
+        Divergence bound (default 1e3): the simulation stops when the plant
+        state exceeds ``max_deviation · (1 + max_t ‖x̄(t)‖∞)`` in the
+        infinity norm (checked at every sample of a discrete controller and
+        every period boundary of a continuous one).
     rtol, atol, method, max_events : optional
         Integration settings, as in `simulate_hybrid` (defaults 1e-10,
         1e-12, 'DOP853', 10000).
@@ -473,7 +500,17 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
         ``outputs`` are the plant outputs (without noise), ``states`` the
         plant states followed by the controller states, ``inputs`` the plant
         inputs ``u`` after saturation.  Extra attributes: ``modes``,
-        ``event_times``, ``noise`` (v on `timepts`).
+        ``event_times``, ``noise`` (v on `timepts`) and ``diverged_at``:
+        None, or the time at which a diverging loop was stopped (see
+        Warns); outputs, states and inputs are NaN and modes -1 after it.
+
+    Warns
+    -----
+    UserWarning
+        When the loop diverges: the state exceeds the `max_deviation`
+        bound or can no longer be integrated (it overflows, or the events
+        exceed `max_events`).  The simulation then stops, so that a
+        destabilising controller costs a bounded run time.
 
     Examples
     --------
@@ -503,15 +540,24 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
     # the noise has one entry per plant output
     vfun = input_function(SimpleNamespace(ninputs=loop.p), 0.0 if noise is None else noise,
                            timepts)
+    if isinstance(max_deviation, bool) or not isinstance(max_deviation, numbers.Real) \
+            or not max_deviation > 0:
+        raise ValueError(f"max_deviation must be a positive number, got {max_deviation!r}")
+    bound = max_deviation * (1 + np.max(np.abs(orbit.states)))
     bar = _progress(progress, timepts)
-    if loop.dt:
-        states, modes, events, u = _run_sampled(loop, opts, timepts, z0, mode, vfun, bar)
-    else:
-        states, modes, events, u = _run_continuous(loop, opts, timepts, z0, mode, vfun, bar)
+    run = _run_sampled if loop.dt else _run_continuous
+    rec = _Record(loop, timepts)
+    try:
+        run(loop, opts, rec, z0, mode, vfun, bar, bound)
+    except (IntegrationError, _Diverged) as err:
+        rec.stop(err)
+        warnings.warn(f"closed_loop_response: the closed loop diverges: {err}; the response "
+                      f"is NaN after t={rec.diverged_at:.6g}", UserWarning, stacklevel=2)
     bar.close()
-    n = loop.n
+    n, states, modes, events, u = loop.n, rec.states, rec.modes, rec.events, rec.inputs
     v = np.array([vfun(t) for t in timepts]).reshape(len(timepts), loop.p).T
-    y = np.column_stack([plant._h(t, states[:n, k], loop.u0, loop.params)
+    y = np.column_stack([plant.output(t, states[:n, k], loop.u0, loop.params)
+                         if modes[k] >= 0 else np.full(loop.p, np.nan)
                          for k, t in enumerate(timepts)])
     resp = ct.TimeResponseData(
         timepts, y, states, u, issiso=loop.m == 1 and loop.p == 1,
@@ -520,7 +566,38 @@ def closed_loop_response(plant, controller, orbit, timepts, initial_state=None,
         sysname=f'{plant.name}+{loop.ctrl.name}', return_x=True, plot_inputs=True,
         title=f"Closed-loop response of {plant.name} with {loop.ctrl.name}")
     resp.modes, resp.event_times, resp.noise = modes, np.array(events), v
+    resp.diverged_at = rec.diverged_at
     return resp
+
+
+class _Diverged(Exception):
+    """The loop's state left the divergence bound."""
+
+
+class _Record:
+    """States, modes, inputs and events of a closed-loop run on `timepts`.
+
+    Filled up to the time reached; `stop` marks the rest NaN (mode -1).
+    """
+
+    def __init__(self, loop, timepts):
+        self.timepts, self.reached, self.diverged_at, self.events = timepts, timepts[0], None, []
+        self.states = np.full((loop.n + loop.nc, timepts.size), np.nan)
+        self.inputs = np.full((loop.m, timepts.size), np.nan)
+        self.modes = np.full(timepts.size, -1)
+
+    def stop(self, err):
+        self.diverged_at = float(getattr(err, 'time', self.reached))
+        after = self.timepts >= self.reached
+        self.states[:, after], self.inputs[:, after], self.modes[after] = np.nan, np.nan, -1
+
+
+def _check_bound(x, t, bound):
+    if not np.max(np.abs(x)) <= bound:
+        err = _Diverged(f"the plant state reaches {np.max(np.abs(x)):.3g} at t={t:.6g}, beyond "
+                        f"max_deviation's bound {bound:.3g}")
+        err.time = t
+        raise err
 
 
 def _progress(progress, timepts):
@@ -537,17 +614,14 @@ def _chunks(timepts, T):
     return np.concatenate([[timepts[0]], inner[inner > timepts[0]], [timepts[-1]]])
 
 
-def _run_sampled(loop, opts, timepts, z, mode, vfun, bar):
+def _run_sampled(loop, opts, rec, z, mode, vfun, bar, bound):
+    timepts = rec.timepts
     k0 = timepts[0] / loop.dt
     if abs(k0 - round(k0)) > 1e-9 * max(1.0, abs(k0)):
         raise ValueError(f"timepts[0]={timepts[0]:g} is not a sampling instant of the "
                          f"discrete controller (dt={loop.dt:g})")
     sampled = _Sampled(loop, opts)
-    n = loop.n
-    states = np.empty((n + loop.nc, timepts.size))
-    u = np.empty((loop.m, timepts.size))
-    modes = np.empty(timepts.size, int)
-    events = []
+    n, states, u, modes = loop.n, rec.states, rec.inputs, rec.modes
     k, t = int(round(k0)), timepts[0]
     while t < timepts[-1]:
         t1 = min((k + 1) * loop.dt, timepts[-1])
@@ -556,31 +630,32 @@ def _run_sampled(loop, opts, timepts, z, mode, vfun, bar):
         xs, modes[inside] = flow.evaluate(timepts[inside])
         # x_c[k] and u[k] hold on [k dt, (k+1) dt)
         states[:n, inside], states[n:, inside], u[:, inside] = xs[:n], z[n:, None], held[:, None]
-        events += [e[0] for e in flow.events]
+        rec.events += [e[0] for e in flow.events]
         bar.update(t1 - t)
         z, mode, t, k = z1, mode1, t1, k + 1
+        rec.reached = t
+        _check_bound(z[:n], t, bound)
     states[:, -1], modes[-1] = z, mode
     u[:, -1] = sampled.sample(k, z, vfun(k * loop.dt))[n + loop.nc:]
-    return states, modes, events, u
 
 
-def _run_continuous(loop, opts, timepts, z, mode, vfun, bar):
-    lp = _loop_plant(loop)
-    states = np.empty((loop.n + loop.nc, timepts.size))
-    modes = np.empty(timepts.size, int)
-    events = []
+def _run_continuous(loop, opts, rec, z, mode, vfun, bar, bound):
+    lp, timepts = _loop_plant(loop), rec.timepts
     edges = _chunks(timepts, loop.T)
     for a, b in zip(edges[:-1], edges[1:]):
         flow = Flow(lp, a, b, z, mode, vfun, loop.params, **opts)
         inside = (timepts >= a) & (timepts < b)
-        states[:, inside], modes[inside] = flow.evaluate(timepts[inside])
-        events += [e[0] for e in flow.events]
+        rec.states[:, inside], rec.modes[inside] = flow.evaluate(timepts[inside])
+        rec.inputs[:, inside] = np.reshape(
+            [lp.output(t, rec.states[:, j], vfun(t), loop.params)[loop.p:]
+             for j, t in zip(np.flatnonzero(inside), timepts[inside])], (-1, loop.m)).T
+        rec.events += [e[0] for e in flow.events]
         z, mode = flow.x_final, flow.mode_final
         bar.update(b - a)
-    states[:, -1], modes[-1] = z, mode
-    u = np.column_stack([lp._h(t, states[:, j], vfun(t), loop.params)[loop.p:]
-                         for j, t in enumerate(timepts)])
-    return states, modes, events, u
+        rec.reached = b
+        _check_bound(z[:loop.n], b, bound)
+    rec.states[:, -1], rec.modes[-1] = z, mode
+    rec.inputs[:, -1] = lp.output(timepts[-1], z, vfun(timepts[-1]), loop.params)[loop.p:]
 
 
 def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_state=None,
@@ -618,12 +693,27 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
     -------
     ClosedLoopOrbit
         With ``is_stable`` False when the controller destabilises the loop.
+        When Newton's method does not converge from the starting point and
+        the period map's Jacobian there has a multiplier of magnitude 1 or
+        more, the loop diverges from its orbit and no search can converge
+        (forward simulation only finds attracting orbits): the result then
+        has ``converged=False``, ``is_stable=False``, the multipliers of
+        that Jacobian (infinite if it overflows) and a `message`, and a
+        warning is issued.  For a linear controller with an inactive
+        saturation the starting point is the closed-loop orbit itself, so
+        these multipliers are the loop's.
 
     Raises
     ------
     RuntimeError
-        If no closed-loop orbit is found (for example, the loop diverges
-        from a destabilising nonlinear controller's guess).
+        If no closed-loop orbit is found although the loop linearised at
+        the starting point is stable (for example, a nonlinear controller
+        whose orbit lies far from the guess).
+
+    Warns
+    -----
+    UserWarning
+        When the loop diverges (``converged=False``, see Returns).
 
     Examples
     --------
@@ -642,35 +732,107 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
     loop = _Loop(plant, controller, orbit, saturation)
     z0, mode0 = _initial(loop, orbit.x0, 0.0 if controller_state is None else controller_state,
                          orbit.mode0, 0.0)
-    if not loop.dt:
-        cl = periodic_orbit(_loop_plant(loop), loop.T, z0, mode0, tol=tol, max_iter=max_iter,
-                            max_periods=max_periods, **opts)
-        return _result(loop.T, cl.x0, loop.n, cl.mode0, cl.monodromy, cl, cl.residual)
-    return _sampled_orbit(_Sampled(loop, opts), z0, mode0, tol, max_iter, max_periods)
+    if loop.dt:
+        sampled = _Sampled(loop, opts)
+        start = _at_start(lambda: sampled.period_map(z0, mode0, jacobian=True), z0)
+
+        def search(iterations, periods):
+            return _sampled_orbit(sampled, z0, mode0, tol, iterations, periods, first=start)
+    else:
+        lp = _loop_plant(loop)
+        start = _at_start(lambda: _flow_map(lp, loop, z0, mode0, opts), z0)
+
+        def search(iterations, periods):
+            cl = periodic_orbit(lp, loop.T, z0, mode0, tol=tol, max_iter=iterations,
+                                max_periods=periods, **opts)
+            return _result(loop.T, cl.x0, loop.n, cl.mode0, cl.monodromy, cl, cl.residual)
+    mult = _multipliers(start[2])
+    if np.abs(mult[0]) < 1:
+        return search(max_iter, max_periods)
+    # unstable at the start: forward simulation runs away from the orbit, and
+    # Newton converges within a few steps or not at all (not at all when one
+    # period moves the state by more than its size)
+    why = start[4] or f"one period moves the state by {start[3]:.3g} relative"
+    if start[3] < 1:
+        try:
+            return search(min(max_iter, _UNSTABLE_NEWTON), 0)
+        except RuntimeError as err:
+            why = str(err)
+    message = (f"the closed loop diverges: the period map at the starting point (the plant "
+               f"orbit, controller state {'zero' if not np.any(z0[loop.n:]) else 'given'}) has "
+               f"the multiplier |mu| = {np.abs(mult[0]):.4g} >= 1, so no orbit search "
+               f"converges; the multipliers are those of the loop linearised there "
+               f"(orbit search: {why})")
+    warnings.warn(f"closed_loop_orbit: {message}", UserWarning, stacklevel=2)
+    return _result(loop.T, z0, loop.n, mode0, start[2], None, start[3], converged=False,
+                   message=message)
 
 
-def _sampled_orbit(sampled, z, mode, tol, max_iter, max_periods):
-    """Newton's method on the sampled-data period map, with simulation fallback."""
+#: Newton iterations from a starting point where the loop is unstable.
+_UNSTABLE_NEWTON = 5
+
+
+def _flow_map(lp, loop, z0, mode0, opts):
+    """Period map, final mode and Jacobian of the continuous loop from ``z0``."""
+    flow = Flow(lp, 0.0, loop.T, z0, mode0, lambda t: np.zeros(loop.p), loop.params,
+                variational=True, **opts)
+    return flow.x_final, flow.mode_final, flow.phi
+
+
+def _at_start(period_map, z0):
+    """``(z_T, mode_T, Jacobian, residual, failure)`` of the period map at the start.
+
+    A loop that cannot be integrated over one period gets an infinite
+    Jacobian and the integrator's message.
+    """
+    try:
+        zT, modeT, J = period_map()
+    except IntegrationError as err:
+        return None, None, np.full((len(z0), len(z0)), np.inf), np.inf, str(err)
+    return zT, modeT, J, float(np.max(np.abs(zT - z0)) / (1 + np.max(np.abs(z0)))), ''
+
+
+def _sampled_orbit(sampled, z, mode, tol, max_iter, max_periods, first=None):
+    """Newton's method on the sampled-data period map, with simulation fallback.
+
+    `first` is the `_at_start` evaluation at `z` (reused by the first iteration).
+    """
     if not isinstance(tol, numbers.Real) or not 0 < tol < 1:
         raise ValueError(f"tol must be a number in (0, 1), got {tol!r}")
     max_iter = check_positive_int(max_iter, 'max_iter')
     max_periods = check_positive_int(max_periods, 'max_periods', minimum=0)
-    loop, periods = sampled.loop, 0
+    loop, periods, why = sampled.loop, 0, "no convergence"
     while True:
         for _ in range(max_iter + 1):
-            zT, modeT, J = sampled.period_map(z, mode, jacobian=True)
+            if first is not None:
+                (zT, modeT, J, _, why), first = first, None
+                if zT is None:
+                    break
+            else:
+                try:
+                    zT, modeT, J = sampled.period_map(z, mode, jacobian=True)
+                except IntegrationError as err:
+                    why = str(err)
+                    break
             res = np.max(np.abs(zT - z)) / (1 + np.max(np.abs(z)))
             if modeT == mode and res <= tol:
                 return _result(loop.T, z, loop.n, mode, J, None, res)
-            if modeT != mode or not np.all(np.isfinite(zT)):
+            if modeT != mode or not (np.all(np.isfinite(zT)) and np.all(np.isfinite(J))):
+                why = "the period changes mode or the state is no longer finite"
                 break
             step = np.linalg.lstsq(J - np.eye(len(z)), z - zT, rcond=None)[0]
             if np.max(np.abs(step)) > 10 * (1 + np.max(np.abs(z))):
+                why = f"Newton step of size {np.max(np.abs(step)):.3g} rejected (divergence)"
                 break
             z = z + step
         if periods >= max_periods:
             raise RuntimeError(f"closed_loop_orbit: no T-periodic orbit of the sampled-data "
-                               f"loop found (tol={tol:g}) after {periods} simulated periods")
-        for _ in range(min(10, max_periods - periods)):
-            z, mode, _ = sampled.period_map(z, mode)
-            periods += 1
+                               f"loop found (tol={tol:g}) after {periods} simulated periods "
+                               f"({why})")
+        try:
+            for _ in range(min(10, max_periods - periods)):
+                z, mode, _ = sampled.period_map(z, mode)
+                periods += 1
+        except IntegrationError as err:
+            raise RuntimeError(f"closed_loop_orbit: the simulated sampled-data loop "
+                               f"diverges after {periods} periods: {err}") from err

@@ -116,6 +116,16 @@ class HybridPlant:
     state_labels, input_labels, output_labels : list of str
     params : dict
     name : str
+    mode_targets : list of int or None
+        Index of the mode entered when each mode's guard fires (None for a
+        mode without a guard).
+
+    Notes
+    -----
+    The methods ``dynamics``, ``guard``, ``reset``, ``output``,
+    ``state_jacobian`` and ``input_jacobian`` evaluate the charts with validated shapes, as
+    python-control's ``sys.dynamics(t, x, u, params)`` and
+    ``sys.output(t, x, u, params)`` do; the mode is the keyword ``mode``.
 
     Examples
     --------
@@ -166,8 +176,8 @@ class HybridPlant:
         if len(set(self.mode_names)) != len(self.mode_names):
             raise ValueError(f"mode names must be unique, got {self.mode_names}")
         self.modes = modes
-        self._targets = [None if m.target is None else self.mode_index(m.target, 'target')
-                         for m in modes]
+        self.mode_targets = [None if m.target is None else self.mode_index(m.target, 'target')
+                             for m in modes]
 
     def __repr__(self):
         return (f"<HybridPlant {self.name!r}: {self.nstates} states, {self.ninputs} inputs, "
@@ -193,19 +203,57 @@ class HybridPlant:
         return int(mode)
 
     #
-    # Evaluation helpers (all take resolved parameter dicts)
+    # Evaluation of the charts: the interface of the integrator, the orbit
+    # solvers and the closed loops.  `params` is the complete parameter dict
+    # (default: the plant's own); `mode` an index or a name.
     #
 
-    def _f(self, i, t, x, u, params):
-        dx = np.asarray(self.modes[i].updfcn(t, x, u, params), float).reshape(-1)
+    def _mode(self, mode):
+        return mode if type(mode) is int else self.mode_index(mode)
+
+    def dynamics(self, t, x, u, params=None, *, mode=0):
+        """Vector field ``f_i(t, x, u, params)`` of one mode, as a float vector.
+
+        Parameters
+        ----------
+        t : float
+            Time.
+        x, u : array_like
+            State and input.
+        params : dict, optional
+            The complete parameters (default: the plant's `params`).
+        mode : int or str, optional
+            The mode i (default 0).
+
+        Returns
+        -------
+        ndarray, shape (nstates,)
+
+        Examples
+        --------
+        >>> air = ltp.HybridMode(lambda t, x, u, p: [x[1], -p['g']], name='air')
+        >>> ball = ltp.HybridPlant([air], states=2, params={'g': 9.81})
+        >>> ball.dynamics(0.0, [1.0, 2.0], [], mode='air')
+        array([ 2.  , -9.81])
+        """
+        i = self._mode(mode)
+        dx = np.asarray(self.modes[i].updfcn(t, x, u, self.params if params is None else params),
+                        float).reshape(-1)
         if dx.size != self.nstates:
             raise ControlDimension(f"updfcn of mode {self.mode_names[i]!r} returned "
                                    f"{dx.size} values, expected {self.nstates}")
         return dx
 
-    def _g(self, i, t, x, u, params):
-        value = self.modes[i].guard(t, x, u, params)
+    def guard(self, t, x, u, params=None, *, mode=0):
+        """Guard value ``g_i(t, x, u, params)`` of a mode with a guard (a finite float).
+
+        The mode is left when it crosses zero from positive to negative.
+        """
+        i = self._mode(mode)
         where = f"guard of mode {self.mode_names[i]!r}"
+        if self.modes[i].guard is None:
+            raise ValueError(f"mode {self.mode_names[i]!r} has no guard")
+        value = self.modes[i].guard(t, x, u, self.params if params is None else params)
         try:
             arr = np.asarray(value, float) if value is not None else None
         except (TypeError, ValueError):
@@ -220,34 +268,53 @@ class HybridPlant:
             raise ValueError(f"{where} returned {value} at t={t:.6g}")
         return value
 
-    def _r(self, i, t, x, u, params):
+    def reset(self, t, x, u, params=None, *, mode=0):
+        """State ``x⁺ = r_i(t, x, u, params)`` after leaving a mode (x without a reset map)."""
+        i = self._mode(mode)
         if self.modes[i].reset is None:
             return np.array(x, float)
-        xp = np.asarray(self.modes[i].reset(t, x, u, params), float).reshape(-1)
+        xp = np.asarray(self.modes[i].reset(t, x, u, self.params if params is None else params),
+                        float).reshape(-1)
         if xp.size != self.nstates:
             raise ControlDimension(f"reset of mode {self.mode_names[i]!r} returned "
                                    f"{xp.size} values, expected {self.nstates}")
         return xp
 
-    def _h(self, t, x, u, params):
+    def output(self, t, x, u, params=None):
+        """Output ``y = h(t, x, u, params)`` (the state without an output function).
+
+        Examples
+        --------
+        >>> m = ltp.HybridMode(lambda t, x, u, p: -x)
+        >>> ltp.HybridPlant([m], lambda t, x, u, p: [2 * x[0]], states=1,
+        ...                 outputs=1).output(0.0, [1.5], [])
+        array([3.])
+        """
         if self.outfcn is None:
             return np.array(x, float)
-        y = np.asarray(self.outfcn(t, x, u, params), float).reshape(-1)
+        y = np.asarray(self.outfcn(t, x, u, self.params if params is None else params),
+                       float).reshape(-1)
         if y.size != self.noutputs:
             raise ControlDimension(f"outfcn returned {y.size} values, expected {self.noutputs}")
         return y
 
-    def _dfdx(self, i, t, x, u, params):
+    def state_jacobian(self, t, x, u, params=None, *, mode=0):
+        """``∂f_i/∂x``: the mode's `jacobian` or central differences."""
+        i = self._mode(mode)
+        params = self.params if params is None else params
         jac = self.modes[i].jacobian
         if jac is not None:
             return _matrix(jac(t, x, u, params), (self.nstates, self.nstates), 'jacobian')
-        return central_jacobian(lambda z: self._f(i, t, z, u, params), x)
+        return central_jacobian(lambda z: self.dynamics(t, z, u, params, mode=i), x)
 
-    def _dfdu(self, i, t, x, u, params):
+    def input_jacobian(self, t, x, u, params=None, *, mode=0):
+        """``∂f_i/∂u``: the mode's `input_jacobian` or central differences."""
+        i = self._mode(mode)
+        params = self.params if params is None else params
         jac = self.modes[i].input_jacobian
         if jac is not None:
             return _matrix(jac(t, x, u, params), (self.nstates, self.ninputs), 'input_jacobian')
-        return central_jacobian(lambda v: self._f(i, t, x, v, params), u)
+        return central_jacobian(lambda v: self.dynamics(t, x, v, params, mode=i), u)
 
 
 def _labels(spec, name, prefix, allow_zero=False):
@@ -365,15 +432,15 @@ def saltation_matrix(plant, mode, t, x, u=None, params=None):
 
 
 def _saltation(plant, i, t, x, u, params, ufun):
-    j = plant._targets[i]
-    xp = plant._r(i, t, x, u, params)
-    f_minus = plant._f(i, t, x, u, params)
-    f_plus = plant._f(j, t, xp, u, params)
+    j = plant.mode_targets[i]
+    xp = plant.reset(t, x, u, params, mode=i)
+    f_minus = plant.dynamics(t, x, u, params, mode=i)
+    f_plus = plant.dynamics(t, xp, u, params, mode=j)
     # gradient of the guard in x and t (t-dependence includes the input signal)
-    dg_dx = central_jacobian(lambda z: plant._g(i, t, z, u, params), x)[0]
-    dg_dt = float(_derivative(lambda s: plant._g(i, s, x, ufun(s), params), t))
-    dr_dx = central_jacobian(lambda z: plant._r(i, t, z, u, params), x)
-    dr_dt = _derivative(lambda s: plant._r(i, s, x, ufun(s), params), t)
+    dg_dx = central_jacobian(lambda z: plant.guard(t, z, u, params, mode=i), x)[0]
+    dg_dt = float(_derivative(lambda s: plant.guard(s, x, ufun(s), params, mode=i), t))
+    dr_dx = central_jacobian(lambda z: plant.reset(t, z, u, params, mode=i), x)
+    dr_dt = _derivative(lambda s: plant.reset(s, x, ufun(s), params, mode=i), t)
     rate = dg_dx @ f_minus + dg_dt
     scale = np.linalg.norm(dg_dx) * np.linalg.norm(f_minus) + abs(dg_dt)
     if rate == 0:
@@ -429,6 +496,12 @@ def input_function(plant, inputs, timepts):
     return lambda t: np.array([np.interp(t, timepts, row) for row in arr])
 
 
+class IntegrationError(RuntimeError):
+    """The hybrid integrator could not continue: solver failure, a state that
+    is no longer finite, or more events than allowed (a diverging or Zeno
+    trajectory)."""
+
+
 class Flow:
     """One integration of a hybrid plant over ``[t0, tf]`` with event handling.
 
@@ -444,18 +517,21 @@ class Flow:
         t, x, i = t0, np.array(x0, float), mode
         phi = np.eye(n)
         while True:
+            if not (np.all(np.isfinite(x)) and np.all(np.isfinite(phi))):
+                raise IntegrationError(f"the state is no longer finite at t={t:.6g} "
+                                       f"(mode {plant.mode_names[i]!r}): the trajectory diverges")
             rhs, z0 = self._system(plant, i, ufun, params, x, phi, variational)
             events = None
             if plant.modes[i].guard is not None:
                 def event(s, z, i=i):
-                    return plant._g(i, s, z[:n], ufun(s), params)
+                    return plant.guard(s, z[:n], ufun(s), params, mode=i)
                 event.terminal, event.direction = True, -1
                 events = [event]
             sol = solve_ivp(rhs, (t, tf), z0, method=method, rtol=rtol, atol=atol,
                             events=events, dense_output=True)
             if sol.status == -1:
-                raise RuntimeError(f"integration failed in mode {plant.mode_names[i]!r} "
-                                   f"at t={sol.t[-1]:.6g}: {sol.message}")
+                raise IntegrationError(f"integration failed in mode {plant.mode_names[i]!r} "
+                                       f"at t={sol.t[-1]:.6g}: {sol.message}")
             t_end, z_end = sol.t[-1], sol.y[:, -1]
             self.segments.append((t, t_end, i, sol.sol))
             x = z_end[:n]
@@ -465,17 +541,17 @@ class Flow:
                 break
             # transition: x⁺ = r(t, x⁻), Φ⁺ = S Φ⁻
             u = ufun(t_end)
-            j = plant._targets[i]
+            j = plant.mode_targets[i]
             if variational:
                 S = _saltation(plant, i, t_end, x, u, params, ufun)
                 self.saltations.append(S)
                 phi = S @ phi
-            x_plus = plant._r(i, t_end, x, u, params)
+            x_plus = plant.reset(t_end, x, u, params, mode=i)
             self.events.append((t_end, i, j, x.copy(), x_plus.copy()))
             x, i, t = x_plus, j, t_end
             if len(self.events) > max_events:
-                raise RuntimeError(f"more than max_events={max_events} events before "
-                                   f"t={t:.6g} (Zeno or chattering behaviour?)")
+                raise IntegrationError(f"more than max_events={max_events} events before "
+                                       f"t={t:.6g} (Zeno or chattering behaviour?)")
         self.x_final, self.mode_final, self.phi = x, i, phi
         self.nstates = n
 
@@ -483,12 +559,12 @@ class Flow:
     def _system(plant, i, ufun, params, x, phi, variational):
         n = plant.nstates
         if not variational:
-            return (lambda s, z: plant._f(i, s, z, ufun(s), params)), x
+            return (lambda s, z: plant.dynamics(s, z, ufun(s), params, mode=i)), x
 
         def rhs(s, z):
             u = ufun(s)
-            A = plant._dfdx(i, s, z[:n], u, params)
-            return np.concatenate([plant._f(i, s, z[:n], u, params),
+            A = plant.state_jacobian(s, z[:n], u, params, mode=i)
+            return np.concatenate([plant.dynamics(s, z[:n], u, params, mode=i),
                                    (A @ z[n:].reshape(n, n)).ravel()])
         return rhs, np.concatenate([x, phi.ravel()])
 
@@ -597,7 +673,7 @@ def simulate_hybrid(plant, timepts, initial_state, mode0=0, inputs=0.0, params=N
     states, modes = flow.evaluate(timepts)
     states[:, -1], modes[-1] = flow.x_final, flow.mode_final
     u = np.array([ufun(t) for t in timepts]).reshape(len(timepts), plant.ninputs).T
-    y = np.column_stack([plant._h(t, states[:, k], u[:, k], params)
+    y = np.column_stack([plant.output(t, states[:, k], u[:, k], params)
                          for k, t in enumerate(timepts)])
     resp = TimeResponseData(
         timepts, y, states, u if plant.ninputs else None,

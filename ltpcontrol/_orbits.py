@@ -19,7 +19,7 @@ from control import NonlinearIOSystem
 from control.exception import ControlArgument, ControlDimension
 
 from ._hybrid import (HybridMode, HybridPlant, central_jacobian, constant_input,
-                      Flow, plant_params, solver_settings)
+                      Flow, IntegrationError, plant_params, solver_settings)
 from ._ltpsys import ltpss
 from ._periodic_matrix import PeriodicMatrix
 from ._validation import check_period, check_positive_int, real_array
@@ -188,9 +188,9 @@ def time_mismatch(plant, x0, u0, params, pairs):
     """
     bumps = np.linspace(-1.0, 1.0, plant.nstates) * 0.1 * (1 + np.abs(x0))
     for i, mode in enumerate(plant.modes):
-        checks = [('updfcn', lambda t, x: plant._f(i, t, x, u0, params))]
+        checks = [('updfcn', lambda t, x: plant.dynamics(t, x, u0, params, mode=i))]
         if mode.guard is not None:
-            checks.append(('guard', lambda t, x: plant._g(i, t, x, u0, params)))
+            checks.append(('guard', lambda t, x: plant.guard(t, x, u0, params, mode=i)))
         for label, func in checks:
             for ta, tb in pairs:
                 for x in (x0, x0 + bumps):
@@ -377,7 +377,11 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
             break
         # fall back to forward simulation towards an attracting orbit
         nper = min(10, warmup + max_periods - periods)
-        sim_x, sim_mode, res = shooter.simulate(sim_x, sim_mode, nper)
+        try:
+            sim_x, sim_mode, res = shooter.simulate(sim_x, sim_mode, nper)
+        except IntegrationError as err:
+            tried.append(f"forward simulation from t={periods}T: {err}")
+            break
         x, mode, periods = sim_x, sim_mode, periods + nper
         tried.append(f"forward simulation to t={periods}T: residual {res:.3g}")
     raise RuntimeError("periodic_orbit did not converge to a T-periodic orbit "
@@ -429,7 +433,11 @@ class _PeriodShooter:
         names, n = self.hp.mode_names, self.hp.nstates
         last, stalled = np.inf, 0
         for it in range(max_iter + 1):
-            fl = self.flow(x, mode, True)
+            try:
+                fl = self.flow(x, mode, True)
+            except IntegrationError as err:
+                tried.append(f"{where}: {err}")
+                return None
             if fl.mode_final != mode:
                 tried.append(f"{where}: the period ends in mode {names[fl.mode_final]!r}, "
                              f"not {names[mode]!r}")
@@ -549,11 +557,11 @@ def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, na
     params, u0, T = orbit.params, orbit.u0, orbit.period
 
     def h_of(t, x, u):
-        return hp._h(t, x, u, params)
+        return hp.output(t, x, u, params)
 
     derivatives = {
-        'A': lambda i, t, x: hp._dfdx(i, t, x, u0, params),
-        'B': lambda i, t, x: hp._dfdu(i, t, x, u0, params),
+        'A': lambda i, t, x: hp.state_jacobian(t, x, u0, params, mode=i),
+        'B': lambda i, t, x: hp.input_jacobian(t, x, u0, params, mode=i),
         'C': lambda i, t, x: central_jacobian(lambda z: h_of(t, z, u0), x),
         'D': lambda i, t, x: central_jacobian(lambda v: h_of(t, x, v), u0),
     }

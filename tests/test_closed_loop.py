@@ -225,6 +225,64 @@ class TestReturnMap:
         assert np.abs(resp.states[0, -1] - orbit.x0[0]) > 0.02
 
 
+class TestDivergence:
+    """A destabilising controller: the return map reports it, the simulation stops."""
+
+    @pytest.fixture(scope='class')
+    def smooth(self):
+        sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t) + u, None, states=1, inputs=1)
+        return sys, ltp.periodic_orbit(sys, 2 * np.pi, [0.0])
+
+    def test_sampled_loop_diverges(self, smooth):
+        sys, orbit = smooth
+        dt = np.pi / 8
+        K = ct.ss([], [], [], [[-50.0]], dt=dt)
+        with pytest.warns(UserWarning, match="closed loop diverges"):
+            cl = ltp.closed_loop_orbit(sys, K, orbit)
+        # zero-order hold: x[k+1] - x̄ = (e^{-dt} - 50 (1 - e^{-dt})) (x[k] - x̄), 16 samples
+        a = np.exp(-dt)
+        assert not cl.converged and not cl.is_stable
+        assert cl.dominant_multiplier == pytest.approx(abs(a - 50 * (1 - a)) ** 16, rel=1e-6)
+        assert 'diverges' in repr(cl) and '|mu|' in cl.message
+
+    def test_continuous_loop_diverges(self, smooth):
+        sys, orbit = smooth
+        with pytest.warns(UserWarning, match="closed loop diverges"):
+            cl = ltp.closed_loop_orbit(sys, ct.ss([], [], [], [[10.0]]), orbit)
+        assert not cl.converged and not cl.is_stable
+        assert cl.dominant_multiplier == pytest.approx(np.exp(9 * 2 * np.pi), rel=1e-6)
+
+    def test_converged_unstable_loop_is_not_a_divergence(self, smooth):
+        sys, orbit = smooth
+        cl = ltp.closed_loop_orbit(sys, ct.ss([], [], [], [[1.5]]), orbit)
+        assert cl.converged and not cl.is_stable
+        assert cl.dominant_multiplier == pytest.approx(np.exp(np.pi), rel=1e-8)
+
+    @pytest.mark.parametrize('dt', [0.0, np.pi / 8])
+    def test_response_stops(self, smooth, dt):
+        sys, orbit = smooth
+        K = ct.ss([], [], [], [[10.0 if dt == 0 else -50.0]], dt=dt)
+        t = np.linspace(0, 40 * np.pi, 161)
+        with pytest.warns(UserWarning, match="closed loop diverges"):
+            resp = ltp.closed_loop_response(sys, K, orbit, t, orbit.x0 + 0.01)
+        stop = resp.diverged_at
+        assert stop is not None and stop < 2 * np.pi + 1e-9
+        assert np.all(np.isnan(resp.states[:, t >= stop])) and np.all(resp.modes[t >= stop] == -1)
+        assert np.all(np.isfinite(resp.states[:, t < stop]))
+        if dt:      # the bound is checked at every sample (every period when continuous)
+            assert np.all(np.abs(resp.states[:, t < stop])
+                          <= 1e3 * (1 + np.abs(orbit.states).max()))
+
+    def test_stable_response_does_not_stop(self, smooth):
+        sys, orbit = smooth
+        resp = ltp.closed_loop_response(sys, ct.ss([], [], [], [[-1.0]]), orbit,
+                                        np.linspace(0, 4, 9), orbit.x0 + 0.01)
+        assert resp.diverged_at is None and np.all(np.isfinite(resp.states))
+        with pytest.raises(ValueError, match="max_deviation"):
+            ltp.closed_loop_response(sys, ct.ss([], [], [], [[-1.0]]), orbit, [0, 1],
+                                     max_deviation=0)
+
+
 class TestBadInput:
     def test_period_mismatch(self, plant, orbit):
         K = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, 0.7)

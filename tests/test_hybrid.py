@@ -138,6 +138,34 @@ class TestDescription:
         assert plant.input_labels == ['u[0]', 'u[1]'] and plant.mode_names == ['mode[0]']
         assert 'p' in repr(plant)
 
+    def test_chart_evaluation(self):
+        # the public evaluation methods against the mode functions themselves
+        plant, x, u = two_mode_switch(), np.array([0.3, -0.2]), np.array([0.4])
+        for i, name in enumerate(plant.mode_names):
+            mode = plant.modes[i]
+            np.testing.assert_array_equal(plant.dynamics(0.7, x, u, mode=name),
+                                          mode.updfcn(0.7, x, u, {}))
+            assert plant.guard(0.7, x, u, mode=i) == mode.guard(0.7, x, u, {})
+            np.testing.assert_array_equal(plant.reset(0.7, x, u, mode=i), x)
+            # central differences against the exact Jacobians of the affine fields
+            A = plant.state_jacobian(0.7, x, u, mode=i)
+            np.testing.assert_allclose(A @ [1.0, 2.0], plant.dynamics(0.7, x + [1.0, 2.0], u,
+                                                                      mode=i)
+                                       - plant.dynamics(0.7, x, u, mode=i), atol=1e-8)
+            np.testing.assert_allclose(plant.input_jacobian(0.7, x, u, mode=i), [[0.0], [1.0]],
+                                       atol=1e-8)
+        assert plant.mode_targets == [1, 0]
+        np.testing.assert_array_equal(plant.output(0.0, x, u), x)
+        b = ball(0.5)
+        np.testing.assert_array_equal(b.reset(0.0, [0.0, -2.0], []), [0.0, 1.0])
+        with pytest.raises(ValueError, match="no guard"):
+            HybridPlant([HybridMode(lambda t, x, u, p: -x)], states=1).guard(0.0, [1.0], [])
+        with pytest.raises(ValueError, match="not one of the modes"):
+            plant.dynamics(0.0, x, u, mode='sideways')
+        with pytest.raises(ControlDimension, match="outfcn"):
+            HybridPlant([HybridMode(lambda t, x, u, p: -x)], lambda t, x, u, p: [1.0, 2.0],
+                        states=1, outputs=1).output(0.0, [1.0], [])
+
     def test_wrong_vector_field_size(self):
         plant = HybridPlant([HybridMode(lambda t, x, u, p: [0.0])], states=2)
         with pytest.raises(ControlDimension, match="updfcn"):
