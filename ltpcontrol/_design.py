@@ -16,10 +16,11 @@ reversal keeps the Floquet multipliers (``Φ̃(T, 0) = Φ(T, 0)ᵀ``).
 """
 
 import numpy as np
+from control import LTI, common_timebase
 from control.exception import ControlArgument, ControlDimension
 
 from ._floquet import lti_representatives
-from ._ltpsys import LTPStateSpace
+from ._ltpsys import LTPStateSpace, series
 from ._periodic_matrix import PeriodicMatrix, as_periodic
 from ._riccati import _check_weights, care, dare
 from ._validation import as_ltp, check_method, real_array
@@ -247,7 +248,7 @@ def dlqe(sys, QN, RN, NN=None, *, method=None):
     return _held(L, sys), _held(P, sys), E
 
 
-def lqg(sys, Q, R, QN, RN, name=None):
+def lqg(sys, Q, R, QN, RN, name=None, *, input_filter=None):
     """Periodic LQG output-feedback controller as an `LTPStateSpace`.
 
     Combines the LQR gain ``K`` of ``(Q, R)`` (`lqr`/`dlqr`) with the
@@ -260,6 +261,15 @@ def lqg(sys, Q, R, QN, RN, name=None):
     closed loop is ``feedback(sys, ctrl, sign=1)``; its Floquet exponents
     are those of ``A - BK`` and ``A - LC`` together (separation principle).
 
+    With an `input_filter` F the design is frequency weighted: the LQG
+    above is designed for ``series(F, sys)`` (state ``[x_F; x]``), with Q
+    on the plant state ``x``, R on the filter input ``v`` and the process
+    noise entering at ``v``, and the controller is that LQG followed by F,
+    ``series(lqg, F)``.  Its command ``u = F v`` then holds only F's
+    frequencies; a low-pass F at the top of the band where a model was
+    identified keeps the controller from acting where the data did not
+    check the model.
+
     Parameters
     ----------
     sys : LTPStateSpace
@@ -270,11 +280,15 @@ def lqg(sys, Q, R, QN, RN, name=None):
         Process (on the inputs of `sys`) and sensor noise intensities.
     name : str, optional
         Name of the controller.
+    input_filter : LTPStateSpace, control.StateSpace or TransferFunction, optional
+        Filter F with as many inputs and outputs as `sys` has inputs and the
+        time base of `sys` (an LTI filter takes its period).
 
     Returns
     -------
     LTPStateSpace
-        Controller with inputs y and outputs u.
+        Controller with inputs y and outputs u; with `input_filter`, states
+        ``[x̂_F; x̂; x_F]`` (the estimated and the implemented filter state).
 
     Examples
     --------
@@ -284,14 +298,54 @@ def lqg(sys, Q, R, QN, RN, name=None):
     >>> loop = ltp.feedback(sys, ctrl, sign=1)
     >>> loop.nstates, ltp.is_stable(loop)
     (4, True)
+
+    The same design with the command low-passed at 0.5 rad/s:
+
+    >>> F = ct.tf([0.5], [1.0, 0.5])
+    >>> ctrl = ltp.lqg(sys, np.eye(2), [[1.0]], [[1.0]], [[0.1]], input_filter=F)
+    >>> ctrl.nstates, ltp.is_stable(ltp.feedback(sys, ctrl, sign=1))
+    (4, True)
     """
     sys = as_ltp(sys)
+    if input_filter is not None:
+        return _filtered_lqg(sys, Q, R, QN, RN, input_filter, name)
     K, _, _ = lqr(sys, Q, R)
     L, _, _ = lqe(sys, QN, RN)
     A = sys.A - sys.B @ K - L @ sys.C + L @ sys.D @ K
     return LTPStateSpace(A, L, -K, np.zeros((sys.ninputs, sys.noutputs)), sys.period,
                          dt=sys.dt, name=name, inputs=sys.output_labels,
                          outputs=sys.input_labels)
+
+
+def _filtered_lqg(sys, Q, R, QN, RN, F, name):
+    """LQG of ``series(F, sys)`` with Q padded to ``diag(0, Q)``, followed by F."""
+    if not isinstance(F, (LTPStateSpace, LTI)):
+        raise ControlArgument("input_filter must be an LTPStateSpace, StateSpace or "
+                              f"TransferFunction, got {type(F).__name__}")
+    if F.ninputs != sys.ninputs or F.noutputs != sys.ninputs:
+        raise ControlDimension(f"input_filter must have {sys.ninputs} inputs and outputs "
+                               f"(the inputs of sys), got {F.ninputs} and {F.noutputs}")
+    try:
+        common_timebase(F.dt, sys.dt)
+    except ValueError:
+        raise ValueError(f"input_filter has the time base dt={F.dt}, sys has "
+                         f"dt={sys.dt}") from None
+    aug = series(F, sys)
+    n = sys.nstates
+    nf = aug.nstates - n
+    if sys.isdtime(strict=True):
+        Qs = _steps(Q, sys, 'Q')
+        Qp = _held(Qs, sys) if len(Qs) > 1 else PeriodicMatrix.constant(Qs[0], sys.period)
+    else:
+        Qp = as_periodic(Q, sys.period, 'Q')
+    if Qp.shape != (n, n):
+        raise ControlDimension(f"Q must have shape {(n, n)} (the states of sys), "
+                               f"got {Qp.shape}")
+    Qa = PeriodicMatrix.block([[np.zeros((nf, nf)), np.zeros((nf, n))],
+                               [np.zeros((n, nf)), Qp]])
+    ctrl = series(lqg(aug, Qa, R, QN, RN), F)
+    return LTPStateSpace(ctrl.A, ctrl.B, ctrl.C, ctrl.D, sys.period, dt=sys.dt, name=name,
+                         inputs=sys.output_labels, outputs=sys.input_labels)
 
 
 #
