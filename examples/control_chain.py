@@ -5,15 +5,18 @@
    white measurement noise on input and output at a given SNR (thesis
    §3.7.5: ``SNR = (A_signal / A_noise)²`` with RMS amplitudes).
 2. `output_lqg`: periodic LQG on a discrete LTP model, weighting the
-   output: ``Σ y² + r u²``, process noise on the input, sensor noise ``rn``.
+   output: ``Σ y² + r u²``, process noise on the input, sensor noise ``rn``;
+   `band_limited_lqg`: the same kept inside the band the data excited.
 3. `push_recovery`: response to a velocity push, open and closed loop, and
    the strides taken to return within 1 % of the orbit.
 4. `record_experiments`: records of multi-experiment designs (one row per
    experiment, e.g. multisines in several bands), each started on the orbit.
 """
 
+import control as ct
 import numpy as np
 from joblib import Parallel, delayed
+from scipy.signal import butter
 
 import ltpcontrol as ltp
 
@@ -58,6 +61,23 @@ def output_lqg(model, r, rn, qn=1.0):
     C = model.C.sample(model.nsteps)
     Q = np.einsum('kij,kil->kjl', C, C)
     return ltp.lqg(model, Q, [[r]], [[qn]], [[rn]], name='lqg')
+
+
+def band_limited_lqg(model, dt, band_top, r, rn, order=4, qn=1.0):
+    """`output_lqg` of `model` sampled at `dt`, acting only inside ``[0, band_top]`` Hz.
+
+    The command passes a Butterworth low-pass of `order` with its cutoff at
+    `band_top` (``ltpcontrol.lqg(..., input_filter=F)``, Tustin-sampled),
+    and the cost weighs the output through the harmonics ``n`` of ``C(t)``
+    inside the band (``n ≤ band_top·T``).
+    """
+    period = model.period
+    dsys = ltp.sample_system(model, dt)
+    C = ltp.PeriodicMatrix(model.C.fourier(int(band_top * period)), period).sample(dsys.nsteps)
+    b, a = butter(order, 2 * np.pi * band_top, analog=True)
+    F = ct.sample_system(ct.ss(ct.tf(b, a)), dt, method='tustin')
+    return ltp.lqg(dsys, np.einsum('kij,kil->kjl', C, C), [[r]], [[qn]], [[rn]],
+                   input_filter=F, name='lqg')
 
 
 def strides_to_recover(resp, orbit, t_push, nstrides, tol=0.01):
