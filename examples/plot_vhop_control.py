@@ -44,9 +44,9 @@ saltation matrices included).
    through the harmonics ``n`` of ``C(t)`` inside the band (``n f_p`` ≤
    5.96 Hz: n ≤ 1).  Above the band the data do not check the model.
    The weights follow from these physical scales and the excitation band;
-   the filter order was compared on the models (first and second order
-   leave the noisy-data designs at 0.32-0.85 on the hybrid plant, orders
-   5-8 do worse than 4 against the noise-free model).
+   the filter order was compared with the cost on all of C(t): first and
+   second order leave the noisy-data designs at 0.32-1.0 on the hybrid
+   plant, orders 5-8 do worse than 4 against the noise-free model.
    Phase: the controller runs on the plant's clock, its step ``k`` acts
    on ``[k dt, (k+1) dt)`` of the limit cycle, whose ``t = 0`` is the
    phase of the pumping force (the data's ``t = 0``).
