@@ -47,6 +47,7 @@ from ._lmi import lmi_statefbk, LMIDesign
 from ._reduction import hsvd, balred, minreal
 from ._refine import refine_ltp, RefineInfo
 from ._montecarlo import monte_carlo, MonteCarloResult
+from ._scenarios import sample_models
 
 __version__ = "0.1.0"
 
@@ -88,6 +89,7 @@ __all__ = [
     'lmi_statefbk', 'LMIDesign', 'hsvd', 'balred', 'minreal',
     # noisy data and Monte-Carlo studies
     'refine_ltp', 'RefineInfo', 'monte_carlo', 'MonteCarloResult',
+    'sample_models',
 ]
 
 # python-control's entry points dispatch LTP systems to ltpcontrol (see _interop)

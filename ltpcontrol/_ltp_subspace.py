@@ -36,7 +36,7 @@ from ._lifted_response import lifted_frequency_response
 from ._ltpsys import LTPStateSpace
 from ._periodic_matrix import PeriodicMatrix
 from ._realization import FloquetRealization, floquet_realization
-from ._refine import _harmonics, refine_ltp
+from ._refine import RefineInfo, _harmonics, refine_ltp
 from ._validation import check_kwargs, check_period, check_positive_int, steps_per_period
 
 __all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
@@ -82,6 +82,9 @@ class LTPSubspaceInfo:
     realized_harmonics : int
         Harmonics of the realized lifted model: K, or fewer when the
         K-harmonic model had no eigenvalue ladders.
+    refinement : RefineInfo or None
+        With ``refine='ml'``: the `RefineInfo` of the refinement
+        (parameters, covariance, ``realize``; e.g. for `sample_models`).
 
     Examples
     --------
@@ -99,6 +102,7 @@ class LTPSubspaceInfo:
     conversion: str
     relative_residual: float
     realized_harmonics: int
+    refinement: RefineInfo = None
 
 
 def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
@@ -356,7 +360,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     return sysc, LTPSubspaceInfo(
         success=success, message=message, nfev=nfev, data=G, lifted=lifted, subspace=sinfo,
         realization=real, conversion=conversion, relative_residual=relres,
-        realized_harmonics=Kr)
+        realized_harmonics=Kr, refinement=ml)
 
 
 def _lifted_data(data, period, K, progress, options):

@@ -36,7 +36,8 @@ LAYERS = {
     'identification': ['_excitation', '_htf_estimate', '_htf_fit', '_fdsubspace',
                        '_hybrid_ls', '_realization', '_floquet_fit', '_canonical',
                        '_structure', '_ltp_subspace', '_refine', '_montecarlo', '_arx',
-                       '_lifted_response'],
+                       '_lifted_response',
+                       '_scenarios'],
 }
 
 #: Method aliases: methods of a class that call a public function of a higher
