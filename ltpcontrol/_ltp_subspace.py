@@ -238,7 +238,9 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         the refit stops before converging.  With 'log' or 'tustin': if the
         realization does not find the Floquet structure or had to use
         fewer harmonics.  Lines of time records at multiples of ``ω_p/2``
-        are skipped with a warning.
+        are skipped with a warning.  If the returned model is unstable
+        (steady-state frequency data come from a stable plant; noise can
+        push a lightly damped fit across), with ``success=False``.
 
     Notes
     -----
@@ -355,6 +357,14 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
                    / np.linalg.norm(Gk))
     success, message = _quality(real, Kr, K, conversion, relres, converged, ml,
                                 realization_options)
+    if not sysc.is_stable():
+        # steady-state responses exist only for a stable plant: an unstable fit is doubtful
+        growth = float(np.max(np.linalg.eigvals(sysc.A(0.0)).real))
+        success, message = False, message + f"; unstable model (exponent {growth:.3g})"
+        warnings.warn(f"the identified model is unstable (largest real part of its Floquet "
+                      f"exponents {growth:.3g}), while steady-state frequency data come from "
+                      "a stable plant; with noisy data try refine='ml' with "
+                      "refine_options={'stable': True}", UserWarning, stacklevel=2)
     if not return_info:
         return sysc
     return sysc, LTPSubspaceInfo(

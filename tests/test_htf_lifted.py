@@ -88,3 +88,15 @@ def test_refine_info_realize_rebuilds_the_model():
     assert np.isclose(moved.A(0.0)[0, 0], model.A(0.0)[0, 0] + 0.1)
     with pytest.raises(ControlDimension, match="parameters"):
         info.realize(info.x[:-1])
+
+
+def test_identify_ltp_warns_for_an_unstable_model():
+    # the exact HTF of an unstable plant: identified exactly, flagged as doubtful
+    sys = ltp.ltpss([[0.5]], lambda t: np.array([[1 + 0.5 * np.cos(WP * t)]]),
+                    [[1.0]], 0, period=T)
+    with pytest.warns(UserWarning, match="no steady-state response"):
+        H = _htf_data(sys, 3)
+    with pytest.warns(UserWarning, match="identified model is unstable"):
+        model, info = ltp.identify_ltp(H, T, 1, 1, estimate_d=False, return_info=True)
+    assert np.allclose(model.A(0.0), [[0.5]], atol=1e-6)
+    assert not info.success and "unstable model" in info.message
