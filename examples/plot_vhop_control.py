@@ -72,8 +72,10 @@ noisy model (other noise draws 0.83, 2.5, 0.64).  Band-limited, the
 noise-free design gives 0.12 and the noisy one 0.29 (84 % of the reduction
 of LQG on the true linearization); the noise draws with seeds 3-8 and 10
 give 0.22, 0.26, 0.22, 0.26, 0.34, 0.23 and 0.24, besides two draws (seeds
-2 and 9) whose identified model is unstable, which no design on it
-repairs.  The band-limited rule on `ltpcontrol.linearize_orbit` gives 1.01:
+2 and 9) whose identified model is unstable (`ltpcontrol.identify_ltp`
+warns), which no design on it repairs; constrained to be stable
+(``refine_options={'stable': True}``) their models have real multipliers
+(0.27 and 0.21) and the design gives 0.83 and 0.79.  The band-limited rule on `ltpcontrol.linearize_orbit` gives 1.01:
 with the events frozen at their nominal times that model's response is
 wrong inside the band.
 
