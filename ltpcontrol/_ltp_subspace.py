@@ -240,7 +240,10 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         fewer harmonics.  Lines of time records at multiples of ``ω_p/2``
         are skipped with a warning.  If the returned model is unstable
         (steady-state frequency data come from a stable plant; noise can
-        push a lightly damped fit across), with ``success=False``.
+        push a lightly damped fit across), with ``success=False``: with
+        'refit', an unstable fit is first restarted from the other
+        realizations (harmonics K-1, K-2) and the stable fit of lowest
+        cost is returned if there is one.
 
     Notes
     -----
@@ -324,33 +327,31 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
                   outputs=[lab.rsplit('_', 1)[0] for lab in G.output_labels[:ny]])
     Gc = _harmonic_data(G.frdata, K, N, ny)
     # 2-4. subspace model, Floquet realization (fewer harmonics if better), continuous time
-    lifted, sinfo, real, Kr, sysc = _realize(
-        G, Gc, period, K, N, nstates, ny, q, estimate_d, realization, seed, progress,
-        realization_options, conversion, labels)
-    # 5. structured refinement: the Floquet-form model fitted to the harmonic data
-    nfev, converged = 0, True
-    if conversion == 'refit':
-        sysc, converged, nfev = _refit(sysc, Gc, G.omega, K, refit_harmonics, estimate_d,
-                                       refit_a, labels)
-        if estimate_d and input_hold is not None and not isinstance(
-                data, ct.FrequencyResponseData):
-            # the direct term sees the samples, not the held input: redo the
-            # hold correction with the fitted D(t) and refit once more
-            record_options['feedthrough'] = sysc.D
-            G = _lifted_data(data, period, K, False, record_options)
-            Gc = _harmonic_data(G.frdata, K, N, ny)
-            sysc, converged, more = _refit(sysc, Gc, G.omega, K, refit_harmonics, True,
-                                           refit_a, labels)
-            nfev += more
-        if not converged:
-            warnings.warn("the least-squares refit did not converge", UserWarning,
-                          stacklevel=2)
-    # 6. optional maximum-likelihood refinement weighted by the data's uncertainty
-    ml = None
-    if refine == 'ml':
-        sysc, ml = refine_ltp(sysc, data if isinstance(data, HTF) else G, return_info=True,
-                              **(refine_options or {}))
-        nfev += ml.nfev
+    candidates = _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, realization, seed,
+                          progress, realization_options, conversion, labels)
+    # 5-6. structured refit and optional maximum-likelihood refinement
+    fit = dict(data=data, period=period, G=G, Gc=Gc, K=K, N=N, ny=ny, conversion=conversion,
+               refit_harmonics=refit_harmonics, estimate_d=estimate_d, refit_a=refit_a,
+               labels=labels, input_hold=input_hold, record_options=record_options,
+               refine=refine, refine_options=refine_options)
+    chosen, (sysc, converged, nfev, ml, G, Gc) = 0, _fit_and_refine(candidates[0][-1], **fit)
+    if not sysc.is_stable() and len(candidates) > 1:
+        # steady-state data come from a stable plant: a local fit that left the
+        # stable models is restarted from the other realizations; keep the stable
+        # fit of lowest cost, if any
+        best = None
+        for i, cand in enumerate(candidates[1:], start=1):
+            trial = _fit_and_refine(cand[-1], **fit)
+            nfev += trial[2]
+            if trial[0].is_stable():
+                cost = _fit_cost(trial, K)
+                if best is None or cost < best[0]:
+                    best = (cost, i, trial)
+        if best is not None:
+            chosen, (sysc, converged, _, ml, G, Gc) = best[1], best[2]
+    lifted, sinfo, real, Kr, _ = candidates[chosen]
+    if conversion == 'refit' and not converged:
+        warnings.warn("the least-squares refit did not converge", UserWarning, stacklevel=2)
     Kc = K if conversion == 'refit' else min(K, Kr)
     Gk = Gc if Kc == K else _harmonic_data(G.frdata, Kc, N, ny)
     relres = float(np.linalg.norm(_harmonic_response(sysc, G.omega, Kc) - Gk)
@@ -371,6 +372,40 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         success=success, message=message, nfev=nfev, data=G, lifted=lifted, subspace=sinfo,
         realization=real, conversion=conversion, relative_residual=relres,
         realized_harmonics=Kr, refinement=ml)
+
+
+def _fit_and_refine(start, *, data, period, G, Gc, K, N, ny, conversion, refit_harmonics,
+                    estimate_d, refit_a, labels, input_hold, record_options, refine,
+                    refine_options):
+    """Steps 5-6 from the realization `start`: ``(model, converged, nfev, ml, G, Gc)``."""
+    sysc, nfev, converged = start, 0, True
+    if conversion == 'refit':
+        sysc, converged, nfev = _refit(sysc, Gc, G.omega, K, refit_harmonics, estimate_d,
+                                       refit_a, labels)
+        if estimate_d and input_hold is not None and not isinstance(
+                data, ct.FrequencyResponseData):
+            # the direct term sees the samples, not the held input: redo the
+            # hold correction with the fitted D(t) and refit once more
+            options = dict(record_options, feedthrough=sysc.D)
+            G = _lifted_data(data, period, K, False, options)
+            Gc = _harmonic_data(G.frdata, K, N, ny)
+            sysc, converged, more = _refit(sysc, Gc, G.omega, K, refit_harmonics, True,
+                                           refit_a, labels)
+            nfev += more
+    ml = None
+    if refine == 'ml':
+        sysc, ml = refine_ltp(sysc, data if isinstance(data, HTF) else G, return_info=True,
+                              **(refine_options or {}))
+        nfev += ml.nfev
+    return sysc, converged, nfev, ml, G, Gc
+
+
+def _fit_cost(fit, K):
+    """The cost a fit minimised: the ML cost, else the harmonic residual norm."""
+    sysc, _, _, ml, G, Gc = fit
+    if ml is not None:
+        return ml.cost
+    return float(np.linalg.norm(_harmonic_response(sysc, G.omega, K) - Gc))
 
 
 def _lifted_data(data, period, K, progress, options):
@@ -417,9 +452,10 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
     poor or missing.  For the refit, the realizations of the data of
     harmonics -k..k, k = K, K-1, K-2, are therefore all formed and the one
     whose continuous model fits the K-harmonic data best starts the refit.
-    Otherwise k = K, with k < K only when K has no realization.
+    Otherwise k = K, with k < K only when K has no realization.  Returns
+    the candidates ``(lifted, info, realization, k, model)``, best first.
     """
-    best = None
+    candidates = []
     for k in range(K, -1, -1):
         Gk = G if k == K else ct.frd(G.frdata[:(2 * k + 1) * ny], G.omega, G.dt)
         order = (2 * k + 1) * nstates
@@ -436,13 +472,12 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
         with np.errstate(all='ignore'):
             miss = np.linalg.norm(_harmonic_response(sysc, G.omega, K) - Gc)
         miss = miss if np.isfinite(miss) else np.inf
-        if best is None or miss < best[0]:
-            best = (miss, lifted, sinfo, real, k, sysc)
+        candidates.append((miss, lifted, sinfo, real, k, sysc))
         if conversion != 'refit' or k <= K - 2:
             break
-    if best is None:
+    if not candidates:
         raise ValueError(f"the Floquet realization failed: {real.message}")
-    return best[1:]
+    return [c[1:] for c in sorted(candidates, key=lambda c: c[0])]
 
 
 def _refit(sys, Gc, omega, K, harmonics, estimate_d, fit_a, labels):

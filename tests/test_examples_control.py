@@ -3,10 +3,13 @@
 import os
 import runpy
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+import ltpcontrol as ltp
 
 EXAMPLES = Path(__file__).resolve().parents[1] / 'examples'
 
@@ -35,9 +38,15 @@ def test_hopper_control_chain(tmp_path, monkeypatch, capsys):
     assert os.environ.get('LTP_EXAMPLES_QUICK') == '1'
 
 
+@pytest.fixture(scope='module')
+def vhop(tmp_path_factory):
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        return _quick_run('plot_vhop_control.py', tmp_path_factory.mktemp('vhop'), monkeypatch)
+
+
 @pytest.mark.slow
-def test_vhop_control_chain(tmp_path, monkeypatch):
-    example, out = _quick_run('plot_vhop_control.py', tmp_path, monkeypatch)
+def test_vhop_control_chain(vhop):
+    example, out = vhop
     # open loop: the exact return map of the hybrid limit cycle
     assert out['open'] == pytest.approx(0.848, abs=1e-3)
     # the model identified from data has the plant's open-loop multipliers
@@ -57,3 +66,22 @@ def test_vhop_control_chain(tmp_path, monkeypatch):
     assert out['strides closed'] is not None and out['strides open'] is not None
     assert out['strides closed'] < out['strides open']
     assert out['effort'] <= example['EFFORT_BOUND']
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize('seed', [2, 9])
+def test_vhop_noisy_draws_restart_to_a_stable_model(vhop, seed):
+    # these noise draws send the refinement from the best-fitting realization
+    # to an unstable model (multiplier 7e9 and 2e5); identify_ltp restarts from
+    # the other realizations and returns the stable model of the plant's multipliers
+    example, out = vhop
+    t, u, y = out['records']['data']
+    with warnings.catch_warnings():
+        warnings.simplefilter('error', UserWarning)
+        warnings.filterwarnings('ignore', message='.*misses the data')       # the noise
+        warnings.filterwarnings('ignore', message='.*Fisher information')
+        model, _ = example['identify']((t, *example['with_noise'](u, y, seed)),
+                                       out['records']['transient'], out['records']['lines'])
+    assert model.is_stable()
+    np.testing.assert_allclose(np.sort_complex(ltp.floquet_multipliers(model)),
+                               np.sort_complex(out['open multipliers']), atol=0.02)
