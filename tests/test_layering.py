@@ -31,7 +31,7 @@ LAYERS = {
     'analysis': ['_lyapunov', '_riccati', '_norms', '_zeros', '_design', '_place', '_lmi',
                  '_reduction', '_periodic_balancing', '_interconnect'],
     # rhythmic (hybrid) plants, their periodic orbits and closed loops
-    'orbits': ['_hybrid', '_orbits', '_autonomous', '_continuation', '_closed_loop'],
+    'orbits': ['_hybrid', '_orbits', '_autonomous', '_continuation', '_loop', '_closed_loop'],
     # experiments and identification from data
     'identification': ['_excitation', '_htf_estimate', '_htf_fit', '_fdsubspace',
                        '_hybrid_ls', '_realization', '_floquet_fit', '_canonical',
