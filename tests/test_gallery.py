@@ -10,11 +10,19 @@ import pytest
 EXAMPLES = Path(__file__).resolve().parents[1] / 'examples'
 
 
+def _slow(script, figure):
+    return pytest.param(script, figure, marks=pytest.mark.slow)
+
+
 @pytest.mark.parametrize("script, figure", [
     ('plot_mathieu_htf.py', 'mathieu_htf.png'),
     ('plot_hopper_htf.py', 'hopper_htf.png'),
     ('plot_switching_mathieu.py', 'switching_mathieu.png'),
     ('plot_analysis.py', 'analysis.png'),
+    _slow('plot_van_der_pol_orbit.py', 'van_der_pol_orbit.png'),
+    _slow('plot_clockfree_hopper.py', 'clockfree_hopper_branch.png'),
+    _slow('plot_slip_running.py', 'slip_running.png'),
+    _slow('plot_orbit_bifurcations.py', 'orbit_period_doubling.png'),
 ])
 def test_gallery_script_runs(script, figure, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
@@ -61,14 +69,3 @@ def test_mathieu_gallery_prediction_agrees():
     rel = [float(line.rsplit(' ', 1)[1]) for line in buf.getvalue().splitlines()
            if 'relative difference' in line]
     assert len(rel) == 3 and max(rel) < 1e-8
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("script, figure", [
-    ('plot_van_der_pol_orbit.py', 'van_der_pol_orbit.png'),
-    ('plot_clockfree_hopper.py', 'clockfree_hopper_branch.png'),
-    ('plot_slip_running.py', 'slip_running.png'),
-    ('plot_orbit_bifurcations.py', 'orbit_period_doubling.png'),
-])
-def test_orbit_gallery_script_runs(script, figure, tmp_path, monkeypatch, capsys):
-    test_gallery_script_runs(script, figure, tmp_path, monkeypatch, capsys)
