@@ -2,9 +2,9 @@ r"""Scenario models drawn from the parameter covariance of a refined model.
 
 The maximum-likelihood parameters θ̂ of `refine_ltp` (`RefineInfo.x`) are
 asymptotically Gaussian about the truth with the covariance ``Σ = F⁻¹``
-(`RefineInfo.cov`).  A scenario is the model at ``θ = θ̂ + Σ^{1/2} z`` with
-z standard normal and ``Σ^{1/2} = U diag(√w) Uᵀ`` from the eigenvalues
-``w >= 0`` of Σ; directions the pseudo-inverse covariance leaves at zero
+(`RefineInfo.cov`).  A scenario is the model at ``θ = θ̂ + L z`` with z
+standard normal and ``L = U diag(√w)`` (``L Lᵀ = Σ``) from the eigenvalues
+``w >= 0`` and eigenvectors U of Σ; directions the pseudo-inverse covariance leaves at zero
 variance stay at θ̂.  Scenarios carry the covariance through any nonlinear
 map of the model (closed-loop multipliers of a design, predictions) without
 linearising it.
@@ -56,8 +56,9 @@ def sample_models(info, n, *, seed=None):
 
     Notes
     -----
-    ``Σ^{1/2}`` is the symmetric square root from the eigen-decomposition
-    of Σ, so a singular (pseudo-inverse) covariance is accepted: the
+    The factor ``L = U diag(√w)`` with ``L Lᵀ = Σ`` comes from the
+    eigen-decomposition of Σ, so a singular (pseudo-inverse) covariance is
+    accepted: the
     parameters it does not determine keep their estimates.  With a zero
     covariance every scenario is the refined model.  The covariance is a
     local (Cramér-Rao) description: where the standard deviations are of
