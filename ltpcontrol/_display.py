@@ -17,7 +17,17 @@ MAX_TIMES = 6
 
 
 def describe(M, nsteps=None):
-    """One-line description of a PeriodicMatrix (never the full switching list)."""
+    """One-line description of a PeriodicMatrix (never the full switching list).
+
+    Examples
+    --------
+    >>> from ltpcontrol._display import describe
+    >>> describe(ltp.PeriodicMatrix.constant(np.eye(2), 1.0))
+    'constant'
+    >>> M = ltp.PeriodicMatrix(np.array([[[0.5]], [[1.0]], [[0.5]]]), 2 * np.pi)
+    >>> describe(M), describe(M, nsteps=8)
+    ('Fourier series, K = 1', 'sequence of 8 matrices per period')
+    """
     if M.is_constant:
         return "constant"
     if nsteps is not None:
@@ -34,7 +44,17 @@ def describe(M, nsteps=None):
 
 
 def text(sys):
-    """The ``print(sys)`` form."""
+    """The ``print(sys)`` form.
+
+    Examples
+    --------
+    >>> from ltpcontrol._display import text
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=2.0, name='P')
+    >>> text(sys) == str(sys)
+    True
+    >>> text(sys).splitlines()[0], text(sys).splitlines()[4]
+    ('<LTPStateSpace>: P', 'period = 2')
+    """
     lines = [f"<LTPStateSpace>: {sys.name}",
              f"Inputs ({sys.ninputs}): {sys.input_labels}",
              f"Outputs ({sys.noutputs}): {sys.output_labels}",
@@ -53,7 +73,18 @@ def text(sys):
 
 
 def html(sys):
-    """Notebook form: info line and LaTeX, or None when the system is too large."""
+    """Notebook form: info line and LaTeX, or None when the system is too large.
+
+    Examples
+    --------
+    >>> from ltpcontrol._display import html
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=2.0)
+    >>> html(sys) == sys._repr_html_(), 'T = 2' in html(sys)
+    (True, True)
+    >>> big = ltp.ltpss(-np.eye(20), np.ones((20, 1)), np.ones((1, 20)), 0, period=1.0)
+    >>> html(big) is None
+    True
+    """
     if sys.nstates + max(sys.noutputs, sys.ninputs) > ct.config.defaults['statesp.latex_maxsize']:
         return None
     if sys.isdtime():

@@ -178,6 +178,15 @@ def lti_representatives(values, A, *, period=None, nper=None):
     constant matrix, its eigenvalues are the natural representatives (those
     of python-control).  Each value is replaced by the eigenvalue equal to
     it modulo that ambiguity, in the order of `values`.
+
+    Examples
+    --------
+    Exponents known modulo ``2πj/T`` are mapped back onto the eigenvalues of A:
+
+    >>> from ltpcontrol._floquet import lti_representatives
+    >>> A = np.diag([-1.0, -3.0])
+    >>> lti_representatives([-3 + 2j * np.pi, -1 - 4j * np.pi], A, period=1.0).real
+    array([-3., -1.])
     """
     ev = list(np.linalg.eigvals(np.asarray(A, float)).astype(complex))
     if period is not None:
@@ -574,7 +583,17 @@ def _assemble(sys, grid, G, E, R):
 
 
 def chebyshev_nodes(degree):
-    """Chebyshev points ``(1 - cos(jπ/D))/2``, j = 0..D, on [0, 1]."""
+    """Chebyshev points ``(1 - cos(jπ/D))/2``, j = 0..D, on [0, 1].
+
+    Examples
+    --------
+    >>> from ltpcontrol._floquet import chebyshev_nodes
+    >>> chebyshev_nodes(2)
+    array([0. , 0.5, 1. ])
+    >>> c = chebyshev_nodes(5)
+    >>> bool(np.allclose(c + c[::-1], 1.0))          # symmetric about 1/2
+    True
+    """
     return 0.5 * (1 - np.cos(np.pi * np.arange(degree + 1) / degree))
 
 
@@ -584,6 +603,18 @@ def piecewise_chebyshev(grid, values):
     ``values[k, j]`` is the value at ``t_k + h_k c_j`` (`chebyshev_nodes`);
     evaluation (at times taken modulo ``grid[-1]``) is by the barycentric
     formula on the interval that contains t.
+
+    Examples
+    --------
+    Degree-3 nodes reproduce ``t³`` exactly on each interval, and t is taken
+    modulo the period ``grid[-1] = 3``:
+
+    >>> from ltpcontrol._floquet import chebyshev_nodes, piecewise_chebyshev
+    >>> grid = np.array([0.0, 1.0, 3.0])
+    >>> t = grid[:-1, None] + np.diff(grid)[:, None] * chebyshev_nodes(3)
+    >>> f = piecewise_chebyshev(grid, t ** 3)
+    >>> bool(np.allclose(f([0.4, 2.5, 3.4]), [0.4 ** 3, 2.5 ** 3, 0.4 ** 3]))
+    True
     """
     period, starts, h = grid[-1], grid[:-1], np.diff(grid)
     degree = values.shape[1] - 1

@@ -87,6 +87,18 @@ def build(sys, K, internal_harmonics, method, where, stacklevel=2):
     """The checked harmonic state space of `sys` with K harmonics.
 
     `stacklevel` is that of the user's call as seen from the caller of `build`.
+
+    Examples
+    --------
+    >>> from ltpcontrol._harmonic_ss import build
+    >>> sys = ltp.ltpss(ct.tf([1], [1, 1]), period=1.0)
+    >>> hss = build(sys, 2, None, 'auto', 'harmonic_ss')
+    >>> hss.K, hss.F.shape                      # harmonics -2..2 of one state
+    (2, (5, 5))
+    >>> build(sys, 2, None, 'fast', 'harmonic_ss')
+    Traceback (most recent call last):
+    ...
+    ValueError: method must be 'auto', 'modal' or 'solve', got 'fast'
     """
     if method not in ('auto', 'modal', 'solve'):
         raise ValueError(f"method must be 'auto', 'modal' or 'solve', got {method!r}")
@@ -112,7 +124,18 @@ def build(sys, K, internal_harmonics, method, where, stacklevel=2):
 
 
 def real_ss(hss, name, inputs, outputs, states):
-    """Real form ``V^H (F, G, H, J) V`` of a continuous harmonic state space."""
+    """Real form ``V^H (F, G, H, J) V`` of a continuous harmonic state space.
+
+    Examples
+    --------
+    >>> from ltpcontrol._harmonic_ss import build, real_ss
+    >>> G = ct.tf([1], [1, 1])
+    >>> sys = ltp.ltpss(G, period=1.0)
+    >>> Hs = real_ss(build(sys, 2, None, 'auto', 'harmonic_ss'), 'H',
+    ...              sys.input_labels, sys.output_labels, sys.state_labels)
+    >>> Hs.input_labels[:3], bool(np.isclose(Hs(0.5j)[0, 0], G(0.5j)))
+    (['u[0]_c0', 'u[0]_c1', 'u[0]_s1'], True)
+    """
     K, Ki = hss.K, hss.Ki
     n = hss.F.shape[0] // (2 * Ki + 1)
     Vs, tags_s = _real_basis(np.arange(-Ki, Ki + 1), 2 * Ki + 2)   # no wrap-around

@@ -564,6 +564,18 @@ def default_omega(H, omega_limits=None, omega_num=None):
     ``omega_num`` points (default ``ltp.config.defaults['htf.omega_num']``),
     logarithmically spaced from ``ω_p/100`` to ``10 K ω_p`` (below the
     Nyquist frequency in discrete time) unless `omega_limits` is given.
+
+    Examples
+    --------
+    From ``ω_p/100`` to ``10 K ω_p``, here with ``ω_p = 1`` and K = 2:
+
+    >>> from ltpcontrol._htf import default_omega
+    >>> H = ltp.htf(ct.ss(ct.tf([1], [1, 1])), 2, period=2 * np.pi)
+    >>> w = default_omega(H, omega_num=50)
+    >>> len(w), round(float(w[0]), 6), round(float(w[-1]), 6)
+    (50, 0.01, 20.0)
+    >>> default_omega(H, (1.0, 100.0), 3)
+    array([  1.,  10., 100.])
     """
     num = config._get('htf.omega_num', omega_num)
     num = check_positive_int(num, 'omega_num', minimum=2)

@@ -341,7 +341,15 @@ def _matrix(value, shape, name):
 
 
 def central_jacobian(func, x):
-    """∂func/∂x by central differences, ``(F(x + h e_j) − F(x − h e_j)) / 2h``."""
+    """∂func/∂x by central differences, ``(F(x + h e_j) − F(x − h e_j)) / 2h``.
+
+    Examples
+    --------
+    >>> from ltpcontrol._hybrid import central_jacobian
+    >>> J = central_jacobian(lambda x: [x[0] * x[1], np.sin(x[0])], [1.0, 2.0])
+    >>> bool(np.allclose(J, [[2.0, 1.0], [np.cos(1.0), 0.0]]))
+    True
+    """
     x = np.asarray(x, float)
     f0 = np.atleast_1d(func(x))
     jac = np.empty((f0.size, x.size))
@@ -455,7 +463,18 @@ def _saltation(plant, i, t, x, u, params, ufun):
 
 
 def plant_params(plant, params):
-    """The plant's parameters updated by `params` (a dict or None)."""
+    """The plant's parameters updated by `params` (a dict or None).
+
+    Examples
+    --------
+    >>> from ltpcontrol._hybrid import plant_params
+    >>> air = ltp.HybridMode(lambda t, x, u, p: [x[1], -p['g']], name='air')
+    >>> ball = ltp.HybridPlant([air], states=2, params={'g': 9.81, 'm': 1.0})
+    >>> plant_params(ball, {'g': 1.62}), plant_params(ball, None)
+    ({'g': 1.62, 'm': 1.0}, {'g': 9.81, 'm': 1.0})
+    >>> ball.params                                  # left unchanged
+    {'g': 9.81, 'm': 1.0}
+    """
     if params is None:
         return dict(plant.params)
     if not isinstance(params, dict):
@@ -464,7 +483,19 @@ def plant_params(plant, params):
 
 
 def constant_input(plant, u, name):
-    """Constant input vector of `plant` from None (zero), a scalar or one entry per input."""
+    """Constant input vector of `plant` from None (zero), a scalar or one entry per input.
+
+    Examples
+    --------
+    >>> from ltpcontrol._hybrid import constant_input
+    >>> plant = ltp.HybridPlant([ltp.HybridMode(lambda t, x, u, p: -x + u)], states=2, inputs=2)
+    >>> constant_input(plant, None, 'u0'), constant_input(plant, 3.0, 'u0')
+    (array([0., 0.]), array([3., 3.]))
+    >>> constant_input(plant, [1.0, 2.0, 3.0], 'u0')
+    Traceback (most recent call last):
+    ...
+    control.exception.ControlDimension: u0 must have 2 entries, got 3
+    """
     if u is None:
         return np.zeros(plant.ninputs)
     u = real_array(u, name, ndim=(0, 1)).reshape(-1)
@@ -476,7 +507,20 @@ def constant_input(plant, u, name):
 
 
 def input_function(plant, inputs, timepts):
-    """Return ``u(t)`` from a scalar, an array on `timepts` or a callable."""
+    """Return ``u(t)`` from a scalar, an array on `timepts` or a callable.
+
+    Examples
+    --------
+    Samples on `timepts` are interpolated linearly:
+
+    >>> from ltpcontrol._hybrid import input_function
+    >>> plant = ltp.HybridPlant([ltp.HybridMode(lambda t, x, u, p: -x + u)], states=1, inputs=1)
+    >>> u = input_function(plant, [0.0, 1.0, 4.0], [0.0, 1.0, 2.0])
+    >>> u(0.5), u(1.5)
+    (array([0.5]), array([2.5]))
+    >>> input_function(plant, np.cos, None)(0.0), input_function(plant, 2.0, None)(7.0)
+    (array([1.]), array([2.]))
+    """
     m = plant.ninputs
     if callable(inputs):
         def ufun(t):
@@ -584,7 +628,18 @@ class Flow:
 
 
 def solver_settings(where, rtol=1e-10, atol=1e-12, method='DOP853', max_events=10000):
-    """Checked `solve_ivp` settings of the hybrid integrator (`Flow`)."""
+    """Checked `solve_ivp` settings of the hybrid integrator (`Flow`).
+
+    Examples
+    --------
+    >>> from ltpcontrol._hybrid import solver_settings
+    >>> solver_settings('simulate_hybrid')
+    {'rtol': 1e-10, 'atol': 1e-12, 'method': 'DOP853', 'max_events': 10000}
+    >>> solver_settings('simulate_hybrid', rtol=0)
+    Traceback (most recent call last):
+    ...
+    ValueError: simulate_hybrid: rtol must be a positive number, got 0
+    """
     for value, label in [(rtol, 'rtol'), (atol, 'atol')]:
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) \
                 or not value > 0:

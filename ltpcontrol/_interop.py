@@ -195,7 +195,18 @@ MATRIX_REFUSED = {
 
 
 def refusal(name):
-    """The error for python-control's `name` (function or method) on an LTP system."""
+    """The error for python-control's `name` (function or method) on an LTP system.
+
+    Examples
+    --------
+    >>> from ltpcontrol._interop import refusal
+    >>> err = refusal('dcgain')
+    >>> isinstance(err, ct.ControlArgument)
+    True
+    >>> print(err)  # doctest: +NORMALIZE_WHITESPACE
+    dcgain does not apply to a linear time-periodic system (LTPStateSpace): use
+    ltp.htf(sys, nharmonics)(0) (the harmonic DC gains)
+    """
     return _refusal(name, REFUSED[name])
 
 
@@ -261,6 +272,19 @@ def install():
     Every module of the ``control`` package that holds a listed function
     (including aliases such as ``bode`` for ``bode_plot``) gets the same
     dispatcher, so internal calls between python-control modules see it too.
+
+    Examples
+    --------
+    Importing ltpcontrol has installed the dispatchers; installing again
+    changes nothing, and LTI systems still reach python-control:
+
+    >>> from ltpcontrol._interop import install
+    >>> wrapped = ct.dcgain
+    >>> install()
+    >>> ct.dcgain is wrapped, hasattr(wrapped, '_ltp_route')
+    (True, True)
+    >>> float(ct.dcgain(ct.tf([2], [1, 1])))
+    2.0
     """
     modules = [m for n, m in list(_sys.modules.items())
                if m is not None and (n == 'control' or n.startswith('control.'))]
@@ -276,6 +300,15 @@ def install():
 
 
 def original(name):
-    """python-control's own function behind a wrapped entry point."""
+    """python-control's own function behind a wrapped entry point.
+
+    Examples
+    --------
+    >>> from ltpcontrol._interop import original
+    >>> original('dcgain') is ct.dcgain.__wrapped__, hasattr(original('dcgain'), '_ltp_route')
+    (True, False)
+    >>> float(original('dcgain')(ct.tf([2], [1, 1])))
+    2.0
+    """
     fn = getattr(ct, name)
     return getattr(fn, '__wrapped__', fn)

@@ -274,7 +274,21 @@ def check_unique(Phi):
 
 
 def periodic_solution(A, Q, grid, X, adjoint):
-    """PeriodicMatrix evaluating the solution from the grid values `X`."""
+    """PeriodicMatrix evaluating the solution from the grid values `X`.
+
+    Examples
+    --------
+    For ``Ẋ = -2X + 2`` (A = -1, Q = 2) the grid values ``X(0) = 0``,
+    ``X(0.5) = 1 - e^{-1}`` are joined by ``X(t) = 1 - e^{-2t}``:
+
+    >>> from ltpcontrol._lyapunov import periodic_solution
+    >>> A = ltp.PeriodicMatrix.constant([[-1.0]], 1.0)
+    >>> Q = ltp.PeriodicMatrix.constant([[2.0]], 1.0)
+    >>> X = periodic_solution(A, Q, np.array([0.0, 0.5, 1.0]),
+    ...                       np.array([[[0.0]], [[1 - np.exp(-1.0)]]]), adjoint=False)
+    >>> X.shape, bool(np.isclose(X(0.25)[0, 0], 1 - np.exp(-0.5)))
+    ((1, 1), True)
+    """
     T, n = A.period, A.shape[0]
     starts, ends = grid[:-1], grid[1:]
     Xn = np.concatenate([X, X[:1]])              # X_M = X_0

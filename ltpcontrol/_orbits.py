@@ -159,7 +159,18 @@ def _phase_index(monodromy, multipliers, direction):
 
 
 def as_hybrid(plant, jacobian):
-    """A `HybridPlant` view of `plant` (a smooth system becomes one mode)."""
+    """A `HybridPlant` view of `plant` (a smooth system becomes one mode).
+
+    Examples
+    --------
+    >>> from ltpcontrol._orbits import as_hybrid
+    >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t), None, states=1, inputs=0, name='P')
+    >>> plant = as_hybrid(sys, None)
+    >>> type(plant).__name__, plant.mode_names, as_hybrid(plant, None) is plant
+    ('HybridPlant', ['P'], True)
+    >>> plant.dynamics(0.0, np.array([1.0]), [])
+    array([0.])
+    """
     if jacobian is not None and not callable(jacobian):
         raise ControlArgument(f"jacobian must be callable, got {type(jacobian).__name__}")
     if isinstance(plant, HybridPlant):
@@ -185,6 +196,19 @@ def time_mismatch(plant, x0, u0, params, pairs):
 
     Compares at `x0` and a perturbed state; returns ``(label, mode name,
     t_a, t_b, largest difference)`` or None.
+
+    Examples
+    --------
+    ``ẋ = -x + cos t`` is 2π-periodic, not 1-periodic:
+
+    >>> from ltpcontrol._orbits import as_hybrid, time_mismatch
+    >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t), None, states=1, inputs=0, name='P')
+    >>> plant, x0, u0 = as_hybrid(sys, None), np.zeros(1), np.zeros(0)
+    >>> time_mismatch(plant, x0, u0, {}, [(0.3, 0.3 + 2 * np.pi)]) is None
+    True
+    >>> label, mode, ta, tb, diff = time_mismatch(plant, x0, u0, {}, [(0.3, 1.3)])
+    >>> label, mode, bool(np.isclose(diff, np.cos(0.3) - np.cos(1.3)))
+    ('updfcn', 'P', True)
     """
     bumps = np.linspace(-1.0, 1.0, plant.nstates) * 0.1 * (1 + np.abs(x0))
     for i, mode in enumerate(plant.modes):
@@ -492,7 +516,18 @@ def _segment_average(func, a, b):
 
 
 def check_orbit_of(orbit, plant, why_inputs):
-    """`orbit` is a `PeriodicOrbit` of `plant` (a `HybridPlant` with inputs)."""
+    """`orbit` is a `PeriodicOrbit` of `plant` (a `HybridPlant` with inputs).
+
+    Examples
+    --------
+    >>> from ltpcontrol._orbits import as_hybrid, check_orbit_of
+    >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t), None, states=1, inputs=0)
+    >>> orbit = ltp.periodic_orbit(sys, 2 * np.pi, [0.0], npoints=8)
+    >>> check_orbit_of(orbit, as_hybrid(sys, None), 'there is nothing to linearise in u')
+    Traceback (most recent call last):
+    ...
+    ValueError: plant has no inputs: there is nothing to linearise in u
+    """
     if not isinstance(orbit, PeriodicOrbit):
         raise ControlArgument(f"orbit must be a PeriodicOrbit, got {type(orbit).__name__}")
     if orbit.plant.nstates != plant.nstates or orbit.plant.mode_names != plant.mode_names:

@@ -53,20 +53,51 @@ _MAX_COS = np.cos(0.3)
 
 
 def gramians(sys, nsteps=None):
-    """Periodic controllability and observability gramians P(t), Q(t)."""
+    """Periodic controllability and observability gramians P(t), Q(t).
+
+    Examples
+    --------
+    For an LTI system the gramians are the constant ones of python-control:
+
+    >>> from ltpcontrol._periodic_balancing import gramians
+    >>> G = ct.ss([[-1.0, 0.0], [1.0, -4.0]], [[1.0], [0.0]], [[0.0, 1.0]], 0)
+    >>> P, Q = gramians(ltp.ltpss(G, period=1.0))
+    >>> bool(np.allclose(P(0.3), ct.gram(G, 'c'))), bool(np.allclose(Q(0.3), ct.gram(G, 'o')))
+    (True, True)
+    """
     P = lyap(sys.A, gram_weight(sys.B), nsteps=nsteps)
     Q = lyap(sys.A, gram_weight(sys.C, True), adjoint=True, nsteps=nsteps)
     return P, Q
 
 
 def sqrt_factor(X):
-    """``S`` with ``X = S Sᵀ`` for symmetric positive semidefinite X (stacked)."""
+    """``S`` with ``X = S Sᵀ`` for symmetric positive semidefinite X (stacked).
+
+    Examples
+    --------
+    >>> from ltpcontrol._periodic_balancing import sqrt_factor
+    >>> X = np.array([[[4.0, 2.0], [2.0, 2.0]], [[1.0, 0.0], [0.0, 0.0]]])
+    >>> S = sqrt_factor(X)
+    >>> S.shape, bool(np.allclose(S @ np.swapaxes(S, 1, 2), X))
+    ((2, 2, 2), True)
+    """
     w, U = np.linalg.eigh(0.5 * (X + np.swapaxes(X, -1, -2)))
     return U * np.sqrt(np.clip(w, 0, None))[..., None, :]
 
 
 def hankel_svd(P, Q):
-    """Square-root factors and the SVD ``RᵀS = UΣVᵀ`` of stacked gramians."""
+    """Square-root factors and the SVD ``RᵀS = UΣVᵀ`` of stacked gramians.
+
+    Examples
+    --------
+    The singular values are those of python-control for an LTI system:
+
+    >>> from ltpcontrol._periodic_balancing import hankel_svd
+    >>> G = ct.ss([[-1.0, 0.0], [1.0, -4.0]], [[1.0], [0.0]], [[0.0, 1.0]], 0)
+    >>> S, R, U, hsv, Vt = hankel_svd(ct.gram(G, 'c')[None], ct.gram(G, 'o')[None])
+    >>> hsv.shape, bool(np.allclose(hsv[0], ct.hankel_singular_values(G)))
+    ((1, 2), True)
+    """
     S, R = sqrt_factor(P), sqrt_factor(Q)
     U, hsv, Vt = np.linalg.svd(np.swapaxes(R, -1, -2) @ S)
     return S, R, U, hsv, Vt
@@ -77,6 +108,20 @@ def truncate(sys, r, nsteps=None):
 
     Returns the reduced ``(Â, B̂, Ĉ)`` and ``sup_t σ_j(t)`` of each
     discarded branch j > r (`branches`).
+
+    Examples
+    --------
+    An LTI system gives python-control's balanced truncation (up to the
+    state's scale), and the bound term is the discarded singular value:
+
+    >>> from ltpcontrol._periodic_balancing import truncate
+    >>> G = ct.ss([[-1.0, 0.0], [1.0, -4.0]], [[1.0], [0.0]], [[0.0, 1.0]], 0)
+    >>> (Ar, Br, Cr), sup = truncate(ltp.ltpss(G, period=1.0), 1)
+    >>> red = ct.balred(G, 1)
+    >>> bool(np.allclose(Ar(0.2), red.A)), bool(np.allclose(Cr(0.2) @ Br(0.2), red.C @ red.B))
+    (True, True)
+    >>> bool(np.allclose(sup, ct.hankel_singular_values(G)[1]))
+    True
     """
     n, T = sys.nstates, sys.period
     P, Q = gramians(sys, nsteps)
@@ -179,6 +224,18 @@ def branches(hsv, vectors):
     by the overlap of the eigenvectors of ``P Q`` (columns of `vectors`)
     among values within 20 % of each other (vanishing values, whose vectors
     are arbitrary, form one group).  Returns ``order`` (samples, n): the column of each branch at each sample.
+
+    Examples
+    --------
+    Two close values whose eigenvectors trade places: the branch along ``e_1``
+    moves from column 0 to column 1.
+
+    >>> from ltpcontrol._periodic_balancing import branches
+    >>> hsv = np.array([[1.1, 1.0], [1.1, 1.0]])
+    >>> vectors = np.array([np.eye(2), np.eye(2)[:, ::-1]])
+    >>> branches(hsv, vectors)
+    array([[0, 1],
+           [1, 0]])
     """
     E = vectors / np.maximum(np.linalg.norm(vectors, axis=1, keepdims=True), 1e-300)
     order = np.empty(hsv.shape, int)
