@@ -223,7 +223,8 @@ def branches(hsv, vectors):
     balanced realization follows the branches, matched from sample to sample
     by the overlap of the eigenvectors of ``P Q`` (columns of `vectors`)
     among values within 20 % of each other (vanishing values, whose vectors
-    are arbitrary, form one group).  Returns ``order`` (samples, n): the column of each branch at each sample.
+    are arbitrary, form one group).  Returns ``order`` (samples, n): the
+    column of each branch at each sample.
 
     Examples
     --------
