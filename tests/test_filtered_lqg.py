@@ -12,7 +12,7 @@ import pytest
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
-from systems import random_periodic_plant
+from systems import random_periodic_plant, switching_mathieu
 
 
 def _augmented(P, F):
@@ -110,3 +110,23 @@ def test_bad_input_filter():
         ltp.lqg(sys, np.eye(3), *args[1:], input_filter=ct.tf([1], [1, 1]))
     with pytest.raises(ValueError, match='input_filter has the time base'):
         ltp.lqg(sys, *args, input_filter=ct.tf([1], [1, 0.5], 0.1))
+
+
+@pytest.mark.parametrize('dt', [0.0, 0.5 / 10])
+def test_separation_on_a_switching_plant(dt):
+    """Switching A(t) (thesis eq. 4.25): the loop's exponents are those of the
+    augmented regulator and estimator, continuous and sampled (N = 10)."""
+    sys = switching_mathieu()
+    F = ct.ss(ct.tf([8.0], [1, 8.0]))
+    if dt:
+        sys, F = ltp.sample_system(sys, dt), ct.sample_system(F, dt, method='tustin')
+    Q, R, QN, RN = np.diag([10.0, 1.0]), [[0.1]], [[1.0]], [[0.01]]
+    ctrl = ltp.lqg(sys, Q, R, QN, RN, input_filter=F)
+    aug = ltp.series(F, sys)
+    _, _, EK = ltp.lqr(aug, np.pad(Q, ((1, 0), (1, 0))), R)
+    _, _, EL = ltp.lqe(aug, QN, RN)
+    got = np.abs(ltp.floquet_multipliers(ltp.feedback(sys, ctrl, sign=1)))
+    expected = np.abs(np.exp(np.concatenate([EK, EL]) * sys.period)) if not dt else \
+        np.abs(np.concatenate([EK, EL])) ** sys.nsteps
+    np.testing.assert_allclose(np.sort(got), np.sort(expected), rtol=1e-6, atol=1e-12)
+    assert np.all(got < 1)
