@@ -50,6 +50,8 @@ __all__ = ['estimate_htf', 'HTFEstimateInfo']
 _COND_WARN = 1e8
 # relative α grid searched by generalised cross-validation
 _GCV_GRID = np.logspace(-8, 6, 15)
+#: Residual degrees of freedom below which a fit counts as interpolating (GCV undefined).
+_GCV_MIN_DOF = 1e-3
 # unmodelled-harmonics test: significance level and the smallest noise-variance
 # inflation (variance ratio) worth a warning
 _HARMONIC_PVALUE = 1e-3
@@ -373,7 +375,11 @@ def _gcv_search(phi, Yb, penalty, scale, progress):
 
     def score(log_alpha):
         g, tr, _ = _solve_joint(phi, Yb, 10.0 ** log_alpha, penalty, scale, False)
-        return n * _residual(phi, Yb, g).sum() / max(n - tr, 1e-12) ** 2
+        # an (almost) interpolating fit leaves n - tr H within rounding of 0: GCV is 0/0
+        # there, so such α are not candidates
+        if n - tr < _GCV_MIN_DOF:
+            return np.inf
+        return n * _residual(phi, Yb, g).sum() / (n - tr) ** 2
 
     logs = np.log10(_GCV_GRID)
     scores = np.array([score(a) for a in tqdm(logs, desc="GCV", leave=False,

@@ -633,8 +633,10 @@ def refine_ltp(sys, data, *, std=None, harmonics=None, weighted=True, stable=Fal
     fisher = J.T @ J / (1.0 if known else scale)
     w_eig, U = np.linalg.eigh(fisher)
     if w_eig[0] <= w_eig[-1] / _COND_FISHER:
-        cond = w_eig[-1] / max(w_eig[0], 1e-300)
-        warnings.warn(f"the Fisher information is singular (condition {cond:.2g}): "
+        # the condition number in logs: the ratio itself can overflow
+        cond = (f"1e{np.log10(w_eig[-1]) - np.log10(w_eig[0]):.0f}" if w_eig[0] > 0
+                else "infinite")
+        warnings.warn(f"the Fisher information is singular (condition {cond}): "
                       "some parameters are not determined by the data; the covariance is "
                       "a pseudo-inverse", UserWarning, stacklevel=2)
     cov = (U / np.where(w_eig > w_eig[-1] / _COND_FISHER, w_eig, np.inf)) @ U.T
