@@ -1,0 +1,1 @@
+"""Analysis and design on LTP models: Lyapunov and Riccati equations, norms, zeros, controllers, reduction."""

@@ -1,0 +1,1 @@
+"""Core: periodic matrices, LTP state-space systems, simulation, Floquet theory, discretization and lifting."""

@@ -1,0 +1,1 @@
+"""Frequency domain: harmonic transfer functions, their plots and the harmonic state space."""

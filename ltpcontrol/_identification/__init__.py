@@ -1,0 +1,1 @@
+"""Identification: excitation design, HTF estimation, subspace identification and refinement."""

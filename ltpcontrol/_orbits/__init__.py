@@ -1,0 +1,1 @@
+"""Rhythmic plants: hybrid plants, periodic orbits, their linearization and closed loops."""
