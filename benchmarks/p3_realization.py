@@ -19,7 +19,7 @@ on the first `pso_models` models only and its time per model is the mean
 over those (said in the JSON file).
 
 ``floquet_realization`` is looked up as ``ltpcontrol.floquet_realization``
-and then in ``ltpcontrol._realization``; when neither exists the workload
+and then in ``ltpcontrol._identification.realization``; when neither exists the workload
 is reported as not available.
 """
 
@@ -44,7 +44,7 @@ def _function():
     fn = getattr(ltp, 'floquet_realization', None)
     if fn is None:
         try:
-            from ltpcontrol._realization import floquet_realization as fn
+            from ltpcontrol._identification.realization import floquet_realization as fn
         except ImportError:
             fn = None
     return fn

@@ -5,7 +5,7 @@ the *same* exact discretization: the recurrence
 
     x[k+1] = Φ_k x[k] + Γ0_k u[k] + Γ1_k (u[k+1] - u[k]),   y[k] = C_k x[k] + D_k u[k]
 
-(phase k mod N, step data from ``ltpcontrol._transition.step_transitions``)
+(phase k mod N, step data from ``ltpcontrol._core.transition.step_transitions``)
 written as a scalar loop and compiled with numba (``pip install numba``; the
 rows are reported as not available without it).  It stores the states and
 the outputs, as `ltp.forced_response` does, and is checked to agree with it
@@ -37,8 +37,8 @@ import numpy as np
 from _common import median_time, not_available, row, timed
 
 import ltpcontrol as ltp
-from ltpcontrol._march import periodic_march
-from ltpcontrol._transition import step_transitions
+from ltpcontrol._core.march import periodic_march
+from ltpcontrol._core.transition import step_transitions
 from systems import mathieu
 
 TOL = 1e-12

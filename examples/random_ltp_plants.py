@@ -5,7 +5,7 @@ import numpy as np
 import control as ct
 
 import ltpcontrol as ltp
-from ltpcontrol._lifting import _real_basis
+from ltpcontrol._core.lifting import _real_basis
 
 
 def random_ltp(seed, nstates=2, noutputs=1, harmonics=2, period=1.0, depth=0.3,

@@ -9,45 +9,45 @@ Examples assume::
     import ltpcontrol as ltp
 """
 
-from ._periodic_matrix import PeriodicMatrix
-from ._ltpsys import LTPStateSpace, ltpss, series, parallel, feedback, append, negate
-from ._interconnect import interconnect
-from ._timeresp import forced_response, step_response, initial_response, impulse_response
-from ._floquet import (monodromy, floquet_multipliers, floquet_exponents, is_stable,
+from ._core.periodic_matrix import PeriodicMatrix
+from ._core.ltpsys import LTPStateSpace, ltpss, series, parallel, feedback, append, negate
+from ._core.interconnect import interconnect
+from ._core.timeresp import forced_response, step_response, initial_response, impulse_response
+from ._core.floquet import (monodromy, floquet_multipliers, floquet_exponents, is_stable,
                        floquet_transform)
-from ._htf import HTF, HTFModel, HTFData, htf
-from ._htfplot import htf_response, bode_htf, htf_map_plot
-from ._discretize import sample_system, d2c
-from ._lifting import lift
-from ._hybrid import HybridMode, HybridPlant, simulate_hybrid, saltation_matrix
-from ._orbits import PeriodicOrbit, periodic_orbit, period_map, linearize_orbit
-from ._autonomous import limit_cycle, poincare_map
-from ._continuation import Bifurcation, OrbitBranch, orbit_continuation
-from ._excitation import Excitation, chirp_replicas, multisine, sine_experiments
-from ._htf_estimate import estimate_htf, HTFEstimateInfo
-from ._htf_fit import HTFFit, DelayEstimate, fit_htf, estimate_delays
-from ._metrics import e_rms, nrmse
-from ._fdsubspace import fdsubspace, FDSubspaceInfo
-from ._hybrid_ls import hybrid_ls, HybridLSResult
-from ._realization import floquet_realization, FloquetRealization
-from ._canonical import to_canonical, matrix_errors, MatrixErrors
-from ._canonical import compare_ltp, LTPComparison
-from ._structure import select_structure, StructureSelection
-from ._ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
-from ._arx import identify_arx
-from ._closed_loop import ClosedLoopOrbit, closed_loop_response, closed_loop_orbit
-from ._lyapunov import lyap, dlyap, gram
-from ._norms import norm
-from ._zeros import zeros
-from ._harmonic_ss import harmonic_ss
-from ._riccati import care, dare
-from ._design import lqr, dlqr, lqe, dlqe, lqg
-from ._place import place
-from ._lmi import lmi_statefbk, LMIDesign
-from ._reduction import hsvd, balred, minreal
-from ._refine import refine_ltp, RefineInfo
-from ._montecarlo import monte_carlo, MonteCarloResult
-from ._scenarios import sample_models
+from ._frequency.htf import HTF, HTFModel, HTFData, htf
+from ._frequency.htfplot import htf_response, bode_htf, htf_map_plot
+from ._core.discretize import sample_system, d2c
+from ._core.lifting import lift
+from ._orbits.hybrid import HybridMode, HybridPlant, simulate_hybrid, saltation_matrix
+from ._orbits.orbits import PeriodicOrbit, periodic_orbit, period_map, linearize_orbit
+from ._orbits.autonomous import limit_cycle, poincare_map
+from ._orbits.continuation import Bifurcation, OrbitBranch, orbit_continuation
+from ._identification.excitation import Excitation, chirp_replicas, multisine, sine_experiments
+from ._identification.htf_estimate import estimate_htf, HTFEstimateInfo
+from ._identification.htf_fit import HTFFit, DelayEstimate, fit_htf, estimate_delays
+from ._core.metrics import e_rms, nrmse
+from ._identification.fdsubspace import fdsubspace, FDSubspaceInfo
+from ._identification.hybrid_ls import hybrid_ls, HybridLSResult
+from ._identification.realization import floquet_realization, FloquetRealization
+from ._identification.canonical import to_canonical, matrix_errors, MatrixErrors
+from ._identification.canonical import compare_ltp, LTPComparison
+from ._identification.structure import select_structure, StructureSelection
+from ._identification.ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
+from ._identification.arx import identify_arx
+from ._orbits.closed_loop import ClosedLoopOrbit, closed_loop_response, closed_loop_orbit
+from ._analysis.lyapunov import lyap, dlyap, gram
+from ._analysis.norms import norm
+from ._analysis.zeros import zeros
+from ._frequency.harmonic_ss import harmonic_ss
+from ._analysis.riccati import care, dare
+from ._analysis.design import lqr, dlqr, lqe, dlqe, lqg
+from ._analysis.place import place
+from ._analysis.lmi import lmi_statefbk, LMIDesign
+from ._analysis.reduction import hsvd, balred, minreal
+from ._identification.refine import refine_ltp, RefineInfo
+from ._identification.montecarlo import monte_carlo, MonteCarloResult
+from ._identification.scenarios import sample_models
 
 __version__ = "0.1.0"
 
@@ -92,7 +92,7 @@ __all__ = [
     'sample_models',
 ]
 
-# python-control's entry points dispatch LTP systems to ltpcontrol (see _interop)
+# python-control's entry points dispatch LTP systems to ltpcontrol (see interop)
 from . import config  # noqa: E402
-from ._interop import install as _install_interop  # noqa: E402
+from .interop import install as _install_interop  # noqa: E402
 _install_interop()

@@ -29,8 +29,8 @@ from control.config import _process_kwargs
 from control.exception import ControlArgument
 from control.timeresp import _timeresp_aliases
 
-from ._ltpsys import LTPStateSpace
-from ._periodic_matrix import PeriodicMatrix
+from ._core.ltpsys import LTPStateSpace
+from ._core.periodic_matrix import PeriodicMatrix
 
 __all__ = []
 
@@ -199,7 +199,7 @@ def refusal(name):
 
     Examples
     --------
-    >>> from ltpcontrol._interop import refusal
+    >>> from ltpcontrol.interop import refusal
     >>> err = refusal('dcgain')
     >>> isinstance(err, ct.ControlArgument)
     True
@@ -278,7 +278,7 @@ def install():
     Importing ltpcontrol has installed the dispatchers; installing again
     changes nothing, and LTI systems still reach python-control:
 
-    >>> from ltpcontrol._interop import install
+    >>> from ltpcontrol.interop import install
     >>> wrapped = ct.dcgain
     >>> install()
     >>> ct.dcgain is wrapped, hasattr(wrapped, '_ltp_route')
@@ -304,7 +304,7 @@ def original(name):
 
     Examples
     --------
-    >>> from ltpcontrol._interop import original
+    >>> from ltpcontrol.interop import original
     >>> original('dcgain') is ct.dcgain.__wrapped__, hasattr(original('dcgain'), '_ltp_route')
     (True, False)
     >>> float(original('dcgain')(ct.tf([2], [1, 1])))

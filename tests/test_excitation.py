@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from control.exception import ControlArgument
 
-from ltpcontrol._excitation import chirp_replicas, multisine, sine_experiments
-from ltpcontrol._htf_estimate import estimate_htf
+from ltpcontrol._identification.excitation import chirp_replicas, multisine, sine_experiments
+from ltpcontrol._identification.htf_estimate import estimate_htf
 from test_htf_estimate import ScalarLTP
 
 

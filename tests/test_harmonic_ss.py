@@ -5,7 +5,7 @@ import pytest
 import control as ct
 
 import ltpcontrol as ltp
-from ltpcontrol._lifting import _real_basis
+from ltpcontrol._core.lifting import _real_basis
 from analysis_systems import stable_rss
 from systems import mathieu, switching_mathieu
 

@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 from control.exception import ControlArgument, ControlDimension
 
-from ltpcontrol._excitation import chirp_replicas
-from ltpcontrol._htf import HTFData
-from ltpcontrol._htf_estimate import HTFEstimateInfo, estimate_htf
-from ltpcontrol._metrics import e_rms, nrmse
+from ltpcontrol._identification.excitation import chirp_replicas
+from ltpcontrol._frequency.htf import HTFData
+from ltpcontrol._identification.htf_estimate import HTFEstimateInfo, estimate_htf
+from ltpcontrol._core.metrics import e_rms, nrmse
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 
@@ -542,7 +542,7 @@ def test_gcv_trace_by_block_sweeps_equals_column_solves(nrec, nfreq, nunk, alpha
     # tr H of the GCV search (two Schur-complement sweeps) against the
     # column-by-column solves, and the blocks against a dense inverse
     import scipy.sparse as sp
-    from ltpcontrol._htf_estimate import _inverse_diagonal_blocks, _penalty, _solve_joint
+    from ltpcontrol._identification.htf_estimate import _inverse_diagonal_blocks, _penalty, _solve_joint
     rng = np.random.default_rng(nfreq)
     phi = rng.normal(size=(nrec, nfreq, nunk)) + 1j * rng.normal(size=(nrec, nfreq, nunk))
     Yb = rng.normal(size=(nrec, nfreq, 2)) + 1j * rng.normal(size=(nrec, nfreq, 2))

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import ltpcontrol as ltp
-from ltpcontrol import _harmonic_ss
+from ltpcontrol._frequency import harmonic_ss as _harmonic_ss
 from systems import random_periodic_plant
 
 matplotlib.use('Agg')

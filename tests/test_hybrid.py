@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from control.exception import ControlArgument, ControlDimension
 
-from ltpcontrol._hybrid import HybridMode, HybridPlant, saltation_matrix, simulate_hybrid
-from ltpcontrol._orbits import period_map
+from ltpcontrol._orbits.hybrid import HybridMode, HybridPlant, saltation_matrix, simulate_hybrid
+from ltpcontrol._orbits.orbits import period_map
 
 G = 9.81
 

@@ -10,7 +10,7 @@ import pytest
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
-from ltpcontrol._excitation import _replicas
+from ltpcontrol._identification.excitation import _replicas
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "examples"))
 from random_ltp_plants import design_lines, lifted_data, random_ltp  # noqa: E402
 

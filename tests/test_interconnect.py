@@ -8,7 +8,7 @@ from hypothesis import given, settings, strategies as st
 from scipy.integrate import solve_ivp
 
 import ltpcontrol as ltp
-from ltpcontrol._validation import commensurate
+from ltpcontrol._core.validation import commensurate
 
 T = 1.0
 W = 2 * np.pi / T

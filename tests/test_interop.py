@@ -11,7 +11,7 @@ from control.exception import ControlArgument
 from scipy.integrate import solve_ivp
 
 import ltpcontrol as ltp
-from ltpcontrol import _interop
+from ltpcontrol import interop as _interop
 
 T = 1.0
 

@@ -17,71 +17,107 @@ import pytest
 PACKAGE = pathlib.Path(__file__).resolve().parents[1] / 'ltpcontrol'
 
 # layer map
-#: Layers from the bottom up; a module may import from its own layer and the
+#: Layers from the bottom up, one folder of ``ltpcontrol/`` each (top-level
+#: modules named explicitly); a module may import from its own layer and the
 #: layers listed before it.
 LAYERS = {
-    # systems, periodic matrices, simulation, Floquet theory, frequency domain
-    'core': ['config', '_validation', '_transition', '_march', '_steps', '_periodic_matrix',
-             '_ltpsys', '_timeresp', '_floquet', '_htf', '_htfplot', '_harmonic_ss',
-             '_display', '_discretize', '_lifting', '_metrics',
-             # python-control's entry points: reaches higher layers only by name,
-             # through the public namespace, when called
-             '_interop'],
+    # configuration
+    'config': ['config'],
+    # systems, periodic matrices, simulation, Floquet theory, discretization, lifting
+    'core': ['_core'],
+    # harmonic transfer functions, their plots, the harmonic state space
+    'frequency': ['_frequency'],
     # analysis and synthesis on LTP models
-    'analysis': ['_lyapunov', '_riccati', '_norms', '_zeros', '_design', '_place', '_lmi',
-                 '_reduction', '_periodic_balancing', '_interconnect'],
+    'analysis': ['_analysis'],
     # rhythmic (hybrid) plants, their periodic orbits and closed loops
-    'orbits': ['_hybrid', '_orbits', '_autonomous', '_continuation', '_loop', '_closed_loop'],
+    'orbits': ['_orbits'],
     # experiments and identification from data
-    'identification': ['_excitation', '_htf_estimate', '_htf_fit', '_fdsubspace',
-                       '_hybrid_ls', '_realization', '_floquet_fit', '_canonical',
-                       '_structure', '_ltp_subspace', '_refine', '_montecarlo', '_arx',
-                       '_lifted_response',
-                       '_scenarios'],
+    'identification': ['_identification'],
+    # python-control's entry points
+    'interop': ['interop'],
 }
 
 #: Method aliases: methods of a class that call a public function of a higher
 #: layer (python-control's ``lti.py`` does the same), e.g. ``sys.zeros()``
 #: for ``ltp.zeros(sys)``, so that python-control's own function dispatches.
-METHOD_ALIASES = {'_ltpsys': {'_zeros', '_floquet', '_discretize', '_interop'}}
+METHOD_ALIASES = {'_core.ltpsys': {'_frequency.htf', '_analysis.zeros', 'interop'},
+                  '_core.interconnect': {'interop'}}
 # end of layer map
 
 #: Modules exempt from the layering: the public namespace imports everything.
 TOP = {'__init__'}
 
 
+def module_key(path):
+    """Dotted name of a package module relative to the package: ``_core.ltpsys``."""
+    parts = path.relative_to(PACKAGE).with_suffix('').parts
+    if parts[-1] == '__init__' and len(parts) > 1:
+        parts = parts[:-1]
+    return '.'.join(parts)
+
+
+def layer_of(module, layers):
+    """The layer whose folder (or top-level module) holds `module`."""
+    head = module.split('.')[0]
+    for name, members in layers.items():
+        if head in members:
+            return name
+    return None
+
+
 def layer_index(layers):
-    """Map each module to the rank of its layer (0 = bottom)."""
+    """Map each folder or top-level module to the rank of its layer (0 = bottom)."""
     rank = {}
-    for i, modules in enumerate(layers.values()):
-        for mod in modules:
+    for i, members in enumerate(layers.values()):
+        for mod in members:
             assert mod not in rank, f"{mod} is assigned to two layers"
             rank[mod] = i
     return rank
 
 
-def package_imports(source, package='ltpcontrol'):
-    """Names of the package's modules imported anywhere in `source`."""
+def package_imports(source, here='', package='ltpcontrol'):
+    """Package modules (dotted, relative to the package) imported anywhere in `source`.
+
+    `here` is the dotted folder of the importing module ('' at the top).
+    ``from .x import y`` names module ``x`` (or ``x.y`` when `y` is a module
+    of the package); ``from . import x`` names ``x``.
+    """
     found = set()
+    base = here.split('.') if here else []
+
+    def resolve(level, module):
+        parts = base[:len(base) - (level - 1)] if level > 1 else list(base)
+        return '.'.join(parts + (module.split('.') if module else []))
+
     for node in ast.walk(ast.parse(source)):
         if isinstance(node, ast.ImportFrom):
-            if node.level == 1 and node.module:            # from ._x import y
-                found.add(node.module.split('.')[0])
-            elif node.level == 1:                          # from . import _x
-                found.update(alias.name for alias in node.names)
-            elif node.level == 0 and node.module and node.module.startswith(package + '.'):
-                found.add(node.module.split('.')[1])
+            if node.level >= 1:
+                target = resolve(node.level, node.module)
+            elif node.module and node.module.startswith(package + '.'):
+                target = node.module[len(package) + 1:]
+            else:
+                continue
+            for alias in node.names:
+                candidate = f"{target}.{alias.name}" if target else alias.name
+                found.add(candidate if _is_module(candidate) or not target else target)
         elif isinstance(node, ast.Import):
             for alias in node.names:
                 if alias.name.startswith(package + '.'):
-                    found.add(alias.name.split('.')[1])
-    return found
+                    found.add(alias.name[len(package) + 1:])
+    return {mod for mod in found if mod}
+
+
+def _is_module(dotted):
+    path = PACKAGE.joinpath(*dotted.split('.'))
+    return path.with_suffix('.py').is_file() or (path / '__init__.py').is_file()
 
 
 def violations(graph, layers, top=frozenset(), aliases=None):
     """Layering errors of a module graph ``{module: set of imported modules}``."""
     aliases = aliases or {}
-    rank = layer_index(layers)
+    members = layer_index(layers)
+    rank = {mod: members[mod.split('.')[0]] for mod in set(graph).union(*graph.values())
+            if mod.split('.')[0] in members}
     names = list(layers)
     errors = []
     for mod in sorted(graph):
@@ -100,9 +136,20 @@ def violations(graph, layers, top=frozenset(), aliases=None):
     return errors
 
 
+def package_paths():
+    """Every module of the package, by its dotted key."""
+    return {module_key(path): path for path in sorted(PACKAGE.rglob('*.py'))}
+
+
+def package_source_imports(key, source):
+    here = key if PACKAGE.joinpath(*key.split('.'), '__init__.py').is_file() else \
+        key.rpartition('.')[0]
+    return package_imports(source, here)
+
+
 def package_graph():
-    return {path.stem: package_imports(path.read_text())
-            for path in sorted(PACKAGE.glob('*.py'))}
+    return {key: package_source_imports(key, path.read_text())
+            for key, path in package_paths().items()}
 
 
 def _module_level(source):
@@ -112,9 +159,9 @@ def _module_level(source):
                      if not isinstance(node, (ast.FunctionDef, ast.ClassDef)))
 
 
-def lazy_imports(source):
+def lazy_imports(source, here=''):
     """Package modules imported inside functions and methods of `source`."""
-    return package_imports(source) - package_imports(_module_level(source))
+    return package_imports(source, here) - package_imports(_module_level(source), here)
 
 
 def reaches(graph, start, goal):
@@ -138,15 +185,17 @@ def unforced_lazy_imports(sources, aliases=None):
     when it serves a method alias.
     """
     aliases = aliases or {}
-    top = {mod: package_imports(_module_level(src)) for mod, src in sources.items()}
+    def here(mod):
+        return mod.rpartition('.')[0]
+    top = {mod: package_imports(_module_level(src), here(mod)) for mod, src in sources.items()}
     return sorted((mod, dep) for mod, src in sources.items()
-                  for dep in lazy_imports(src) - TOP
+                  for dep in lazy_imports(src, here(mod)) - TOP
                   if dep not in aliases.get(mod, ()) and not reaches(top, dep, mod))
 
 
 @functools.cache
 def package_unforced():
-    sources = {path.stem: path.read_text() for path in sorted(PACKAGE.glob('*.py'))}
+    sources = {key: path.read_text() for key, path in package_paths().items()}
     return unforced_lazy_imports(sources, METHOD_ALIASES)
 
 
@@ -157,8 +206,8 @@ def test_package_respects_layers():
 
 def modules(pending, reason):
     """The package's modules; those in `pending` must fail (strict xfail) until mended."""
-    return [pytest.param(path.stem, marks=pytest.mark.xfail(strict=True, reason=reason))
-            if path.stem in pending else path.stem for path in sorted(PACKAGE.glob('*.py'))]
+    return [pytest.param(key, marks=pytest.mark.xfail(strict=True, reason=reason))
+            if key in pending else key for key in package_paths()]
 
 
 # modules whose lazy imports are not yet at module level
@@ -224,7 +273,7 @@ PENDING_OPTIONS = set()
 @pytest.mark.parametrize('module', modules(PENDING_OPTIONS,
                                               "documented option in **kwargs"))
 def test_documented_options_are_parameters(module):
-    found = hidden_options((PACKAGE / f'{module}.py').read_text())
+    found = hidden_options(package_paths()[module].read_text())
     assert not found, f"{module}: make these keyword-only parameters: {found}"
 
 
@@ -238,7 +287,7 @@ def test_hidden_option_is_found():
 
 
 def test_library_does_not_patch_with_unittest():
-    users = [path.stem for path in PACKAGE.glob('*.py')
+    users = [key for key, path in package_paths().items()
              if {'unittest'} & {alias.name.split('.')[0] for node in
                                 ast.walk(ast.parse(path.read_text()))
                                 if isinstance(node, (ast.Import, ast.ImportFrom))
@@ -256,8 +305,8 @@ def private_periodic_matrix_access(source):
 
 
 def test_periodic_matrix_is_used_through_public_methods():
-    users = {path.stem: found for path in PACKAGE.glob('*.py')
-             if path.stem != '_periodic_matrix'
+    users = {key: found for key, path in package_paths().items()
+             if key != '_core.periodic_matrix'
              and (found := private_periodic_matrix_access(path.read_text()))}
     assert users == {}
 
@@ -301,15 +350,18 @@ def test_module_in_two_layers_is_rejected():
 
 
 @pytest.mark.parametrize('source, expected', [
-    ("from ._orbits import periodic_orbit", {'_orbits'}),
-    ("from . import _hybrid", {'_hybrid'}),
-    ("import ltpcontrol._htf as h", {'_htf'}),
-    ("from ltpcontrol._floquet import monodromy", {'_floquet'}),
-    ("def f():\n    from ._realization import floquet_realization\n", {'_realization'}),
+    ("from .._orbits.orbits import periodic_orbit", {'_orbits.orbits'}),
+    ("from .._orbits import hybrid", {'_orbits.hybrid'}),
+    ("from .floquet import monodromy", {'_core.floquet'}),
+    ("from .. import config", {'config'}),
+    ("import ltpcontrol._frequency.htf as h", {'_frequency.htf'}),
+    ("from ltpcontrol._core.floquet import monodromy", {'_core.floquet'}),
+    ("def f():\n    from .._identification.realization import floquet_realization\n",
+     {'_identification.realization'}),
     ("import numpy as np\nfrom scipy import linalg", set()),
 ])
 def test_imports_are_found_everywhere(source, expected):
-    assert package_imports(source) == expected
+    assert package_imports(source, '_core') == expected
 
 
 def test_upward_lazy_import_in_a_source_fails():

@@ -8,9 +8,9 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
-from ltpcontrol._canonical import matrix_errors, to_canonical
-from ltpcontrol._lifting import _real_basis, lift
-from ltpcontrol._ltp_subspace import (identify_ltp, lifted_frequency_response,
+from ltpcontrol._identification.canonical import matrix_errors, to_canonical
+from ltpcontrol._core.lifting import _real_basis, lift
+from ltpcontrol._identification.ltp_subspace import (identify_ltp, lifted_frequency_response,
                                       _harmonic_response)
 from systems import mathieu
 

@@ -60,7 +60,7 @@ def test_interconnections_match_simulated_block_diagrams():
     u = np.sin(3 * t)
     # reference: python-control's own interconnection and ODE solver (its
     # functions as they are without ltpcontrol's dispatch)
-    from ltpcontrol._interop import original
+    from ltpcontrol.interop import original
     Pn = P.copy('P')
     Pn.set_inputs(['r'])
     Pn.set_outputs(['e'])

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 import ltpcontrol as ltp
-from ltpcontrol._march import block_length, periodic_march
+from ltpcontrol._core.march import block_length, periodic_march
 from systems import mathieu, switching_mathieu
 
 
@@ -47,7 +47,7 @@ def test_equals_scalar_recurrence(seed, n, m, p, N, R, L, foh):
 
 
 def test_row_chunks_give_the_same_result(monkeypatch):
-    import ltpcontrol._march as march
+    import ltpcontrol._core.march as march
     args = random_data(np.random.default_rng(1), 3, 2, 2, 10, 7, 333, True)
     whole = periodic_march(*args)
     monkeypatch.setattr(march, '_CHUNK_BYTES', 1)          # one row per matrix product
@@ -69,7 +69,7 @@ def test_block_length_divides_or_repeats_the_period(N, L, expected):
 @pytest.mark.parametrize("hold", ['foh', 'zoh'])
 def test_forced_response_equals_step_recurrence(make, hold):
     # the exact discretization marched one step at a time, from the public step data
-    from ltpcontrol._transition import step_transitions
+    from ltpcontrol._core.transition import step_transitions
     sys = make()
     h = sys.period / 50
     t = 0.13 + h * np.arange(377)                    # starts inside a period
@@ -104,7 +104,7 @@ def test_time_varying_feedthrough_discrete_odd_and_even_N():
 @pytest.mark.parametrize("scale", [1e-4, 1e-2, 0.2, 0.8, 2.0, 5.0, 50.0])
 def test_expm_batch_equals_scipy_at_every_pade_degree(scale):
     import scipy.linalg as sla
-    from ltpcontrol._transition import expm_batch
+    from ltpcontrol._core.transition import expm_batch
     X = np.random.default_rng(2).normal(size=(30, 5, 5)) * scale / 5
     E = expm_batch(X)
     for x, e in zip(X, E):

@@ -8,9 +8,9 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
-from ltpcontrol._lifting import lift
-from ltpcontrol._realization import floquet_realization, FloquetRealization
-from ltpcontrol._canonical import to_canonical, matrix_errors, MatrixErrors
+from ltpcontrol._core.lifting import lift
+from ltpcontrol._identification.realization import floquet_realization, FloquetRealization
+from ltpcontrol._identification.canonical import to_canonical, matrix_errors, MatrixErrors
 
 from systems import mathieu
 
@@ -174,7 +174,7 @@ class TestDirect:
         assert res.success and res.corrected_distance < 1e-18
         assert res.terms['A'] > 1e-3 and res.terms['C'] < 1e-18
         # the literal distance is not scale invariant: d_C shrinks with T
-        from ltpcontrol._realization import _Problem
+        from ltpcontrol._identification.realization import _Problem
         prob = _Problem.from_system(ident, 1, 50, None, 'all')
         T = np.random.default_rng(0).standard_normal((6, 6))
         lit = [prob.distance(c * T[None], literal=True)[1]['C'][0] for c in (1.0, 0.1)]

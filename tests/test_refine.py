@@ -18,7 +18,7 @@ from hypothesis import given, settings, strategies as st
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
-from ltpcontrol._refine import (_Parametrisation, _data_points, _modal, _normalise,
+from ltpcontrol._identification.refine import (_Parametrisation, _data_points, _modal, _normalise,
                                 _response)
 
 
@@ -128,7 +128,7 @@ def test_lifted_response_with_std_and_identify_ltp_start():
     # lifted response: G_n(jΩ) at the input lines Ω (component n at Ω + nω_p)
     Gn = np.stack([ltp.htf(true, K).components(w + n * 2 * np.pi / T)[1][n + K]
                    for n in range(-K, K + 1)])                         # (H, 1, 1, M)
-    from ltpcontrol._lifting import _real_basis
+    from ltpcontrol._core.lifting import _real_basis
     V, _ = _real_basis(np.arange(-K, K + 1), 20)
     frd = ct.frd((V.conj().T @ Gn[:, 0, 0])[:, None, :], w, dt=T / 20)
     start = perturbed(true, 6, 0.05)
@@ -240,7 +240,7 @@ def test_identify_ltp_refine_hook():
     w = 2 * np.pi / T * (np.arange(1, 40) / 8 + 1 / 16)
     H = ltp.htf(true, K)
     Gn = np.stack([H.components(w + n * 2 * np.pi / T)[1][n + K] for n in range(-K, K + 1)])
-    from ltpcontrol._lifting import _real_basis
+    from ltpcontrol._core.lifting import _real_basis
     V, _ = _real_basis(np.arange(-K, K + 1), N)
     rng = np.random.default_rng(0)
     noise = 1e-3 * (rng.standard_normal(Gn.shape) + 1j * rng.standard_normal(Gn.shape))

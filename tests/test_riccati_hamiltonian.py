@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import ltpcontrol as ltp
-from ltpcontrol._periodic_matrix import as_periodic
-from ltpcontrol._riccati import _hamiltonian
+from ltpcontrol._core.periodic_matrix import as_periodic
+from ltpcontrol._analysis.riccati import _hamiltonian
 
 
 def _fourier(rng, K, n, m, T, sym=False):

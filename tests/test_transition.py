@@ -5,8 +5,8 @@ import pytest
 import scipy.linalg as sla
 
 import ltpcontrol as ltp
-from ltpcontrol._steps import step_integrals
-from ltpcontrol._transition import _segments, step_transitions
+from ltpcontrol._core.steps import step_integrals
+from ltpcontrol._core.transition import _segments, step_transitions
 
 
 def segments_by_loop(t0, h, bps, period):

@@ -11,7 +11,7 @@ import pytest
 import scipy.linalg as la
 
 import ltpcontrol as ltp
-from ltpcontrol._transition import step_transitions
+from ltpcontrol._core.transition import step_transitions
 
 C1, C2 = 0.5 - np.sqrt(3) / 6, 0.5 + np.sqrt(3) / 6
 

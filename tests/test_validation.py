@@ -6,7 +6,7 @@ import pytest
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
-from ltpcontrol._validation import (TIME_RTOL, as_ltp, check_period, check_positive,
+from ltpcontrol._core.validation import (TIME_RTOL, as_ltp, check_period, check_positive,
                                     time_record)
 
 SYS = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)

@@ -1,7 +1,7 @@
 """Periodic LQR, Kalman filters and LQG controllers.
 
 The gains come from the stabilizing periodic Riccati solutions of
-`ltpcontrol._riccati`.  LQR: ``K = R⁻¹(BᵀX + Nᵀ)`` (continuous),
+`ltpcontrol._analysis.riccati`.  LQR: ``K = R⁻¹(BᵀX + Nᵀ)`` (continuous),
 ``K_k = (R_k + B_kᵀX_{k+1}B_k)⁻¹(B_kᵀX_{k+1}A_k + N_kᵀ)`` (discrete).
 
 Kalman filters by duality.  Continuous time: the filter Riccati equation
@@ -19,11 +19,11 @@ import numpy as np
 from control import LTI, common_timebase
 from control.exception import ControlArgument, ControlDimension
 
-from ._floquet import lti_representatives
-from ._ltpsys import LTPStateSpace, series
-from ._periodic_matrix import PeriodicMatrix, as_periodic
-from ._riccati import _check_weights, care, dare
-from ._validation import as_ltp, check_method, real_array
+from .._core.floquet import lti_representatives
+from .._core.ltpsys import LTPStateSpace, series
+from .._core.periodic_matrix import PeriodicMatrix, as_periodic
+from .riccati import _check_weights, care, dare
+from .._core.validation import as_ltp, check_method, real_array
 
 __all__ = ['lqr', 'dlqr', 'lqe', 'dlqe', 'lqg']
 

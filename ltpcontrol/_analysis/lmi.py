@@ -29,9 +29,9 @@ from dataclasses import dataclass
 import numpy as np
 from control.exception import ControlArgument
 
-from ._floquet import _log_multipliers
-from ._periodic_matrix import PeriodicMatrix
-from ._validation import as_ltp
+from .._core.floquet import _log_multipliers
+from .._core.periodic_matrix import PeriodicMatrix
+from .._core.validation import as_ltp
 
 __all__ = ['lmi_statefbk', 'LMIDesign']
 

@@ -27,10 +27,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from control.exception import ControlArgument, ControlDimension
 
-from ._floquet import _log_multipliers
-from ._periodic_matrix import PeriodicMatrix, as_periodic
-from ._steps import step_grid, step_integrals
-from ._validation import as_ltp, real_array
+from .._core.floquet import _log_multipliers
+from .._core.periodic_matrix import PeriodicMatrix, as_periodic
+from .._core.steps import step_grid, step_integrals
+from .._core.validation import as_ltp, real_array
 
 __all__ = ['lyap', 'dlyap', 'gram']
 
@@ -211,7 +211,7 @@ def cyclic_lyap(Phi, W, adjoint=False, check=True):
 
     Examples
     --------
-    >>> from ltpcontrol._lyapunov import cyclic_lyap
+    >>> from ltpcontrol._analysis.lyapunov import cyclic_lyap
     >>> X = cyclic_lyap(np.array([[[0.5]], [[3.0]]]), np.ones((2, 1, 1)))
     >>> X[:, 0, 0]          # X1 = X0/4 + 1, X0 = 9 X1 + 1
     array([-8., -1.])
@@ -252,7 +252,7 @@ def check_unique(Phi):
 
     Examples
     --------
-    >>> from ltpcontrol._lyapunov import check_unique
+    >>> from ltpcontrol._analysis.lyapunov import check_unique
     >>> check_unique(np.array([[[2.0, 0.0], [0.0, 0.5]]]))
     Traceback (most recent call last):
     ...
@@ -281,7 +281,7 @@ def periodic_solution(A, Q, grid, X, adjoint):
     For ``Ẋ = -2X + 2`` (A = -1, Q = 2) the grid values ``X(0) = 0``,
     ``X(0.5) = 1 - e^{-1}`` are joined by ``X(t) = 1 - e^{-2t}``:
 
-    >>> from ltpcontrol._lyapunov import periodic_solution
+    >>> from ltpcontrol._analysis.lyapunov import periodic_solution
     >>> A = ltp.PeriodicMatrix.constant([[-1.0]], 1.0)
     >>> Q = ltp.PeriodicMatrix.constant([[2.0]], 1.0)
     >>> X = periodic_solution(A, Q, np.array([0.0, 0.5, 1.0]),

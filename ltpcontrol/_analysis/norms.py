@@ -29,14 +29,14 @@ import numpy as np
 import control as ct
 from scipy.optimize import minimize_scalar
 
-from ._floquet import _log_multipliers
-from ._harmonic_ss import _HarmonicStateSpace, _internal_order
-from ._lifting import lift
-from ._lyapunov import cyclic_lyap, periodic_solution
-from ._periodic_matrix import PeriodicMatrix
-from ._steps import gram_weight, step_grid, step_integrals
-from ._transition import step_transitions
-from ._validation import as_ltp, check_method
+from .._core.floquet import _log_multipliers
+from .._frequency.harmonic_ss import _HarmonicStateSpace, _internal_order
+from .._core.lifting import lift
+from .lyapunov import cyclic_lyap, periodic_solution
+from .._core.periodic_matrix import PeriodicMatrix
+from .._core.steps import gram_weight, step_grid, step_integrals
+from .._core.transition import step_transitions
+from .._core.validation import as_ltp, check_method
 
 __all__ = ['norm']
 

@@ -40,10 +40,10 @@ import numpy as np
 import scipy.linalg as la
 from scipy.optimize import linear_sum_assignment
 
-from ._floquet import chebyshev_nodes, piecewise_chebyshev
-from ._lyapunov import lyap
-from ._periodic_matrix import PeriodicMatrix
-from ._steps import gram_weight, step_grid
+from .._core.floquet import chebyshev_nodes, piecewise_chebyshev
+from .lyapunov import lyap
+from .._core.periodic_matrix import PeriodicMatrix
+from .._core.steps import gram_weight, step_grid
 
 __all__ = []
 
@@ -59,7 +59,7 @@ def gramians(sys, nsteps=None):
     --------
     For an LTI system the gramians are the constant ones of python-control:
 
-    >>> from ltpcontrol._periodic_balancing import gramians
+    >>> from ltpcontrol._analysis.periodic_balancing import gramians
     >>> G = ct.ss([[-1.0, 0.0], [1.0, -4.0]], [[1.0], [0.0]], [[0.0, 1.0]], 0)
     >>> P, Q = gramians(ltp.ltpss(G, period=1.0))
     >>> bool(np.allclose(P(0.3), ct.gram(G, 'c'))), bool(np.allclose(Q(0.3), ct.gram(G, 'o')))
@@ -75,7 +75,7 @@ def sqrt_factor(X):
 
     Examples
     --------
-    >>> from ltpcontrol._periodic_balancing import sqrt_factor
+    >>> from ltpcontrol._analysis.periodic_balancing import sqrt_factor
     >>> X = np.array([[[4.0, 2.0], [2.0, 2.0]], [[1.0, 0.0], [0.0, 0.0]]])
     >>> S = sqrt_factor(X)
     >>> S.shape, bool(np.allclose(S @ np.swapaxes(S, 1, 2), X))
@@ -92,7 +92,7 @@ def hankel_svd(P, Q):
     --------
     The singular values are those of python-control for an LTI system:
 
-    >>> from ltpcontrol._periodic_balancing import hankel_svd
+    >>> from ltpcontrol._analysis.periodic_balancing import hankel_svd
     >>> G = ct.ss([[-1.0, 0.0], [1.0, -4.0]], [[1.0], [0.0]], [[0.0, 1.0]], 0)
     >>> S, R, U, hsv, Vt = hankel_svd(ct.gram(G, 'c')[None], ct.gram(G, 'o')[None])
     >>> hsv.shape, bool(np.allclose(hsv[0], ct.hankel_singular_values(G)))
@@ -114,7 +114,7 @@ def truncate(sys, r, nsteps=None):
     An LTI system gives python-control's balanced truncation (up to the
     state's scale), and the bound term is the discarded singular value:
 
-    >>> from ltpcontrol._periodic_balancing import truncate
+    >>> from ltpcontrol._analysis.periodic_balancing import truncate
     >>> G = ct.ss([[-1.0, 0.0], [1.0, -4.0]], [[1.0], [0.0]], [[0.0, 1.0]], 0)
     >>> (Ar, Br, Cr), sup = truncate(ltp.ltpss(G, period=1.0), 1)
     >>> red = ct.balred(G, 1)
@@ -231,7 +231,7 @@ def branches(hsv, vectors):
     Two close values whose eigenvectors trade places: the branch along ``e_1``
     moves from column 0 to column 1.
 
-    >>> from ltpcontrol._periodic_balancing import branches
+    >>> from ltpcontrol._analysis.periodic_balancing import branches
     >>> hsv = np.array([[1.1, 1.0], [1.1, 1.0]])
     >>> vectors = np.array([np.eye(2), np.eye(2)[:, ::-1]])
     >>> branches(hsv, vectors)

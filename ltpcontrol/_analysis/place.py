@@ -26,10 +26,10 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
-from ._discretize import sample_system
-from ._floquet import _log_multipliers
-from ._periodic_matrix import PeriodicMatrix
-from ._validation import as_ltp, real_array
+from .._core.discretize import sample_system
+from .._core.floquet import _log_multipliers
+from .._core.periodic_matrix import PeriodicMatrix
+from .._core.validation import as_ltp, real_array
 
 __all__ = ['place']
 

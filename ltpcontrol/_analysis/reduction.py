@@ -30,10 +30,10 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
-from ._ltpsys import LTPStateSpace
-from ._lyapunov import dlyap
-from ._periodic_balancing import gramians, hankel_svd, truncate
-from ._validation import as_ltp, check_positive_int, real_array
+from .._core.ltpsys import LTPStateSpace
+from .lyapunov import dlyap
+from .periodic_balancing import gramians, hankel_svd, truncate
+from .._core.validation import as_ltp, check_positive_int, real_array
 
 __all__ = ['hsvd', 'balred', 'minreal']
 

@@ -35,7 +35,7 @@ Both cases then share one algorithm:
    condition (one Stein equation each) and checked;
 4. the closed-loop step factors (``U`` of ``Ψ_k [I; X_k]``, or
    ``A_k - B_k G_k``) give the closed-loop multipliers through the
-   periodic Schur form (`ltpcontrol._floquet`).
+   periodic Schur form (`ltpcontrol._core.floquet`).
 
 Values inside a step ``[t_k, t_{k+1}]`` are ``X(t) = V U⁻¹`` with
 ``[U; V] = Φ_H(t_{k+1}, t)⁻¹ [I; X_{k+1}]`` (the backward flow, which
@@ -50,11 +50,11 @@ import numpy as np
 import scipy.linalg as la
 from control.exception import ControlArgument, ControlDimension
 
-from ._floquet import _log_multipliers, chebyshev_nodes, lti_representatives, piecewise_chebyshev
-from ._periodic_matrix import PeriodicMatrix, as_periodic
-from ._steps import step_grid
-from ._transition import step_transitions
-from ._validation import check_period, real_array
+from .._core.floquet import _log_multipliers, chebyshev_nodes, lti_representatives, piecewise_chebyshev
+from .._core.periodic_matrix import PeriodicMatrix, as_periodic
+from .._core.steps import step_grid
+from .._core.transition import step_transitions
+from .._core.validation import check_period, real_array
 
 __all__ = ['care', 'dare']
 

@@ -20,9 +20,9 @@ import numpy as np
 import scipy.linalg as la
 from control.exception import ControlDimension
 
-from ._harmonic_ss import _toeplitz
-from ._lifting import lift
-from ._validation import as_ltp, check_positive_int
+from .._frequency.harmonic_ss import _toeplitz
+from .._core.lifting import lift
+from .._core.validation import as_ltp, check_positive_int
 
 __all__ = ['zeros']
 

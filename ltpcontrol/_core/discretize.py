@@ -26,10 +26,10 @@ import numpy as np
 import scipy.linalg as la
 import control as ct
 
-from ._ltpsys import LTPStateSpace
-from ._periodic_matrix import PeriodicMatrix
-from ._transition import expm_batch, step_transitions
-from ._validation import as_ltp, check_positive, steps_per_period
+from .ltpsys import LTPStateSpace
+from .periodic_matrix import PeriodicMatrix
+from .transition import expm_batch, step_transitions
+from .validation import as_ltp, check_positive, steps_per_period
 
 __all__ = ['sample_system', 'd2c']
 

@@ -21,7 +21,7 @@ def describe(M, nsteps=None):
 
     Examples
     --------
-    >>> from ltpcontrol._display import describe
+    >>> from ltpcontrol._core.display import describe
     >>> describe(ltp.PeriodicMatrix.constant(np.eye(2), 1.0))
     'constant'
     >>> M = ltp.PeriodicMatrix(np.array([[[0.5]], [[1.0]], [[0.5]]]), 2 * np.pi)
@@ -48,7 +48,7 @@ def text(sys):
 
     Examples
     --------
-    >>> from ltpcontrol._display import text
+    >>> from ltpcontrol._core.display import text
     >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=2.0, name='P')
     >>> text(sys) == str(sys)
     True
@@ -77,7 +77,7 @@ def html(sys):
 
     Examples
     --------
-    >>> from ltpcontrol._display import html
+    >>> from ltpcontrol._core.display import html
     >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=2.0)
     >>> html(sys) == sys._repr_html_(), 'T = 2' in html(sys)
     (True, True)

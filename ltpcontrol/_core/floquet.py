@@ -27,11 +27,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from control.exception import ControlArgument
 
-from ._ltpsys import ltpss
-from ._periodic_matrix import PeriodicMatrix
-from ._steps import step_grid
-from ._transition import expm_batch, step_transitions
-from ._validation import as_ltp, check_kwargs, check_positive_int, steps_per_period
+from .ltpsys import ltpss
+from .periodic_matrix import PeriodicMatrix
+from .steps import step_grid
+from .transition import expm_batch, step_transitions
+from .validation import as_ltp, check_kwargs, check_positive_int, steps_per_period
 
 __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
            'is_stable', 'floquet_transform']
@@ -183,7 +183,7 @@ def lti_representatives(values, A, *, period=None, nper=None):
     --------
     Exponents known modulo ``2πj/T`` are mapped back onto the eigenvalues of A:
 
-    >>> from ltpcontrol._floquet import lti_representatives
+    >>> from ltpcontrol._core.floquet import lti_representatives
     >>> A = np.diag([-1.0, -3.0])
     >>> lti_representatives([-3 + 2j * np.pi, -1 - 4j * np.pi], A, period=1.0).real
     array([-3., -1.])
@@ -587,7 +587,7 @@ def chebyshev_nodes(degree):
 
     Examples
     --------
-    >>> from ltpcontrol._floquet import chebyshev_nodes
+    >>> from ltpcontrol._core.floquet import chebyshev_nodes
     >>> chebyshev_nodes(2)
     array([0. , 0.5, 1. ])
     >>> c = chebyshev_nodes(5)
@@ -609,7 +609,7 @@ def piecewise_chebyshev(grid, values):
     Degree-3 nodes reproduce ``t³`` exactly on each interval, and t is taken
     modulo the period ``grid[-1] = 3``:
 
-    >>> from ltpcontrol._floquet import chebyshev_nodes, piecewise_chebyshev
+    >>> from ltpcontrol._core.floquet import chebyshev_nodes, piecewise_chebyshev
     >>> grid = np.array([0.0, 1.0, 3.0])
     >>> t = grid[:-1, None] + np.diff(grid)[:, None] * chebyshev_nodes(3)
     >>> f = piecewise_chebyshev(grid, t ** 3)

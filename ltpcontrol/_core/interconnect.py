@@ -20,8 +20,8 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
-from ._interop import original
-from ._ltpsys import LTPStateSpace, _loop_inverse, _period_and_dt, _to_ltp, append
+from ..interop import original
+from .ltpsys import LTPStateSpace, _loop_inverse, _period_and_dt, _to_ltp, append
 
 __all__ = ['interconnect']
 

@@ -29,7 +29,7 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
-from ._validation import as_ltp, check_kwargs, check_positive_int
+from .validation import as_ltp, check_kwargs, check_positive_int
 
 __all__ = ['lift']
 

@@ -21,10 +21,10 @@ from control.exception import ControlArgument, ControlDimension
 from control.iosys import _process_iosys_keywords
 from control.nlsys import NonlinearIOSystem
 
-from ._display import html, text
-from ._htf import htf
-from ._periodic_matrix import PeriodicMatrix, as_periodic
-from ._validation import (as_ltp, check_period, check_positive, commensurate, real_array,
+from .display import html, text
+from .._frequency.htf import htf
+from .periodic_matrix import PeriodicMatrix, as_periodic
+from .validation import (as_ltp, check_period, check_positive, commensurate, real_array,
                           steps_per_period)
 
 __all__ = ['LTPStateSpace', 'ltpss', 'series', 'parallel', 'feedback',
@@ -216,7 +216,7 @@ class LTPStateSpace(NonlinearIOSystem):
         return ct.ss(self.A(t), self.B(t), self.C(t), self.D(t), self.dt, **kwargs)
 
     def __call__(self, *args, **kwargs):
-        from ._interop import _refusal
+        from ..interop import _refusal
         raise _refusal("evaluation sys(s) of a transfer function",
                        "ltp.htf(sys, nharmonics)(s), the harmonic transfer function")
 
@@ -246,17 +246,17 @@ class LTPStateSpace(NonlinearIOSystem):
 
     def monodromy(self, **kwargs):
         """State transition matrix over one period, ``Φ(T, 0)``; see `ltpcontrol.monodromy`."""
-        from ._floquet import monodromy
+        from .floquet import monodromy
         return monodromy(self, **kwargs)
 
     def floquet_multipliers(self, **kwargs):
         """Characteristic multipliers; see `ltpcontrol.floquet_multipliers`."""
-        from ._floquet import floquet_multipliers
+        from .floquet import floquet_multipliers
         return floquet_multipliers(self, **kwargs)
 
     def floquet_exponents(self, **kwargs):
         """Characteristic exponents; see `ltpcontrol.floquet_exponents`."""
-        from ._floquet import floquet_exponents
+        from .floquet import floquet_exponents
         return floquet_exponents(self, **kwargs)
 
     def poles(self):
@@ -273,22 +273,22 @@ class LTPStateSpace(NonlinearIOSystem):
     # -- LTI-only requests: a clear pointer to the LTP counterpart --
     def frequency_response(self, omega=None, squeeze=None):
         """Not defined for an LTP system: its frequency response is the HTF (`ltpcontrol.htf`)."""
-        from ._interop import refusal
+        from ..interop import refusal
         raise refusal('frequency_response')
 
     def dcgain(self, warn_infinite=False):
         """Not defined for an LTP system; see `ltpcontrol.htf`."""
-        from ._interop import refusal
+        from ..interop import refusal
         raise refusal('dcgain')
 
     def zeros(self, nharmonics=None, *, rtol=1e-8):
         """Transmission zeros; see `ltpcontrol.zeros` (so `control.zeros` works)."""
-        from ._zeros import zeros
+        from .._analysis.zeros import zeros
         return zeros(self, nharmonics, rtol=rtol)
 
     def is_stable(self, **kwargs):
         """True when all Floquet multipliers lie inside the unit circle."""
-        from ._floquet import is_stable
+        from .floquet import is_stable
         return is_stable(self, **kwargs)
 
     def htf(self, nharmonics, **kwargs):
@@ -298,7 +298,7 @@ class LTPStateSpace(NonlinearIOSystem):
     def sample(self, Ts, method='zoh', alpha=None, prewarp_frequency=None,
                name=None, copy_names=True, **kwargs):
         """Discretize the system; see `ltpcontrol.sample_system`."""
-        from ._discretize import sample_system
+        from .discretize import sample_system
         return sample_system(self, Ts, method=method, alpha=alpha,
                              prewarp_frequency=prewarp_frequency, name=name,
                              copy_names=copy_names, **kwargs)

@@ -51,7 +51,7 @@ def block_length(N, L):
 
     Examples
     --------
-    >>> from ltpcontrol._march import block_length
+    >>> from ltpcontrol._core.march import block_length
     >>> block_length(50, 20001), block_length(37, 1000), block_length(2, 1000)
     (25, 37, 20)
     """
@@ -83,7 +83,7 @@ def periodic_march(Phi, E, F, C, D, u, x0):
 
     Examples
     --------
-    >>> from ltpcontrol._march import periodic_march
+    >>> from ltpcontrol._core.march import periodic_march
     >>> Phi = np.array([[[0.5]], [[2.0]]])               # x[k+1] = Φ_k x[k] + u[k]
     >>> E, C, D = np.ones((2, 1, 1)), np.ones((2, 1, 1)), np.zeros((2, 1, 1))
     >>> x, y = periodic_march(Phi, E, None, C, D, np.ones((1, 1, 5)), np.ones((1, 1)))

@@ -10,7 +10,7 @@ signals over the last axis; restrict the arrays to the evaluation window
 import numpy as np
 from control.exception import ControlDimension
 
-from ._validation import real_array
+from .validation import real_array
 
 __all__ = ['e_rms', 'nrmse']
 

@@ -20,8 +20,8 @@ import warnings
 import numpy as np
 from control.exception import ControlDimension
 
-from ._display import describe
-from ._validation import check_period, check_positive_int, commensurate, real_array
+from .display import describe
+from .validation import check_period, check_positive_int, commensurate, real_array
 
 __all__ = ['PeriodicMatrix']
 
@@ -699,7 +699,7 @@ def as_periodic(value, period, name, shape=None):
 
     Examples
     --------
-    >>> from ltpcontrol._periodic_matrix import as_periodic
+    >>> from ltpcontrol._core.periodic_matrix import as_periodic
     >>> as_periodic([[1.0, 0.0]], 2.0, 'C').shape
     (1, 2)
     """

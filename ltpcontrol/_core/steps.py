@@ -28,9 +28,9 @@ The steps are short (``h ‖A‖ <= 1`` by default), so the growing blocks
 
 import numpy as np
 
-from ._periodic_matrix import PeriodicMatrix
-from ._transition import step_transitions
-from ._validation import check_positive_int
+from .periodic_matrix import PeriodicMatrix
+from .transition import step_transitions
+from .validation import check_positive_int
 
 __all__ = []
 
@@ -44,7 +44,7 @@ def step_grid(A, others=(), nsteps=None):
 
     Examples
     --------
-    >>> from ltpcontrol._steps import step_grid
+    >>> from ltpcontrol._core.steps import step_grid
     >>> A = ltp.PeriodicMatrix.switching([[[-1.0]], [[-2.0]]], [0, 0.3], 1.0)
     >>> step_grid(A, nsteps=2)
     array([0. , 0.3, 0.5, 1. ])
@@ -75,7 +75,7 @@ def gram_weight(F, adjoint=False):
 
     Examples
     --------
-    >>> from ltpcontrol._steps import gram_weight
+    >>> from ltpcontrol._core.steps import gram_weight
     >>> C = ltp.PeriodicMatrix.constant([[1.0, 2.0]], 1.0)
     >>> gram_weight(C, adjoint=True)(0.0)
     array([[1., 2.],
@@ -109,7 +109,7 @@ def step_integrals(A, t0, h, Qf=None, Qa=None):
     --------
     Scalar ``ẋ = -x``: ``W = ∫_0^h e^{-2(h-s)} ds = (1 - e^{-2h})/2``.
 
-    >>> from ltpcontrol._steps import step_integrals
+    >>> from ltpcontrol._core.steps import step_integrals
     >>> A = ltp.PeriodicMatrix.constant([[-1.0]], 1.0)
     >>> Q = ltp.PeriodicMatrix.constant([[1.0]], 1.0)
     >>> Phi, W, V, S = step_integrals(A, np.array([0.0]), np.array([0.5]), Qf=Q)

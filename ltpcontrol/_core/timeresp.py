@@ -22,9 +22,9 @@ from control.exception import ControlDimension
 from control.timeresp import _default_time_vector, _timeresp_aliases
 from scipy.integrate import solve_ivp
 
-from ._march import periodic_march
-from ._transition import step_transitions
-from ._validation import as_ltp, check_kwargs, check_positive, real_array
+from .march import periodic_march
+from .transition import step_transitions
+from .validation import as_ltp, check_kwargs, check_positive, real_array
 
 __all__ = ['forced_response', 'step_response', 'initial_response', 'impulse_response']
 

@@ -50,7 +50,7 @@ def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=4096):
 
     Examples
     --------
-    >>> from ltpcontrol._transition import step_transitions
+    >>> from ltpcontrol._core.transition import step_transitions
     >>> A = ltp.PeriodicMatrix.constant([[-1.0]], 1.0)
     >>> B = ltp.PeriodicMatrix.constant([[1.0]], 1.0)
     >>> Phi, G0, G1 = step_transitions(A, B, np.array([0.0]), 0.5)
@@ -183,7 +183,7 @@ def expm_batch(X):
 
     Examples
     --------
-    >>> from ltpcontrol._transition import expm_batch
+    >>> from ltpcontrol._core.transition import expm_batch
     >>> E = expm_batch(np.array([[[0.0, 1.0], [0.0, 0.0]]]))
     >>> E[0]
     array([[1., 1.],

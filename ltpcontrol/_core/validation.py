@@ -20,7 +20,7 @@ import control as ct
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
-from .config import _get
+from ..config import _get
 
 __all__ = []
 
@@ -49,7 +49,7 @@ def as_ltp(sys, name="sys", *, period=None, discrete=None, lti_hint=None):
 
     Examples
     --------
-    >>> from ltpcontrol._validation import as_ltp
+    >>> from ltpcontrol._core.validation import as_ltp
     >>> as_ltp(ct.ss(-1, 1, 1, 0), period=2.0).period
     2.0
     >>> as_ltp(ct.ss(-1, 1, 1, 0), lti_hint='control.forced_response')
@@ -58,7 +58,7 @@ def as_ltp(sys, name="sys", *, period=None, discrete=None, lti_hint=None):
     control.exception.ControlArgument: sys must be an LTPStateSpace; it is an LTI system: use control.forced_response, or convert it with ltpss(sys, period)
     """
     # _ltpsys imports this module: the system class is looked up at call time
-    from ._ltpsys import LTPStateSpace, ltpss
+    from .ltpsys import LTPStateSpace, ltpss
     if isinstance(sys, LTPStateSpace):
         if period is not None:
             raise TypeError(f"the period is taken from the LTPStateSpace {name}; "
@@ -83,7 +83,7 @@ def check_kwargs(kwargs, where):
 
     Examples
     --------
-    >>> from ltpcontrol._validation import check_kwargs
+    >>> from ltpcontrol._core.validation import check_kwargs
     >>> check_kwargs({'colour': 1}, 'plot')
     Traceback (most recent call last):
     ...
@@ -101,7 +101,7 @@ def check_positive(value, name, below=None):
 
     Examples
     --------
-    >>> from ltpcontrol._validation import check_positive
+    >>> from ltpcontrol._core.validation import check_positive
     >>> check_positive(0.01, 'dt')
     0.01
     >>> check_positive(0, 'Ts')
@@ -127,7 +127,7 @@ def check_method(method):
 
     Examples
     --------
-    >>> from ltpcontrol._validation import check_method
+    >>> from ltpcontrol._core.validation import check_method
     >>> check_method('scipy')
     >>> check_method('fast')
     Traceback (most recent call last):
@@ -143,7 +143,7 @@ def check_period(period, name="period"):
 
     Examples
     --------
-    >>> from ltpcontrol._validation import check_period
+    >>> from ltpcontrol._core.validation import check_period
     >>> check_period(2)
     2.0
     """
@@ -155,7 +155,7 @@ def check_positive_int(value, name, minimum=1):
 
     Examples
     --------
-    >>> from ltpcontrol._validation import check_positive_int
+    >>> from ltpcontrol._core.validation import check_positive_int
     >>> check_positive_int(3.0, 'nharmonics', minimum=0)
     3
     """
@@ -187,7 +187,7 @@ def real_array(data, name, ndim=None, allow_complex=False):
 
     Examples
     --------
-    >>> from ltpcontrol._validation import real_array
+    >>> from ltpcontrol._core.validation import real_array
     >>> real_array([[1, 2]], 'B', ndim=2)
     array([[1., 2.]])
     """
@@ -228,7 +228,7 @@ def commensurate(a, b, rtol=None, max_multiple=None):
 
     Examples
     --------
-    >>> from ltpcontrol._validation import commensurate
+    >>> from ltpcontrol._core.validation import commensurate
     >>> commensurate(0.5, 1.5)
     1.5
     >>> commensurate(1.0, 1.5)
@@ -250,7 +250,7 @@ def steps_per_period(period, dt, name="dt"):
 
     Examples
     --------
-    >>> from ltpcontrol._validation import steps_per_period
+    >>> from ltpcontrol._core.validation import steps_per_period
     >>> steps_per_period(0.5, 0.01)
     50
     """
@@ -288,7 +288,7 @@ def time_record(t, signals, *, tname="t", min_samples=2):
 
     Examples
     --------
-    >>> from ltpcontrol._validation import time_record
+    >>> from ltpcontrol._core.validation import time_record
     >>> t, dt, (u,) = time_record([0.0, 0.5, 1.0], {'u': [1, 2, 3]})
     >>> dt, u.shape
     (0.5, (1, 3))

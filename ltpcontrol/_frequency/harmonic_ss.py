@@ -26,9 +26,9 @@ import control as ct
 from scipy import sparse
 from tqdm.auto import tqdm
 
-from . import config
-from ._lifting import _frequency_lift, _full_harmonics, _harmonic_labels, _real_basis
-from ._validation import as_ltp, check_positive_int
+from .. import config
+from .._core.lifting import _frequency_lift, _full_harmonics, _harmonic_labels, _real_basis
+from .._core.validation import as_ltp, check_positive_int
 
 __all__ = ['harmonic_ss']
 
@@ -90,7 +90,7 @@ def build(sys, K, internal_harmonics, method, where, stacklevel=2):
 
     Examples
     --------
-    >>> from ltpcontrol._harmonic_ss import build
+    >>> from ltpcontrol._frequency.harmonic_ss import build
     >>> sys = ltp.ltpss(ct.tf([1], [1, 1]), period=1.0)
     >>> hss = build(sys, 2, None, 'auto', 'harmonic_ss')
     >>> hss.K, hss.F.shape                      # harmonics -2..2 of one state
@@ -128,7 +128,7 @@ def real_ss(hss, name, inputs, outputs, states):
 
     Examples
     --------
-    >>> from ltpcontrol._harmonic_ss import build, real_ss
+    >>> from ltpcontrol._frequency.harmonic_ss import build, real_ss
     >>> G = ct.tf([1], [1, 1])
     >>> sys = ltp.ltpss(G, period=1.0)
     >>> Hs = real_ss(build(sys, 2, None, 'auto', 'harmonic_ss'), 'H',

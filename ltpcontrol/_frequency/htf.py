@@ -21,9 +21,9 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument, ControlDimension
 
-from . import config
-from ._harmonic_ss import build, real_ss
-from ._validation import as_ltp, check_period, check_positive_int, real_array
+from .. import config
+from .harmonic_ss import build, real_ss
+from .._core.validation import as_ltp, check_period, check_positive_int, real_array
 
 __all__ = ['HTF', 'HTFModel', 'HTFData', 'htf']
 
@@ -313,7 +313,7 @@ class HTF(abc.ABC):
         'ControlPlot'
         """
         # _htfplot draws HTF objects, so it imports this module: a true cycle
-        from ._htfplot import bode_htf
+        from .htfplot import bode_htf
         return bode_htf(self, *args, **kwargs)
 
     #
@@ -569,7 +569,7 @@ def default_omega(H, omega_limits=None, omega_num=None):
     --------
     From ``ω_p/100`` to ``10 K ω_p``, here with ``ω_p = 1`` and K = 2:
 
-    >>> from ltpcontrol._htf import default_omega
+    >>> from ltpcontrol._frequency.htf import default_omega
     >>> H = ltp.htf(ct.ss(ct.tf([1], [1, 1])), 2, period=2 * np.pi)
     >>> w = default_omega(H, omega_num=50)
     >>> len(w), round(float(w[0]), 6), round(float(w[-1]), 6)

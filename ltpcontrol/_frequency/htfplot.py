@@ -14,8 +14,8 @@ import matplotlib.axes
 import matplotlib.pyplot as plt
 from control.exception import ControlArgument
 
-from ._htf import HTF, HTFData, _harmonic, default_omega
-from ._validation import real_array
+from .htf import HTF, HTFData, _harmonic, default_omega
+from .._core.validation import real_array
 
 __all__ = ['htf_response', 'bode_htf', 'htf_map_plot']
 

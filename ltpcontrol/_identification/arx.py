@@ -21,8 +21,8 @@ estimator-based (LQG) controller.
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
-from ._ltpsys import LTPStateSpace
-from ._validation import (check_kwargs, check_period, check_positive_int, real_array,
+from .._core.ltpsys import LTPStateSpace
+from .._core.validation import (check_kwargs, check_period, check_positive_int, real_array,
                           steps_per_period)
 
 __all__ = ['identify_arx']

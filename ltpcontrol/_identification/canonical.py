@@ -26,10 +26,10 @@ import numpy as np
 from control.exception import ControlArgument, ControlDimension
 from scipy.optimize import linear_sum_assignment
 
-from ._ltpsys import ltpss
-from ._floquet import floquet_exponents
-from ._htf import htf
-from ._validation import as_ltp, check_kwargs, check_positive_int, real_array
+from .._core.ltpsys import ltpss
+from .._core.floquet import floquet_exponents
+from .._frequency.htf import htf
+from .._core.validation import as_ltp, check_kwargs, check_positive_int, real_array
 
 __all__ = ['to_canonical', 'matrix_errors', 'MatrixErrors', 'compare_ltp', 'LTPComparison']
 

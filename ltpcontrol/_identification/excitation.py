@@ -32,7 +32,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 from control.exception import ControlArgument
 
-from ._validation import (check_kwargs, check_period, check_positive, check_positive_int,
+from .._core.validation import (check_kwargs, check_period, check_positive, check_positive_int,
                           real_array, steps_per_period)
 
 __all__ = ['chirp_replicas', 'multisine', 'sine_experiments', 'Excitation']

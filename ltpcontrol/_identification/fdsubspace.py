@@ -22,7 +22,7 @@ import control as ct
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
-from ._validation import check_positive, check_positive_int, real_array
+from .._core.validation import check_positive, check_positive_int, real_array
 
 __all__ = ["fdsubspace", "FDSubspaceInfo"]
 

@@ -27,9 +27,9 @@ M)``: entry ``[j, n + K, :, w]`` is ``G_n(jΩ_w)`` of input j.
 
 import numpy as np
 
-from ._lifting import _real_basis
-from ._ltpsys import LTPStateSpace
-from ._periodic_matrix import PeriodicMatrix
+from .._core.lifting import _real_basis
+from .._core.ltpsys import LTPStateSpace
+from .._core.periodic_matrix import PeriodicMatrix
 
 __all__ = []
 
@@ -175,7 +175,7 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
     Fitted to the exact response of ``ẋ = -2x + (1 + cos t) u``, a start at
     ``A = -1.5`` recovers the exponent:
 
-    >>> from ltpcontrol._floquet_fit import fit_floquet, _harmonic_response
+    >>> from ltpcontrol._identification.floquet_fit import fit_floquet, _harmonic_response
     >>> B = ltp.PeriodicMatrix(np.array([[[0.5]], [[1.0]], [[0.5]]]), 2 * np.pi)
     >>> omega = np.linspace(0.1, 3.0, 8)
     >>> Gc = _harmonic_response(ltp.ltpss([[-2.0]], B, [[1.0]], 0, period=2 * np.pi), omega, 1)

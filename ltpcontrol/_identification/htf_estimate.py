@@ -40,8 +40,8 @@ from control.exception import ControlArgument, ControlDimension
 from control.timeresp import TimeResponseData
 from tqdm.auto import tqdm
 
-from ._htf import HTFData
-from ._validation import (check_period, check_positive_int,
+from .._frequency.htf import HTFData
+from .._core.validation import (check_period, check_positive_int,
                           real_array, steps_per_period)
 
 __all__ = ['estimate_htf', 'HTFEstimateInfo']

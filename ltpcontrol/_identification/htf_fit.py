@@ -24,8 +24,8 @@ import numpy as np
 import scipy.optimize
 from control.exception import ControlArgument, ControlDimension
 
-from ._htf import HTF, HTFData
-from ._validation import check_kwargs, real_array
+from .._frequency.htf import HTF, HTFData
+from .._core.validation import check_kwargs, real_array
 
 __all__ = ['fit_htf', 'estimate_delays', 'HTFFit', 'DelayEstimate']
 

@@ -23,9 +23,9 @@ import warnings
 import numpy as np
 from control.exception import ControlDimension
 
-from ._ltpsys import ltpss
-from ._periodic_matrix import PeriodicMatrix
-from ._validation import (check_period, check_positive, check_positive_int, real_array,
+from .._core.ltpsys import ltpss
+from .._core.periodic_matrix import PeriodicMatrix
+from .._core.validation import (check_period, check_positive, check_positive_int, real_array,
                           time_record)
 
 __all__ = ["hybrid_ls", "HybridLSResult"]

@@ -25,10 +25,10 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 from tqdm.auto import tqdm
 
-from ._htf import HTF, HTFData
-from ._lifting import _harmonic_labels, _real_basis
-from ._periodic_matrix import PeriodicMatrix, as_periodic
-from ._validation import (check_kwargs, check_period, check_positive, check_positive_int,
+from .._frequency.htf import HTF, HTFData
+from .._core.lifting import _harmonic_labels, _real_basis
+from .._core.periodic_matrix import PeriodicMatrix, as_periodic
+from .._core.validation import (check_kwargs, check_period, check_positive, check_positive_int,
                           real_array, steps_per_period, time_record)
 
 __all__ = ['lifted_frequency_response']

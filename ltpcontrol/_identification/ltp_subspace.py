@@ -28,16 +28,16 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
-from ._discretize import d2c
-from ._fdsubspace import fdsubspace, FDSubspaceInfo
-from ._floquet_fit import _harmonic_data, _harmonic_response, fit_floquet
-from ._htf import HTF
-from ._lifted_response import lifted_frequency_response
-from ._ltpsys import LTPStateSpace
-from ._periodic_matrix import PeriodicMatrix
-from ._realization import FloquetRealization, floquet_realization
-from ._refine import RefineInfo, _harmonics, refine_ltp
-from ._validation import check_kwargs, check_period, check_positive_int, steps_per_period
+from .._core.discretize import d2c
+from .fdsubspace import fdsubspace, FDSubspaceInfo
+from .floquet_fit import _harmonic_data, _harmonic_response, fit_floquet
+from .._frequency.htf import HTF
+from .lifted_response import lifted_frequency_response
+from .._core.ltpsys import LTPStateSpace
+from .._core.periodic_matrix import PeriodicMatrix
+from .realization import FloquetRealization, floquet_realization
+from .refine import RefineInfo, _harmonics, refine_ltp
+from .._core.validation import check_kwargs, check_period, check_positive_int, steps_per_period
 
 __all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
 

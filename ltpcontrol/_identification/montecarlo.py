@@ -14,7 +14,7 @@ import numpy as np
 from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
-from ._validation import check_positive_int
+from .._core.validation import check_positive_int
 
 __all__ = ['monte_carlo', 'MonteCarloResult']
 

@@ -60,9 +60,9 @@ from control.exception import ControlArgument, ControlDimension
 from scipy.optimize import linear_sum_assignment, minimize
 from tqdm.auto import tqdm
 
-from ._lifting import _real_basis, lift
-from ._ltpsys import LTPStateSpace, ltpss
-from ._validation import check_kwargs, check_period, check_positive, check_positive_int
+from .._core.lifting import _real_basis, lift
+from .._core.ltpsys import LTPStateSpace, ltpss
+from .._core.validation import check_kwargs, check_period, check_positive, check_positive_int
 
 __all__ = ['floquet_realization', 'FloquetRealization']
 

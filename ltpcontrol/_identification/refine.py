@@ -46,11 +46,11 @@ import scipy.optimize
 import scipy.sparse as sp
 from control.exception import ControlArgument, ControlDimension
 
-from ._floquet_fit import _harmonic_data
-from ._htf import HTF, HTFData
-from ._ltpsys import LTPStateSpace
-from ._periodic_matrix import PeriodicMatrix
-from ._validation import as_ltp, check_kwargs, check_positive_int, real_array, steps_per_period
+from .floquet_fit import _harmonic_data
+from .._frequency.htf import HTF, HTFData
+from .._core.ltpsys import LTPStateSpace
+from .._core.periodic_matrix import PeriodicMatrix
+from .._core.validation import as_ltp, check_kwargs, check_positive_int, real_array, steps_per_period
 
 __all__ = ['refine_ltp', 'RefineInfo']
 
@@ -504,7 +504,7 @@ def refine_ltp(sys, data, *, std=None, harmonics=None, weighted=True, stable=Fal
 
     Notes
     -----
-    See the module notes of ``ltpcontrol._refine`` and the Identification
+    See the module notes of ``ltpcontrol._identification.refine`` and the Identification
     with noise guide for the model, the minimal parametrisation (modal A,
     one pivot of B per mode held at 1) and the likelihood.  The Cramér-Rao
     bound at the true system is ``info.cov`` of ``refine_ltp(true_sys,

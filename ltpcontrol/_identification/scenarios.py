@@ -13,8 +13,8 @@ linearising it.
 import numpy as np
 from control.exception import ControlArgument
 
-from ._refine import RefineInfo
-from ._validation import check_positive_int, real_array
+from .refine import RefineInfo
+from .._core.validation import check_positive_int, real_array
 
 __all__ = ['sample_models']
 

@@ -27,9 +27,9 @@ import control as ct
 from control.exception import ControlArgument
 from tqdm.auto import tqdm
 
-from ._floquet_fit import _harmonic_data, _harmonic_response
-from ._ltp_subspace import identify_ltp
-from ._validation import check_kwargs, check_period, check_positive_int, steps_per_period
+from .floquet_fit import _harmonic_data, _harmonic_response
+from .ltp_subspace import identify_ltp
+from .._core.validation import check_kwargs, check_period, check_positive_int, steps_per_period
 
 __all__ = ['select_structure', 'StructureSelection']
 

@@ -26,9 +26,9 @@ import numpy as np
 from control.exception import ControlArgument, ControlDimension
 from scipy.optimize import brentq
 
-from ._hybrid import central_jacobian, constant_input, Flow, plant_params, solver_settings
-from ._orbits import PeriodicOrbit, as_hybrid, time_mismatch
-from ._validation import check_period, check_positive, check_positive_int, real_array
+from .hybrid import central_jacobian, constant_input, Flow, plant_params, solver_settings
+from .orbits import PeriodicOrbit, as_hybrid, time_mismatch
+from .._core.validation import check_period, check_positive, check_positive_int, real_array
 
 __all__ = ['limit_cycle', 'poincare_map']
 

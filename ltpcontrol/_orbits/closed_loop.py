@@ -36,10 +36,10 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 from tqdm.auto import tqdm
 
-from ._hybrid import Flow, input_function, IntegrationError, solver_settings
-from ._loop import FeedbackLoop, SampledLoop
-from ._orbits import PeriodicOrbit, periodic_orbit
-from ._validation import check_positive_int, real_array
+from .hybrid import Flow, input_function, IntegrationError, solver_settings
+from .loop import FeedbackLoop, SampledLoop
+from .orbits import PeriodicOrbit, periodic_orbit
+from .._core.validation import check_positive_int, real_array
 
 __all__ = ['ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit']
 

@@ -32,9 +32,9 @@ from control.exception import ControlArgument
 from scipy.optimize import brentq
 from tqdm.auto import tqdm
 
-from ._autonomous import limit_cycle
-from ._orbits import PeriodicOrbit, periodic_orbit
-from ._validation import check_positive_int, real_array
+from .autonomous import limit_cycle
+from .orbits import PeriodicOrbit, periodic_orbit
+from .._core.validation import check_positive_int, real_array
 
 __all__ = ['Bifurcation', 'OrbitBranch', 'orbit_continuation']
 

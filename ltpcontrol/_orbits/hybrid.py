@@ -19,7 +19,7 @@ from control import TimeResponseData
 from control.exception import ControlArgument, ControlDimension
 from scipy.integrate import solve_ivp
 
-from ._validation import check_positive_int, real_array
+from .._core.validation import check_positive_int, real_array
 
 __all__ = ['HybridMode', 'HybridPlant', 'simulate_hybrid', 'saltation_matrix']
 
@@ -345,7 +345,7 @@ def central_jacobian(func, x):
 
     Examples
     --------
-    >>> from ltpcontrol._hybrid import central_jacobian
+    >>> from ltpcontrol._orbits.hybrid import central_jacobian
     >>> J = central_jacobian(lambda x: [x[0] * x[1], np.sin(x[0])], [1.0, 2.0])
     >>> bool(np.allclose(J, [[2.0, 1.0], [np.cos(1.0), 0.0]]))
     True
@@ -467,7 +467,7 @@ def plant_params(plant, params):
 
     Examples
     --------
-    >>> from ltpcontrol._hybrid import plant_params
+    >>> from ltpcontrol._orbits.hybrid import plant_params
     >>> air = ltp.HybridMode(lambda t, x, u, p: [x[1], -p['g']], name='air')
     >>> ball = ltp.HybridPlant([air], states=2, params={'g': 9.81, 'm': 1.0})
     >>> plant_params(ball, {'g': 1.62}), plant_params(ball, None)
@@ -487,7 +487,7 @@ def constant_input(plant, u, name):
 
     Examples
     --------
-    >>> from ltpcontrol._hybrid import constant_input
+    >>> from ltpcontrol._orbits.hybrid import constant_input
     >>> plant = ltp.HybridPlant([ltp.HybridMode(lambda t, x, u, p: -x + u)], states=2, inputs=2)
     >>> constant_input(plant, None, 'u0'), constant_input(plant, 3.0, 'u0')
     (array([0., 0.]), array([3., 3.]))
@@ -513,7 +513,7 @@ def input_function(plant, inputs, timepts):
     --------
     Samples on `timepts` are interpolated linearly:
 
-    >>> from ltpcontrol._hybrid import input_function
+    >>> from ltpcontrol._orbits.hybrid import input_function
     >>> plant = ltp.HybridPlant([ltp.HybridMode(lambda t, x, u, p: -x + u)], states=1, inputs=1)
     >>> u = input_function(plant, [0.0, 1.0, 4.0], [0.0, 1.0, 2.0])
     >>> u(0.5), u(1.5)
@@ -632,7 +632,7 @@ def solver_settings(where, rtol=1e-10, atol=1e-12, method='DOP853', max_events=1
 
     Examples
     --------
-    >>> from ltpcontrol._hybrid import solver_settings
+    >>> from ltpcontrol._orbits.hybrid import solver_settings
     >>> solver_settings('simulate_hybrid')
     {'rtol': 1e-10, 'atol': 1e-12, 'method': 'DOP853', 'max_events': 10000}
     >>> solver_settings('simulate_hybrid', rtol=0)

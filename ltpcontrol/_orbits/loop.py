@@ -1,7 +1,7 @@
 """The feedback loop of a hybrid plant and a controller about a periodic orbit.
 
 `FeedbackLoop` validates the plant, controller, orbit and saturation and
-evaluates the loop's signals (see `ltpcontrol._closed_loop` for the
+evaluates the loop's signals (see `ltpcontrol._orbits.closed_loop` for the
 equations and the phase lock)::
 
     e(t) = y(t) + v(t) − ȳ(t),      u(t) = sat(u0 + w(t))
@@ -17,10 +17,10 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument, ControlDimension
 
-from ._hybrid import Flow, HybridMode, HybridPlant, central_jacobian
-from ._ltpsys import LTPStateSpace
-from ._orbits import as_hybrid, check_orbit_of
-from ._validation import steps_per_period
+from .hybrid import Flow, HybridMode, HybridPlant, central_jacobian
+from .._core.ltpsys import LTPStateSpace
+from .orbits import as_hybrid, check_orbit_of
+from .._core.validation import steps_per_period
 
 __all__ = []
 

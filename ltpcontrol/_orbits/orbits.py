@@ -18,11 +18,11 @@ import numpy as np
 from control import NonlinearIOSystem
 from control.exception import ControlArgument, ControlDimension
 
-from ._hybrid import (HybridMode, HybridPlant, central_jacobian, constant_input,
+from .hybrid import (HybridMode, HybridPlant, central_jacobian, constant_input,
                       Flow, IntegrationError, plant_params, solver_settings)
-from ._ltpsys import ltpss
-from ._periodic_matrix import PeriodicMatrix
-from ._validation import check_period, check_positive_int, real_array
+from .._core.ltpsys import ltpss
+from .._core.periodic_matrix import PeriodicMatrix
+from .._core.validation import check_period, check_positive_int, real_array
 
 __all__ = ['PeriodicOrbit', 'periodic_orbit', 'period_map', 'linearize_orbit']
 
@@ -163,7 +163,7 @@ def as_hybrid(plant, jacobian):
 
     Examples
     --------
-    >>> from ltpcontrol._orbits import as_hybrid
+    >>> from ltpcontrol._orbits.orbits import as_hybrid
     >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t), None, states=1, inputs=0, name='P')
     >>> plant = as_hybrid(sys, None)
     >>> type(plant).__name__, plant.mode_names, as_hybrid(plant, None) is plant
@@ -201,7 +201,7 @@ def time_mismatch(plant, x0, u0, params, pairs):
     --------
     ``ẋ = -x + cos t`` is 2π-periodic, not 1-periodic:
 
-    >>> from ltpcontrol._orbits import as_hybrid, time_mismatch
+    >>> from ltpcontrol._orbits.orbits import as_hybrid, time_mismatch
     >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t), None, states=1, inputs=0, name='P')
     >>> plant, x0, u0 = as_hybrid(sys, None), np.zeros(1), np.zeros(0)
     >>> time_mismatch(plant, x0, u0, {}, [(0.3, 0.3 + 2 * np.pi)]) is None
@@ -520,7 +520,7 @@ def check_orbit_of(orbit, plant, why_inputs):
 
     Examples
     --------
-    >>> from ltpcontrol._orbits import as_hybrid, check_orbit_of
+    >>> from ltpcontrol._orbits.orbits import as_hybrid, check_orbit_of
     >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t), None, states=1, inputs=0)
     >>> orbit = ltp.periodic_orbit(sys, 2 * np.pi, [0.0], npoints=8)
     >>> check_orbit_of(orbit, as_hybrid(sys, None), 'there is nothing to linearise in u')
