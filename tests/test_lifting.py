@@ -198,15 +198,18 @@ def test_harmonic_modules_import_at_the_top():
     import pathlib
     root = pathlib.Path(ltp.__file__).parent
     lazy = {}
-    for mod in ('_htf', '_htfplot', '_harmonic_ss', '_lifting', '_htf_estimate',
-                '_htf_fit', '_ltpsys'):
-        tree = ast.parse((root / f'{mod}.py').read_text())
+    paths = {'_htf': '_frequency/htf', '_htfplot': '_frequency/htfplot',
+             '_harmonic_ss': '_frequency/harmonic_ss', '_lifting': '_core/lifting',
+             '_htf_estimate': '_identification/htf_estimate',
+             '_htf_fit': '_identification/htf_fit', '_ltpsys': '_core/ltpsys'}
+    for mod, path in paths.items():
+        tree = ast.parse((root / f'{path}.py').read_text())
         for func in ast.walk(tree):
             if isinstance(func, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 for node in ast.walk(func):
-                    if isinstance(node, ast.ImportFrom) and node.level == 1:
-                        lazy.setdefault(mod, set()).add(node.module)
-    assert lazy.get('_htf') == {'_htfplot'}
+                    if isinstance(node, ast.ImportFrom) and node.level >= 1:
+                        lazy.setdefault(mod, set()).add(node.module.rpartition('.')[2])
+    assert lazy.get('_htf') == {'htfplot'}
     assert not any(lazy.get(m) for m in ('_htfplot', '_harmonic_ss', '_lifting',
                                          '_htf_estimate', '_htf_fit'))
-    assert '_htf' not in lazy.get('_ltpsys', set())
+    assert 'htf' not in lazy.get('_ltpsys', set())
