@@ -41,6 +41,7 @@ from ._analysis.norms import norm
 from ._analysis.floquet_modes import floquet_modes, FloquetModes
 from ._rotors.rotor_model import RotorStateSpace
 from ._rotors.mbc import mbc, coleman_matrix
+from ._rotors.read_lin import read_lin
 from ._analysis.zeros import zeros
 from ._frequency.harmonic_ss import harmonic_ss
 from ._analysis.riccati import care, dare
@@ -94,7 +95,7 @@ __all__ = [
     'refine_ltp', 'RefineInfo', 'monte_carlo', 'MonteCarloResult',
     'sample_models',
     # rotors and wind turbines
-    'floquet_modes', 'FloquetModes', 'RotorStateSpace', 'mbc', 'coleman_matrix',
+    'floquet_modes', 'FloquetModes', 'RotorStateSpace', 'mbc', 'coleman_matrix', 'read_lin',
 ]
 
 # python-control's entry points dispatch LTP systems to ltpcontrol (see interop)

@@ -21,6 +21,7 @@ with ``𝒯̇`` holding ``Ω T'`` and ``Ω² T'' + Ω̇ T'`` (Bir 2008; Hansen 2
 """
 
 import numbers
+import re
 
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
@@ -83,7 +84,7 @@ def _coleman_weights(N):
     return w
 
 
-def mbc(sys, rotating, nblades, *, rates=None, rotating_inputs=None,
+def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
         rotating_outputs=None, rotor_speed=None, azimuth0=None, inverse=False, name=None):
     """Transform a rotor model to (or from) multi-blade coordinates.
 
@@ -94,7 +95,7 @@ def mbc(sys, rotating, nblades, *, rates=None, rotating_inputs=None,
         coordinates (``inverse=True``); its time axis is the rotor's (blade-1
         azimuth ``ψ(t) = ψ_0 + ∫Ω``).  A `RotorStateSpace` supplies its rotor
         speed, azimuth and samples.
-    rotating : sequence of sequences
+    rotating : sequence of sequences, optional
         Groups of blade states: each group lists the N states (indices or
         labels) of one blade degree of freedom, blade 1 first.  For a
         second-order degree of freedom, the group of displacements.  In
@@ -159,6 +160,14 @@ def mbc(sys, rotating, nblades, *, rates=None, rotating_inputs=None,
     n, m, p = sys.nstates, sys.ninputs, sys.noutputs
     T = sys.period
     rotor = isinstance(sys, RotorStateSpace)
+    if rotating is None:
+        if not rotor:
+            raise ControlArgument("rotating is needed unless sys is a RotorStateSpace with "
+                                  "rotating-frame flags (e.g. from read_lin)")
+        if rates is not None or rotating_inputs is not None or rotating_outputs is not None:
+            raise ControlArgument("rates, rotating_inputs and rotating_outputs are inferred "
+                                  "with the groups: give rotating too")
+        rotating, rates, rotating_inputs, rotating_outputs = _infer_groups(sys, N)
     groups = _groups(rotating, N, sys.state_labels, 'rotating')
     if rates is None:
         rates = [None] * len(groups)
@@ -314,6 +323,49 @@ def _check_revolutions(mean, T):
     if not revs > 0.5 or abs(revs - round(revs)) > 1e-9 * max(1.0, revs):
         raise ValueError(f"the rotor turns {revs:.6g} revolutions per period: the mean rotor "
                          "speed must be a positive multiple of 2π/period")
+
+
+def _infer_groups(sys, N):
+    """Blade groups from a rotor model's flags, in OpenFAST's state order."""
+    flags, order = np.asarray(sys.rotating_states, bool), np.asarray(sys.derivative_order)
+    n2 = int(np.count_nonzero(order == 2))
+    if np.any(flags & (order == 0)):
+        raise ValueError("the derivative order of rotating states is unknown: give rotating "
+                         "(and rates) explicitly")
+    if n2 % 2 or not np.all(order[:n2] == 2):
+        raise ValueError("the second-order states must come first, displacements then rates "
+                         "(OpenFAST's order): give rotating and rates explicitly")
+    half = n2 // 2
+    if np.any(flags[:half] != flags[half:n2]):
+        raise ValueError("the rotating-frame flags of the displacements and of their rates "
+                         "differ: give rotating and rates explicitly")
+
+    def consecutive(indices, what, descriptions):
+        if len(indices) % N:
+            raise ValueError(f"{len(indices)} rotating {what} cannot be split into groups of "
+                             f"nblades = {N}: wrong blade count")
+        groups = [list(indices[i:i + N]) for i in range(0, len(indices), N)]
+        for g in groups:
+            blades = [_blade_number(descriptions[i]) for i in g]
+            if all(b is not None for b in blades) and blades != list(range(1, N + 1)):
+                raise ValueError(f"rotating {what} {g} describe blades {blades}, not 1..{N}: "
+                                 "wrong blade count or order")
+        return groups
+
+    desc = sys.state_descriptions
+    disp = consecutive(np.flatnonzero(flags[:half]), 'displacements', desc)
+    first = consecutive(n2 + np.flatnonzero(flags[n2:]), 'first-order states', desc)
+    rates = [[i + half for i in g] for g in disp] + [None] * len(first)
+    ins = consecutive(np.flatnonzero(sys.rotating_inputs), 'inputs', sys.input_descriptions)
+    outs = consecutive(np.flatnonzero(sys.rotating_outputs), 'outputs',
+                       sys.output_descriptions)
+    return disp + first, rates, ins, outs
+
+
+def _blade_number(text):
+    """The blade a description names ('blade 2', 'Blade2', 'B2...'), or None."""
+    m = re.search(r'blade\s*(\d+)', text, re.I)
+    return int(m.group(1)) if m else None
 
 
 def _groups(spec, N, labels, what):
