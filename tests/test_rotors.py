@@ -238,3 +238,24 @@ def test_mbc_rejects_wrong_blade_count():
 def test_floquet_modes_rejects_bad_frame():
     with pytest.raises(ct.ControlDimension, match="columns"):
         ltp.floquet_modes(flap_model(0.1), frame=np.eye(3))
+
+
+def test_stiff_multipliers_keep_relative_accuracy():
+    # exponents 0 and -24 exactly (multipliers 1 and e^{-48π} = 1.6e-66)
+    A = lambda t: np.array([[0.0, 1.0], [-10 * np.cos(t), -24 - 10 * np.sin(t)]])
+    sys = ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=2 * np.pi)
+    modes = ltp.floquet_modes(sys, nharmonics=24)
+    small = modes.multipliers[np.argmin(np.abs(modes.multipliers))]
+    assert abs(small / np.exp(-48 * np.pi) - 1) < 1e-8
+    assert np.allclose(np.sort(modes.exponents.real), [-24.0, 0.0], atol=1e-9)
+    assert modes.liouville_error < 1e-10
+    # a discrete product of 400 graded steps
+    rng = np.random.default_rng(0)
+    steps = np.array([np.diag([1.0, 0.5, 0.1]) + 0.01 * rng.standard_normal((3, 3))
+                      for _ in range(400)])
+    sysd = ltp.ltpss(steps, np.zeros((400, 3, 1)), np.zeros((400, 1, 3)), 0, period=400.0,
+                     dt=1.0)
+    modes = ltp.floquet_modes(sysd)
+    logdet = np.sum(np.linalg.slogdet(steps)[1])
+    # per-step exponents ρ = μ^{1/N}: the multiplier 0.1^400 itself underflows
+    assert abs(400 * np.sum(np.log(np.abs(modes.exponents))) - logdet) < 1e-9 * abs(logdet)

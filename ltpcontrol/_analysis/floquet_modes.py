@@ -20,7 +20,9 @@ Periodic vectors come from the cyclic two-point problems on a grid
     right:  e^{λ h_k} p_{k+1} = Φ_k p_k,       left:  conj(e^{λ h_k}) q_k = Φ_kᴴ q_{k+1},
 
 solved as one bordered sparse system each, so no product of the factors is
-ever formed; the multipliers come from the periodic Schur form.
+ever formed; the multipliers come from the periodic Schur form of the
+factors (``product_eigenvalues``), accurate to their relative precision
+however long or stiff the product.
 """
 
 import warnings
@@ -31,8 +33,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from control.exception import ControlArgument, ControlDimension
 
-from .._core.floquet import _log_multipliers
 from .._core.periodic_matrix import PeriodicMatrix
+from .._core.periodic_schur import product_eigenvalues
 from .._core.steps import step_grid
 from .._core.transition import step_transitions
 from .._core.validation import as_ltp, check_positive_int, steps_per_period
@@ -218,7 +220,7 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
     else:
         grid, factors, sample_idx, K = _continuous_grid(sys, nharmonics, nsteps)
     F = _frame(frame, sys)
-    logmod, arg = _log_multipliers(sys, None, grid=grid, factors=factors)
+    logmod, arg = product_eigenvalues(factors)
     dtime = bool(sys.dt)
     nper = len(factors)
     # strip exponents: per unit time (continuous) or per step (discrete)
