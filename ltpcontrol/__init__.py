@@ -42,6 +42,7 @@ from ._analysis.floquet_modes import floquet_modes, FloquetModes
 from ._rotors.rotor_model import RotorStateSpace
 from ._rotors.mbc import mbc, coleman_matrix
 from ._rotors.read_lin import read_lin
+from ._rotors.campbell import campbell, CampbellDiagram
 from ._analysis.zeros import zeros
 from ._frequency.harmonic_ss import harmonic_ss
 from ._analysis.riccati import care, dare
@@ -96,6 +97,7 @@ __all__ = [
     'sample_models',
     # rotors and wind turbines
     'floquet_modes', 'FloquetModes', 'RotorStateSpace', 'mbc', 'coleman_matrix', 'read_lin',
+    'campbell', 'CampbellDiagram',
 ]
 
 # python-control's entry points dispatch LTP systems to ltpcontrol (see interop)

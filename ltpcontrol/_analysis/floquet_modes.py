@@ -17,10 +17,10 @@ samples of p, and ``ρ e^{j2πh*/N}``.
 Periodic vectors come from the cyclic two-point problems on a grid
 ``t_0 < ... < t_M = T`` with step factors ``Φ_k``:
 
-    right:  e^{λ h_k} p_{k+1} = Φ_k p_k,       left:  conj(e^{λ h_k}) q_k = Φ_kᴴ q_{k+1},
+    e^{λ h_k} p_{k+1} = Φ_k p_k   (right),   and its adjoint (left),
 
-solved as one bordered sparse system each, so no product of the factors is
-ever formed; the multipliers come from the periodic Schur form of the
+solved with one LU of a bordered sparse cyclic matrix, so no product of the
+factors is ever formed; the multipliers come from the periodic Schur form of the
 factors (``product_eigenvalues``), accurate to their relative precision
 however long or stiff the product.
 """
@@ -172,7 +172,8 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
     nharmonics : int, optional
         Continuous time: number K of harmonics ``-K..K`` in the content
         (``2K+1`` uniform samples of p per period).  By default
-        ``K = clip(ceil(2 max_t ‖A(t)‖₂ / ω_p) + 4, 8, 256)``.  Discrete
+        ``K = clip(ceil(1.5 ρ / ω_p) + 4, 8, 256)`` with ρ the largest
+        eigenvalue modulus of A(t) over one period.  Discrete
         time: all N harmonics of the N steps are used and `nharmonics` must
         not be given.
     nsteps : int, optional
@@ -239,16 +240,16 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
         coef = np.full(nper, lam) if dtime else np.exp(lam * h)
         pair = i + 1 < n and arg[i] > 0 and np.isclose(arg[i + 1], -arg[i]) \
             and logmod[i + 1] == logmod[i]
-        p = _cyclic_vector(factors, coef, adjoint=False)
-        q = _cyclic_vector(factors, coef, adjoint=True)
-        if p is None or q is None:
+        found = _cyclic_vectors(factors, coef)
+        if found is None:
             failed.append(i)
         else:
+            p, q = found
             p = p / np.linalg.norm(p[0])
-            q = q / np.conj(np.vdot(q[0], p[0]))           # q_0ᴴ p_0 = 1
-            right[i], left[:, i] = p, q[0]
+            q = q / np.conj(np.vdot(q, p[0]))              # q_0ᴴ p_0 = 1
+            right[i], left[:, i] = p, q
             if pair:
-                right[i + 1], left[:, i + 1] = np.conj(p), np.conj(q[0])
+                right[i + 1], left[:, i + 1] = np.conj(p), np.conj(q)
         i += 2 if pair else 1
     if failed:
         warnings.warn(f"{len(failed)} periodic eigenvectors could not be computed "
@@ -324,9 +325,10 @@ def _continuous_grid(sys, nharmonics, nsteps):
     """Floquet grid containing 2K+1 uniform sample instants, and its factors."""
     A, T = sys.A, sys.period
     if nharmonics is None:
-        probe = np.arange(64) * T / 64
-        norm = np.max(np.linalg.norm(A(probe), ord=2, axis=(1, 2)))
-        K = int(np.clip(np.ceil(2 * norm / sys.omega_p) + 4, 8, _KMAX))
+        # the frequencies of the frozen dynamics, with a margin
+        probe = np.arange(16) * T / 16
+        radius = np.max(np.abs(np.linalg.eigvals(A(probe))))
+        K = int(np.clip(np.ceil(1.5 * radius / sys.omega_p) + 4, 8, _KMAX))
     else:
         K = check_positive_int(nharmonics, 'nharmonics')
     S = 2 * K + 1
@@ -372,55 +374,49 @@ def _frame(frame, sys):
     return lambda t: np.broadcast_to(M.astype(float), (len(t),) + M.shape)
 
 
-def _cyclic_vector(factors, coef, adjoint):
-    """Periodic vector of the cyclic problem; None when it is not unique.
+def _cyclic_vectors(factors, coef):
+    """Right and left periodic vectors of the cyclic problem; None when not unique.
 
-    Right: ``coef_k p_{k+1} - Φ_k p_k = 0``; adjoint:
-    ``conj(coef_k) q_k - Φ_kᴴ q_{k+1} = 0`` (indices mod M), bordered by a
-    random column and a random row acting on the first block.
+    The cyclic matrix L has row blocks ``c_k p_{k+1} - Φ_k p_k`` (indices
+    mod M); it is bordered by a random column and a random row acting on
+    the first block, and one LU gives both null vectors: ``L p = 0`` (the
+    right vectors ``p_k``) and ``Lᴴ y = 0``, whose blocks satisfy
+    ``conj(c_{k-1}) y_{k-1} = Φ_kᴴ y_k``, so that ``y_{M-1}`` is the left
+    eigenvector of the monodromy at t = 0.
     """
     M, n = factors.shape[0], factors.shape[1]
     size = M * n
     k = np.arange(M)
     blk = k[:, None, None] * n
-    r_i = np.broadcast_to(blk + np.arange(n)[None, :, None], factors.shape).ravel()
-    c_i = np.broadcast_to(blk + np.arange(n)[None, None, :], factors.shape).ravel()
-    nxt = ((k + 1) % M)[:, None] * n + np.arange(n)
-    cur = k[:, None] * n + np.arange(n)
-    if adjoint:
-        # row block k: conj(c_k) q_k - Φ_kᴴ q_{k+1}
-        mats = -np.conj(np.swapaxes(factors, 1, 2)).ravel()
-        rows_m = r_i
-        cols_m = np.broadcast_to(((k + 1) % M)[:, None, None] * n
-                                 + np.arange(n)[None, None, :], factors.shape).ravel()
-        diag_rows, diag_cols, diag = cur.ravel(), cur.ravel(), np.repeat(np.conj(coef), n)
-    else:
-        # row block k: c_k p_{k+1} - Φ_k p_k
-        mats = -factors.ravel().astype(complex)
-        rows_m, cols_m = r_i, c_i
-        diag_rows, diag_cols, diag = cur.ravel(), nxt.ravel(), np.repeat(coef, n)
+    rows_m = np.broadcast_to(blk + np.arange(n)[None, :, None], factors.shape).ravel()
+    cols_m = np.broadcast_to(blk + np.arange(n)[None, None, :], factors.shape).ravel()
+    cur = (k[:, None] * n + np.arange(n)).ravel()
+    nxt = (((k + 1) % M)[:, None] * n + np.arange(n)).ravel()
     rng = np.random.default_rng(7)
     bcol, brow = rng.standard_normal(size), rng.standard_normal(n)
-    rows = np.concatenate([rows_m, diag_rows, np.arange(size), np.full(n, size)])
-    cols = np.concatenate([cols_m, diag_cols, np.full(size, size), np.arange(n)])
-    vals = np.concatenate([mats, diag.astype(complex), bcol, brow]).astype(complex)
+    rows = np.concatenate([rows_m, cur, np.arange(size), np.full(n, size)])
+    cols = np.concatenate([cols_m, nxt, np.full(size, size), np.arange(n)])
+    vals = np.concatenate([-factors.ravel(), np.repeat(coef, n), bcol, brow]).astype(complex)
     L = sp.csc_matrix((vals, (rows, cols)), shape=(size + 1, size + 1))
     rhs = np.zeros(size + 1, complex)
     rhs[-1] = 1.0
     try:
         with warnings.catch_warnings():
             warnings.simplefilter('error', spla.MatrixRankWarning)
-            sol = spla.splu(L).solve(rhs)
+            lu = spla.splu(L)
+            right, left = lu.solve(rhs), lu.solve(rhs, trans='H')
     except (RuntimeError, spla.MatrixRankWarning):
         return None
-    if not np.all(np.isfinite(sol)):
-        return None
-    # a unique solution has a negligible border unknown (residual of the null vector)
-    vec = sol[:-1].reshape(M, n)
-    scale = np.abs(vec).max()
-    if scale == 0 or abs(sol[-1]) > 1e-6 * scale * max(1.0, np.abs(factors).max()):
-        return None
-    return vec
+    tol = 1e-6 * max(1.0, np.abs(factors).max())
+    out = []
+    for sol in (right, left):
+        vec = sol[:-1].reshape(M, n)
+        scale = np.abs(vec).max() if np.all(np.isfinite(sol)) else 0.0
+        # a unique null vector leaves a negligible border unknown
+        if scale == 0 or abs(sol[-1]) > tol * scale:
+            return None
+        out.append(vec)
+    return out[0], out[1][-1]
 
 
 def _liouville(sys, factors, logmod, dtime, nper):
