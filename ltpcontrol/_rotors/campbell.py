@@ -41,7 +41,7 @@ class CampbellDiagram:
     values : ndarray, shape (K,)
         The sweep values.
     exponents : ndarray of complex, shape (K, n)
-        Exponents on the principal-harmonic branch (see `floquet_modes`).
+        Exponents on the branch chosen by `campbell` (see its ``branch``).
     frequency : ndarray, shape (K, n)
         Natural frequencies (rad/s).
     damped_frequency : ndarray, shape (K, n)
@@ -49,7 +49,8 @@ class CampbellDiagram:
     damping : ndarray, shape (K, n)
         Damping ratios.
     principal_harmonic : ndarray of int, shape (K, n)
-        Principal harmonic of each track at each value.
+        Branch of each track at each value, counted in harmonics from the
+        strip of `floquet_exponents`.
     mac : ndarray, shape (K-1, n)
         MAC between a track's shapes at neighbouring values (1: same shape).
     rotor_speed : ndarray, shape (K,)
@@ -163,8 +164,8 @@ class CampbellDiagram:
         return ct.ControlPlot(lines, ax.reshape(2, 1), fig)
 
 
-def campbell(factory, values, *, rotor_speed=None, per_rev=(1, 2, 3), frame=None,
-             nharmonics=None, n_jobs=None, backend=None):
+def campbell(factory, values, *, rotor_speed=None, per_rev=(1, 2, 3), branch='continuous',
+             frame=None, nharmonics=None, n_jobs=None, backend=None):
     """Floquet modes over a parameter sweep, tracked by mode shape.
 
     Parameters
@@ -182,6 +183,13 @@ def campbell(factory, values, *, rotor_speed=None, per_rev=(1, 2, 3), frame=None
         over rotor speed).
     per_rev : sequence of int
         The nP lines whose crossings with the tracks are reported.
+    branch : {'continuous', 'principal'}
+        Branch of each exponent (defined modulo ``jω_p``): 'principal'
+        keeps the principal-harmonic branch of `floquet_modes` at every
+        value, which jumps by ``ω_p`` where two harmonics exchange the
+        largest share; 'continuous' (default, continuous-time models) takes
+        the principal-harmonic branch at the first value and then, along
+        each track, the branch nearest to the track's previous exponent.
     frame, nharmonics
         Passed to `floquet_modes`.
     n_jobs : int, optional
@@ -259,7 +267,20 @@ def campbell(factory, values, *, rotor_speed=None, per_rev=(1, 2, 3), frame=None
         perm[k, rows] = cols
         mac[k - 1, rows] = macs[perm[k - 1][rows], cols]
     pick = lambda attr: np.array([getattr(m, attr)[p] for m, p in zip(modes, perm)])
-    freq = pick('frequency')
+    exps, hstar = pick('exponents'), pick('principal_harmonic')
+    if branch not in ('continuous', 'principal'):
+        raise ValueError(f"branch must be 'continuous' or 'principal', got {branch!r}")
+    if branch == 'continuous' and not modes[0].dt:
+        strip = pick('strip_exponents')
+        for k in range(1, K):
+            wp = 2 * np.pi / modes[k].period
+            # the branch strip + j m ω_p nearest to the previous exponent
+            m = np.round((exps[k - 1] - strip[k]).imag / wp)
+            exps[k], hstar[k] = strip[k] + 1j * m * wp, m.astype(int)
+    freq = np.abs(exps)
+    with np.errstate(invalid='ignore', divide='ignore'):
+        damping = np.where(freq > 0, -exps.real / np.where(freq > 0, freq, 1.0),
+                           -np.sign(exps.real))
     crossings = []
     for track in range(n):
         for nrev in per_rev:
@@ -268,9 +289,9 @@ def campbell(factory, values, *, rotor_speed=None, per_rev=(1, 2, 3), frame=None
                                   float(nrev * np.interp(value, values, speeds)
                                         if steps[0] > 0 else
                                         nrev * np.interp(value, values[::-1], speeds[::-1]))))
-    return CampbellDiagram(values=values, exponents=pick('exponents'), frequency=freq,
-                           damped_frequency=pick('damped_frequency'), damping=pick('damping'),
-                           principal_harmonic=pick('principal_harmonic'), mac=mac,
+    return CampbellDiagram(values=values, exponents=exps, frequency=freq,
+                           damped_frequency=exps.imag, damping=damping,
+                           principal_harmonic=hstar, mac=mac,
                            rotor_speed=speeds, crossings=crossings, modes=tuple(modes))
 
 

@@ -1,4 +1,4 @@
-"""Rotor models of the literature for the rotor tests and the gallery.
+"""Rotor models of the literature for the rotor gallery and its tests.
 
 Ground resonance (Hammond 1974): a four-bladed rotor with rigid blades on
 lag hinges at offset e, on a hub with masses Mx, My, springs Kx, Ky and
