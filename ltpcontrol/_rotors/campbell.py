@@ -56,7 +56,7 @@ class CampbellDiagram:
     rotor_speed : ndarray, shape (K,)
         Ω at each value (rad/s), for the nP lines.
     crossings : list of tuple
-        ``(track, n, value, frequency)`` where track `track` crosses the
+        ``(track, n, value, frequency)`` where track ``track`` crosses the
         nP line ``n Ω``.
     modes : tuple of FloquetModes
         The modes at each value (in their own order).
@@ -174,7 +174,7 @@ def campbell(factory, values, *, rotor_speed=None, per_rev=(1, 2, 3), branch='co
         ``factory(value) -> LTPStateSpace``: the model at one sweep value
         (rotor speed, wind speed, advance ratio, ...).  It must be picklable
         for process-based parallel backends (module-level functions,
-        `functools.partial`, lambdas with joblib's default backend).
+        ``functools.partial``, lambdas with joblib's default backend).
     values : array_like, shape (K,)
         Sweep values, at least two, strictly monotonic.
     rotor_speed : array_like or callable, optional
