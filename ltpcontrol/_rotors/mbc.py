@@ -208,23 +208,31 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
             P[np.ix_(g, g)] = coleman_matrix(psi, N)
         return P
 
-    def transformed(t, A, B, C, D):
+    def transformed(t, mats, which=(0, 1, 2, 3)):
+        """The transformed matrices `which` (0: A, 1: B, 2: C, 3: D) at time t."""
         omega, domega, psi = speed(t, psi0)
         P, dP = state_transform(t, omega, domega, psi)
         Pu, Py = signal_transform(m, in_groups, psi), signal_transform(p, out_groups, psi)
         if inverse:
             # z = 𝒯⁻¹ x: the inverse map of the forward formulas
-            Pinv = np.linalg.inv(P)
-            dPinv = -Pinv @ dP @ Pinv
-            return (P @ (A @ Pinv - dPinv), P @ B @ np.linalg.inv(Pu),
-                    Py @ C @ Pinv, Py @ D @ np.linalg.inv(Pu))
-        return (np.linalg.solve(P, A @ P - dP), np.linalg.solve(P, B @ Pu),
-                np.linalg.solve(Py, C @ P), np.linalg.solve(Py, D @ Pu))
+            P, dP = np.linalg.inv(P), -np.linalg.solve(P, dP) @ np.linalg.inv(P)
+            Pu, Py = np.linalg.inv(Pu), np.linalg.inv(Py)
+        out = []
+        for j in which:
+            M = mats[j](t) if callable(mats[j]) else mats[j]
+            if j == 0:
+                out.append(np.linalg.solve(P, M @ P - dP))
+            elif j == 1:
+                out.append(np.linalg.solve(P, M @ Pu))
+            elif j == 2:
+                out.append(np.linalg.solve(Py, M @ P))
+            else:
+                out.append(np.linalg.solve(Py, M @ Pu))
+        return out
 
     def matrix(index, shape):
         def f(t):
-            t = float(t)
-            return transformed(t, sys.A(t), sys.B(t), sys.C(t), sys.D(t))[index]
+            return transformed(float(t), (sys.A, sys.B, sys.C, sys.D), (index,))[0]
         return PeriodicMatrix.from_function(f, T, shape, check=False)
 
     data = sys.rotor_data() if rotor else {}
@@ -247,7 +255,7 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
         times = np.mod((np.asarray(sys.azimuths) - psi0) / omega, T)
         samples = [[], [], [], []]
         for s, t in enumerate(times):
-            out = transformed(t, *(M[s] for M in sys.samples))
+            out = transformed(t, [M[s] for M in sys.samples])
             for j in range(4):
                 samples[j].append(out[j])
         samples = tuple(np.array(M).reshape((len(times),) + sys.samples[j].shape[1:])
