@@ -100,6 +100,16 @@ class FloquetModes:
         time): a measure of the aliasing of the harmonic content.
     period, dt : float
         Period and sampling time of the system.
+
+    Examples
+    --------
+    >>> sys = ltp.ltpss([[0.0, 1.0], [-4.0, -0.4]], [[0.0], [1.0]], [[1.0, 0.0]], 0,
+    ...                 period=1.0)
+    >>> modes = ltp.floquet_modes(sys)
+    >>> len(modes), modes.frequency.round(6)
+    (2, array([2., 2.]))
+    >>> modes.damping.round(6)
+    array([0.1, 0.1])
     """
 
     exponents: np.ndarray

@@ -60,6 +60,17 @@ class CampbellDiagram:
         nP line ``n Ω``.
     modes : tuple of FloquetModes
         The modes at each value (in their own order).
+
+    Examples
+    --------
+    >>> def spring(k):
+    ...     return ltp.ltpss([[0.0, 1.0], [-k, -0.1]], np.zeros((2, 0)), np.zeros((0, 2)),
+    ...                      0, period=1.0)
+    >>> cd = ltp.campbell(spring, [1.0, 4.0, 9.0], rotor_speed=[1.0, 1.0, 1.0], n_jobs=1)
+    >>> cd.frequency[:, 0].round(6)
+    array([1., 2., 3.])
+    >>> [(n, round(value, 6)) for _, n, value, _ in cd.crossings if n == 2][:1]
+    [(2, 4.0)]
     """
 
     values: np.ndarray

@@ -96,7 +96,7 @@ class RotorStateSpace(LTPStateSpace):
         for key, value in defaults.items():
             setattr(self, key, value)
 
-    def rotor_data(self, **changes):
+    def rotor_data(self):
         """The rotor data as a dict (for building a derived model).
 
         Examples
@@ -104,12 +104,10 @@ class RotorStateSpace(LTPStateSpace):
         >>> A = ltp.PeriodicMatrix.constant([[-1.0]], 1.0)
         >>> rot = ltp.RotorStateSpace(A, np.zeros((1, 0)), np.zeros((0, 1)),
         ...                           np.zeros((0, 0)), 1.0)
-        >>> rot.rotor_data(nblades=3)['nblades']
-        3
+        >>> rot.rotor_data()['frame']
+        'rotating'
         """
-        data = {key: getattr(self, key) for key in self._KEYS}
-        data.update(changes)
-        return data
+        return {key: getattr(self, key) for key in self._KEYS}
 
     def average(self, *, method='fourier', **kwargs):
         """Azimuth-averaged LTI system.
