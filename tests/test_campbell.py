@@ -80,3 +80,21 @@ def test_campbell_rejects_bad_input():
         ltp.campbell(42, [0.0, 1.0])
     with pytest.raises(ValueError, match="one value per sweep value"):
         ltp.campbell(crossing_oscillators, [0.0, 1.0], rotor_speed=[1.0], n_jobs=1)
+
+
+def test_threaded_sweep_equals_serial_sweep():
+    values = np.linspace(0.0, 2.0, 6)
+    serial = ltp.campbell(crossing_oscillators, values, n_jobs=1)
+    threaded = ltp.campbell(crossing_oscillators, values, n_jobs=2, backend='threading')
+    assert np.allclose(serial.exponents, threaded.exponents)
+    assert serial.crossings == threaded.crossings
+
+
+def test_dask_sweep_equals_serial_sweep():
+    distributed = pytest.importorskip('distributed')
+    values = np.linspace(0.0, 2.0, 6)
+    serial = ltp.campbell(crossing_oscillators, values, n_jobs=1)
+    with distributed.Client(processes=False, n_workers=1, threads_per_worker=2,
+                            dashboard_address=None):
+        dask = ltp.campbell(crossing_oscillators, values, n_jobs=2, backend='dask')
+    assert np.allclose(serial.exponents, dask.exponents)
