@@ -91,6 +91,14 @@ def test_floquet_modes_of_mbc_model_are_its_lti_eigenvalues(Omega):
     assert np.allclose(modes.damping, zeta[order], rtol=1e-6, atol=1e-9)
     assert np.allclose(modes.participation.sum(axis=1), 1.0)
     assert modes.liouville_error < 1e-9
+    # right and left vectors: eigenvectors of A, bi-orthonormal, also for the
+    # double eigenvalue (collective and differential lag modes)
+    A0 = mbc_by_hand(Omega, 0.0)
+    V, W, lam = modes.vectors, modes.left_vectors, modes.exponents
+    assert np.abs(A0 @ V - V * lam).max() < 1e-8 * np.abs(A0).max()
+    assert np.abs(W.conj().T @ A0 - lam[:, None] * W.conj().T).max() < 1e-8 * np.abs(
+        A0).max() * np.abs(W).max()
+    assert np.allclose(W.conj().T @ V, np.eye(12), atol=1e-8)
     # eigenvalue condition numbers of the simple eigenvalues, from scipy's eig
     import scipy.linalg as la
     lam, W, V = la.eig(mbc_by_hand(Omega, 0.0), left=True, right=True)

@@ -80,8 +80,9 @@ class FloquetModes:
         of the frequency ``Im λ_strip + h ω_p``.
     vectors, left_vectors : ndarray of complex, shape (nstates, n)
         Right and left Floquet vectors at t = 0 (eigenvectors of the
-        monodromy), ``left_vectors[:, i]ᴴ vectors[:, i] = 1``, unit-norm
-        right vectors.
+        monodromy), bi-orthonormal (``left_vectorsᴴ vectors = I``), unit-norm
+        right vectors.  A repeated (semisimple) multiplier gets an
+        orthonormal basis of its eigenspace.
     times : ndarray, shape (S,)
         Instants of one period at which the mode shapes are given.
     shapes : ndarray of complex, shape (r, n, S)
@@ -244,27 +245,35 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
     right = np.full((n, nper, n), np.nan, complex)        # (mode, step, state)
     left = np.full((n, n), np.nan, complex)
     failed = []
-    i = 0
-    while i < n:
+    # groups of equal multipliers (a repeated multiplier needs a basis)
+    same = lambda a, b: abs(logmod[a] - logmod[b]) <= 1e-9 * max(1.0, abs(logmod[a])) \
+        and abs(arg[a] - arg[b]) <= 1e-9
+    done = np.zeros(n, bool)
+    for i in range(n):
+        if done[i]:
+            continue
+        group = [j for j in range(i, n) if not done[j] and same(i, j)]
         lam = strip[i]
         coef = np.full(nper, lam) if dtime else np.exp(lam * h)
-        pair = i + 1 < n and arg[i] > 0 and np.isclose(arg[i + 1], -arg[i]) \
-            and logmod[i + 1] == logmod[i]
-        found = _cyclic_vectors(factors, coef)
+        found = _eigenspace(factors, coef, len(group))
+        done[group] = True
         if found is None:
-            failed.append(i)
-        else:
-            p, q = found
-            p = p / np.linalg.norm(p[0])
-            q = q / np.conj(np.vdot(q, p[0]))              # q_0ᴴ p_0 = 1
-            right[i], left[:, i] = p, q
-            if pair:
-                right[i + 1], left[:, i + 1] = np.conj(p), np.conj(q)
-        i += 2 if pair else 1
+            failed += group
+            continue
+        P, Q = found
+        right[group], left[:, group] = P, Q
+        if arg[i] > 0:
+            # the conjugate group: conjugate vectors
+            conj = [j for j in range(n) if not done[j] and abs(logmod[j] - logmod[i])
+                    <= 1e-9 * max(1.0, abs(logmod[i])) and abs(arg[j] + arg[i]) <= 1e-9]
+            conj = conj[:len(group)]
+            if len(conj) == len(group):
+                right[conj], left[:, conj] = np.conj(P), np.conj(Q)
+                done[conj] = True
     if failed:
         warnings.warn(f"{len(failed)} periodic eigenvectors could not be computed "
-                      "(repeated or defective multipliers); their shapes are NaN and "
-                      "their exponents are left in the strip", UserWarning, stacklevel=2)
+                      "(defective multipliers); their shapes are NaN and their exponents "
+                      "are left in the strip", UserWarning, stacklevel=2)
     # periodic shapes at uniform instants, in the user's frame
     times = grid[sample_idx]
     on_samples = right[:, sample_idx, :]                   # (mode, S, state)
@@ -384,7 +393,41 @@ def _frame(frame, sys):
     return lambda t: np.broadcast_to(M.astype(float), (len(t),) + M.shape)
 
 
-def _cyclic_vectors(factors, coef):
+def _eigenspace(factors, coef, size):
+    """Bases of the right periodic vectors and left vectors at t = 0 of a multiplier.
+
+    Returns ``P`` of shape (size, M, n) and ``Q`` (n, size) with
+    ``Q[:, i]ᴴ P[j, 0] = δ_ij`` and unit ``‖P[i, 0]‖``, or None when the
+    eigenspace has fewer than `size` independent vectors (defective).
+    """
+    Ps, Qs = [], []
+    for seed in range(size):
+        found = _cyclic_vectors(factors, coef, seed)
+        if found is None:
+            return None
+        Ps.append(found[0].ravel())
+        Qs.append(found[1])
+    Ps, Qs = np.array(Ps), np.array(Qs).T
+    if size > 1:
+        # orthonormal bases of the spans (random borders give independent vectors)
+        u, sv, vh = np.linalg.svd(Ps.T, full_matrices=False)
+        uq, svq, _ = np.linalg.svd(Qs, full_matrices=False)
+        if sv[-1] <= 1e-8 * sv[0] or svq[-1] <= 1e-8 * svq[0]:
+            return None
+        Ps, Qs = u.T, uq
+    M, n = factors.shape[0], factors.shape[1]
+    P = Ps.reshape(size, M, n)
+    P = P / np.linalg.norm(P[:, 0], axis=1)[:, None, None]
+    # bi-orthonormal at t = 0:  Qᴴ P_0 = I
+    G = np.conj(Qs).T @ P[:, 0].T
+    try:
+        Q = Qs @ np.linalg.inv(G).conj().T
+    except np.linalg.LinAlgError:
+        return None
+    return P, Q
+
+
+def _cyclic_vectors(factors, coef, seed=0):
     """Right and left periodic vectors of the cyclic problem; None when not unique.
 
     The cyclic matrix L has row blocks ``c_k p_{k+1} - Φ_k p_k`` (indices
@@ -402,7 +445,7 @@ def _cyclic_vectors(factors, coef):
     cols_m = np.broadcast_to(blk + np.arange(n)[None, None, :], factors.shape).ravel()
     cur = (k[:, None] * n + np.arange(n)).ravel()
     nxt = (((k + 1) % M)[:, None] * n + np.arange(n)).ravel()
-    rng = np.random.default_rng(7)
+    rng = np.random.default_rng(7 + seed)
     bcol, brow = rng.standard_normal(size), rng.standard_normal(n)
     rows = np.concatenate([rows_m, cur, np.arange(size), np.full(n, size)])
     cols = np.concatenate([cols_m, nxt, np.full(size, size), np.arange(n)])
