@@ -21,6 +21,7 @@ def run(script, tmp_path, monkeypatch, capsys):
     return capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_flapping_blade_gallery_matches_simulation(tmp_path, monkeypatch, capsys):
     out = run('plot_flapping_blade.py', tmp_path, monkeypatch, capsys)
     assert (tmp_path / 'flapping_blade.png').stat().st_size > 10_000
