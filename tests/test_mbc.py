@@ -58,7 +58,7 @@ def test_mbc_with_varying_rotor_speed_maps_solutions():
         T0 = ltp.coleman_matrix(azimuth(t), 3)
         T1 = ltp.coleman_matrix(azimuth(t), 3, 1)
         return np.block([[T0, np.zeros((3, 3))], [speed(t) * T1, T0]])
-    times = np.linspace(0, 2 * T_REV, 9)
+    times = np.linspace(0, T_REV, 5)
     xs = solve_ivp(lambda t, x: sys.A(t) @ x, (0, times[-1]), x0, t_eval=times,
                    rtol=1e-11, atol=1e-12).y
     z0 = np.linalg.solve(state_map(0.0), x0)

@@ -22,6 +22,7 @@ with ``𝒯̇`` holding ``Ω T'`` and ``Ω² T'' + Ω̇ T'`` (Bir 2008; Hansen 2
 
 import numbers
 import re
+import warnings
 
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
@@ -111,7 +112,8 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
     rotating_inputs, rotating_outputs : sequence of sequences, optional
         Groups of blade inputs and outputs, transformed with ``T(ψ)``.
     rotor_speed : float, PeriodicMatrix or callable, optional
-        Ω in rad/s: a constant, or a T-periodic 1x1 matrix (Fourier form,
+        Ω in rad/s: a constant (0 for a parked rotor: a constant
+        transform at `azimuth0`), or a T-periodic 1x1 matrix (Fourier form,
         or a smooth callable) whose mean is a multiple of ``2π/T``.
         Default: that of a `RotorStateSpace`, otherwise ``2π/T`` (one
         revolution per period).
@@ -187,47 +189,54 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
         rotor_speed = sys.rotor_speed if rotor else 2 * np.pi / T
     speed = _speed(rotor_speed, T)
 
-    def state_transform(t, omega, domega, psi):
-        """𝒯 and 𝒯̇ at one instant."""
-        P, dP = np.eye(n), np.zeros((n, n))
+    w = _coleman_weights(N)
+
+    def state_transform(omega, domega, psi):
+        """𝒯, 𝒯⁻¹ and 𝒯̇ at one instant (T⁻¹ = diag(w) Tᵀ)."""
+        P, Pinv, dP = np.eye(n), np.eye(n), np.zeros((n, n))
         T0 = coleman_matrix(psi, N)
+        T0inv = w[:, None] * T0.T
         T1, T2 = coleman_matrix(psi, N, 1), coleman_matrix(psi, N, 2)
         for g, r in zip(groups, rate_groups):
-            P[np.ix_(g, g)] = T0
+            P[np.ix_(g, g)], Pinv[np.ix_(g, g)] = T0, T0inv
             dP[np.ix_(g, g)] = omega * T1
             if r is not None:
-                P[np.ix_(r, r)] = T0
+                # [[T, 0], [Ω T', T]]⁻¹ = [[T⁻¹, 0], [-Ω T⁻¹ T' T⁻¹, T⁻¹]]
+                P[np.ix_(r, r)], Pinv[np.ix_(r, r)] = T0, T0inv
                 P[np.ix_(r, g)] = omega * T1
+                Pinv[np.ix_(r, g)] = -omega * T0inv @ T1 @ T0inv
                 dP[np.ix_(r, r)] = omega * T1
                 dP[np.ix_(r, g)] = omega ** 2 * T2 + domega * T1
-        return P, dP
+        return P, Pinv, dP
 
     def signal_transform(size, sgroups, psi):
-        P = np.eye(size)
+        P, Pinv = np.eye(size), np.eye(size)
+        T0 = coleman_matrix(psi, N)
         for g in sgroups:
-            P[np.ix_(g, g)] = coleman_matrix(psi, N)
-        return P
+            P[np.ix_(g, g)], Pinv[np.ix_(g, g)] = T0, w[:, None] * T0.T
+        return P, Pinv
 
     def transformed(t, mats, which=(0, 1, 2, 3)):
         """The transformed matrices `which` (0: A, 1: B, 2: C, 3: D) at time t."""
         omega, domega, psi = speed(t, psi0)
-        P, dP = state_transform(t, omega, domega, psi)
-        Pu, Py = signal_transform(m, in_groups, psi), signal_transform(p, out_groups, psi)
+        P, Pinv, dP = state_transform(omega, domega, psi)
+        (Pu, Puinv), (Py, Pyinv) = signal_transform(m, in_groups, psi), \
+            signal_transform(p, out_groups, psi)
         if inverse:
-            # z = 𝒯⁻¹ x: the inverse map of the forward formulas
-            P, dP = np.linalg.inv(P), -np.linalg.solve(P, dP) @ np.linalg.inv(P)
-            Pu, Py = np.linalg.inv(Pu), np.linalg.inv(Py)
+            # z = 𝒯⁻¹ x: the forward formulas with 𝒯⁻¹, d(𝒯⁻¹)/dt = -𝒯⁻¹ 𝒯̇ 𝒯⁻¹
+            P, Pinv, dP = Pinv, P, -Pinv @ dP @ Pinv
+            Pu, Puinv, Py, Pyinv = Puinv, Pu, Pyinv, Py
         out = []
         for j in which:
             M = mats[j](t) if callable(mats[j]) else mats[j]
             if j == 0:
-                out.append(np.linalg.solve(P, M @ P - dP))
+                out.append(Pinv @ (M @ P - dP))
             elif j == 1:
-                out.append(np.linalg.solve(P, M @ Pu))
+                out.append(Pinv @ M @ Pu)
             elif j == 2:
-                out.append(np.linalg.solve(Py, M @ P))
+                out.append(Pyinv @ M @ P)
             else:
-                out.append(np.linalg.solve(Py, M @ Pu))
+                out.append(Pyinv @ M @ Pu)
         return out
 
     def matrix(index, shape):
@@ -252,7 +261,8 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
     samples = None
     if rotor and sys.samples is not None:
         omega = sys.rotor_speed
-        times = np.mod((np.asarray(sys.azimuths) - psi0) / omega, T)
+        times = np.mod((np.asarray(sys.azimuths) - psi0) / omega, T) if omega else \
+            np.zeros(len(sys.azimuths))
         samples = [[], [], [], []]
         for s, t in enumerate(times):
             out = transformed(t, [M[s] for M in sys.samples])
@@ -264,7 +274,7 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
             mats = [sampled_matrix(M, sys.azimuths, psi0, T, None, nm)
                     for M, nm in zip(samples, 'ABCD')]
     P = PeriodicMatrix.from_function(
-        lambda t: state_transform(float(t), *speed(float(t), psi0))[0], T, (n, n), check=False)
+        lambda t: state_transform(*speed(float(t), psi0))[0], T, (n, n), check=False)
     if inverse:
         Pf = P
         P = PeriodicMatrix.from_function(lambda t: np.linalg.inv(Pf(t)), T, (n, n),
@@ -303,8 +313,12 @@ def _speed(rotor_speed, T):
     wp = 2 * np.pi / T
     if isinstance(rotor_speed, (numbers.Real, np.number)) and not isinstance(rotor_speed, bool):
         Om = float(rotor_speed)
+        if Om == 0:
+            # a parked rotor: the transform is constant, at the azimuth ψ_0
+            return lambda t, psi0: (0.0, 0.0, psi0)
         if not Om > 0:
-            raise ValueError(f"rotor_speed must be positive, got {rotor_speed!r}")
+            raise ValueError(f"rotor_speed must be positive (or 0 for a parked rotor), "
+                             f"got {rotor_speed!r}")
         _check_revolutions(Om, T)
         return lambda t, psi0: (Om, 0.0, psi0 + Om * t)
     if not (isinstance(rotor_speed, PeriodicMatrix) or callable(rotor_speed)):
@@ -364,10 +378,48 @@ def _infer_groups(sys, N):
     disp = consecutive(np.flatnonzero(flags[:half]), 'displacements', desc)
     first = consecutive(n2 + np.flatnonzero(flags[n2:]), 'first-order states', desc)
     rates = [[i + half for i in g] for g in disp] + [None] * len(first)
-    ins = consecutive(np.flatnonzero(sys.rotating_inputs), 'inputs', sys.input_descriptions)
-    outs = consecutive(np.flatnonzero(sys.rotating_outputs), 'outputs',
-                       sys.output_descriptions)
+    ins = _signal_groups(np.flatnonzero(sys.rotating_inputs), sys.input_descriptions, N,
+                         'inputs')
+    outs = _signal_groups(np.flatnonzero(sys.rotating_outputs), sys.output_descriptions, N,
+                          'outputs')
     return disp + first, rates, ins, outs
+
+
+def _signal_groups(indices, descriptions, N, what):
+    """Blade groups of rotating inputs or outputs, matched by their names.
+
+    Items whose descriptions differ only in the blade number ('Blade 2 pitch',
+    'TipDxb2') form a group of N; flagged items that form no complete group
+    stay in the rotating frame, with a warning.
+    """
+    keyed = {}
+    for i in indices:
+        key, blade = _blade_key(descriptions[i])
+        keyed.setdefault(key, []).append((blade, int(i)))
+    groups, left = [], []
+    for key, items in keyed.items():
+        blades = sorted(b for b, _ in items)
+        if key is not None and blades == list(range(1, N + 1)):
+            groups.append([i for _, i in sorted(items)])
+        else:
+            left += [i for _, i in items]
+    if left:
+        warnings.warn(f"{len(left)} rotating {what} form no group of {N} blades (e.g. "
+                      f"{descriptions[left[0]]!r}); they are left in the rotating frame",
+                      UserWarning, stacklevel=4)
+    return groups
+
+
+def _blade_key(text):
+    """(description without its blade number, blade number), or (None, None)."""
+    m = re.search(r'blade\s*(\d+)', text, re.I)
+    if m:
+        return text[:m.start()] + 'blade #' + text[m.end():], int(m.group(1))
+    name, _, rest = text.partition(',')
+    m = re.match(r'^(.*?\D)(\d)(\D*)$', name.strip())
+    if m:
+        return m.group(1) + '#' + m.group(3) + ',' + rest, int(m.group(2))
+    return None, None
 
 
 def _blade_number(text):
