@@ -38,6 +38,11 @@ from ._identification.arx import identify_arx
 from ._orbits.closed_loop import ClosedLoopOrbit, closed_loop_response, closed_loop_orbit
 from ._analysis.lyapunov import lyap, dlyap, gram
 from ._analysis.norms import norm
+from ._analysis.floquet_modes import floquet_modes, FloquetModes
+from ._rotors.rotor_model import RotorStateSpace
+from ._rotors.mbc import mbc, coleman_matrix
+from ._rotors.read_lin import read_lin
+from ._rotors.campbell import campbell, CampbellDiagram
 from ._analysis.zeros import zeros
 from ._frequency.harmonic_ss import harmonic_ss
 from ._analysis.riccati import care, dare
@@ -90,6 +95,9 @@ __all__ = [
     # noisy data and Monte-Carlo studies
     'refine_ltp', 'RefineInfo', 'monte_carlo', 'MonteCarloResult',
     'sample_models',
+    # rotors and wind turbines
+    'floquet_modes', 'FloquetModes', 'RotorStateSpace', 'mbc', 'coleman_matrix', 'read_lin',
+    'campbell', 'CampbellDiagram',
 ]
 
 # python-control's entry points dispatch LTP systems to ltpcontrol (see interop)

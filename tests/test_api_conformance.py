@@ -126,6 +126,10 @@ KWARG_CALLS = {
     'LTPStateSpace.htf': lambda **kw: SYS.htf(1, **kw),
     'LTPStateSpace.sample': lambda **kw: SYS.sample(0.1, **kw),
     'HTF.plot': lambda **kw: H.plot(omega_num=5, **kw),
+    'RotorStateSpace': lambda **kw: ltp.RotorStateSpace(
+        ltp.PeriodicMatrix.constant([[-1.0]], T), [[1.0]], [[1.0]], [[0.0]], T, **kw),
+    'RotorStateSpace.average': lambda **kw: ltp.RotorStateSpace(
+        ltp.PeriodicMatrix.constant([[-1.0]], T), [[1.0]], [[1.0]], [[0.0]], T).average(**kw),
     # feedback around orbits
     'closed_loop_response': lambda **kw: ltp.closed_loop_response(
         FORCED, ct.ss([], [], [], [[-1.0]]), ltp.periodic_orbit(FORCED, T, [0.0]), [0, 0.5],
@@ -220,6 +224,7 @@ _RESULT_CLASSES |= {'OrbitBranch', 'Bifurcation'}
 _RESULT_CLASSES |= {'LMIDesign'}
 _RESULT_CLASSES |= {'RefineInfo', 'MonteCarloResult'}
 _RESULT_CLASSES |= {'HTFEstimateInfo'}
+_RESULT_CLASSES |= {'FloquetModes', 'CampbellDiagram'}
 
 DOC_DEFECTS = {}
 

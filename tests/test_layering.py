@@ -33,6 +33,8 @@ LAYERS = {
     'orbits': ['_orbits'],
     # experiments and identification from data
     'identification': ['_identification'],
+    # rotors and wind turbines: multi-blade coordinates, OpenFAST files, Campbell diagrams
+    'rotors': ['_rotors'],
     # python-control's entry points
     'interop': ['interop'],
 }

@@ -29,6 +29,7 @@ from control.exception import ControlArgument
 
 from .ltpsys import ltpss
 from .periodic_matrix import PeriodicMatrix
+from .periodic_schur import product_eigenvalues
 from .steps import step_grid
 from .transition import expm_batch, step_transitions
 from .validation import as_ltp, check_kwargs, check_positive_int, steps_per_period
@@ -406,66 +407,9 @@ def _log_multipliers(sys, nsteps, grid=None, factors=None):
     """``log|μ_i|`` and ``arg μ_i`` from the periodic Schur form, sorted."""
     if factors is None:
         grid, factors = _factors(sys, nsteps)
-    n = factors.shape[1]
-    if n == 0:
+    if factors.shape[1] == 0:
         return np.zeros(0), np.zeros(0)
-    # slycot order H_1 H_2 ... H_p with H_1 = Φ_{M-1}, ..., H_p = Φ_0
-    H = np.asfortranarray(np.moveaxis(factors[::-1], 0, -1))
-    if n > 1:
-        from slycot import mb03vd, mb03wd
-        HQ, _ = mb03vd(n, 1, n, H.copy(order='F'))
-        # keep H_1 upper Hessenberg and H_2..H_p upper triangular
-        H = np.triu(np.moveaxis(HQ, -1, 0))
-        H[0] += np.diag(np.diag(HQ[:, :, 0], -1), -1)
-        H = np.asfortranarray(np.moveaxis(H, 0, -1))
-        H, _, _ = mb03wd('S', 'N', n, 1, n, 1, n, H, np.zeros_like(H))
-    logmod, arg = np.empty(n), np.empty(n)
-    i = 0
-    with np.errstate(divide='ignore'):
-        while i < n:
-            if i + 1 < n and H[i + 1, i, 0] != 0:
-                logmod[i:i + 2], arg[i:i + 2] = _block_2x2(H[i:i + 2, i:i + 2])
-                i += 2
-            else:
-                # μ = Π_j t_jj: log|μ| = Σ_j log|t_jj|
-                d = H[i, i]
-                logmod[i] = np.sum(np.log(np.abs(d)))
-                arg[i] = np.pi if np.count_nonzero(d < 0) % 2 else 0.0
-                i += 1
-    order = np.argsort(-logmod, kind='stable')
-    return logmod[order], arg[order]
-
-
-def _block_2x2(blocks):
-    """Eigenvalues of ``Π_j B_j`` (B_j = blocks[:, :, j]) in log form."""
-    prod, logscale = np.eye(2), 0.0
-    # running product normalised at every factor: Π_j B_j = e^{logscale} prod
-    for j in range(blocks.shape[2]):
-        prod = prod @ blocks[:, :, j]
-        s = np.abs(prod).max()
-        if s == 0:
-            return np.full(2, -np.inf), np.zeros(2)
-        prod /= s
-        logscale += np.log(s)
-    dets = np.linalg.det(np.moveaxis(blocks, -1, 0))
-    logdet = np.sum(np.log(np.abs(dets)))
-    detsign = -1.0 if np.count_nonzero(dets < 0) % 2 else 1.0
-    # y = x e^{-logscale} solves y² - tr y + δ = 0, δ = det e^{-2 logscale}
-    tr = np.trace(prod)
-    with np.errstate(under='ignore'):
-        delta = detsign * np.exp(logdet - 2 * logscale)
-    disc = tr * tr - 4 * delta
-    if disc < 0:
-        ang = np.angle(complex(0.5 * tr, 0.5 * np.sqrt(-disc)))
-        return np.full(2, 0.5 * logdet), np.array([ang, -ang])
-    y1 = 0.5 * (tr + np.copysign(np.sqrt(disc), tr))
-    if y1 == 0:
-        return np.full(2, -np.inf), np.zeros(2)
-    # the small root from the determinant: log|y2| = log|det| - log|y1|
-    log1 = np.log(abs(y1)) + logscale
-    sign2 = detsign * np.sign(y1)
-    return np.array([log1, logdet - log1]), np.array(
-        [0.0 if y1 > 0 else np.pi, 0.0 if sign2 > 0 else np.pi])
+    return product_eigenvalues(factors)
 
 
 def _floquet_vectors(grid, factors, rate, flip, dtime):

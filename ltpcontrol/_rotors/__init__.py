@@ -1,0 +1,1 @@
+"""Rotors and wind turbines: multi-blade coordinates, OpenFAST linearizations, Campbell diagrams."""
