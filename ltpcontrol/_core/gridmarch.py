@@ -1,0 +1,305 @@
+"""Exact simulation on time grids whose steps do not divide the period.
+
+On a uniform grid whose step divides the period the step data repeat and
+one period of them is computed (``_march``).  On any other grid every step
+``[t_k, t_k + h_k]`` has its own phase, and computing every step's
+transition data afresh costs as many fourth-order Magnus integrations as
+there are samples.  Instead:
+
+* **Repeating phases.**  When ``q h = p T`` for small integers (a uniform
+  grid commensurate with the period), the step data repeat every q steps:
+  q steps are computed and the periodic march runs with period q.
+* **Phase table.**  Otherwise one period is cut into N equal cells of
+  length ``g = T/N <= h_min / r`` and a step is split into a head piece
+  ``[t_k, a_k]``, c whole cells ``[a_k, b_k]`` and a tail piece
+  ``[b_k, t_k + h_k]`` (a, b on the cell grid).  The cells' data are
+  computed once per period; the pieces are shorter than a cell, so their
+  Magnus integration needs few sub-steps (r is chosen from the sub-steps a
+  whole step needs, so that a piece needs about four).
+
+The data of an interval ``I = [a, b]`` with a linear input
+``u(τ) = u_k + (τ - t_k)/h_k Δu`` are
+
+    Φ_I = Φ(b, a),   W_I = ∫_I Φ(b, s) B(s) ds,   Z_I = ∫_I Φ(b, s) B(s) (s - a) ds,
+
+and the input enters as ``W_I (u_k + (a - t_k)/h_k Δu) + Z_I Δu / h_k``.  They
+compose exactly: for ``I1 = [a, c]`` followed by ``I2 = [c, b]``
+
+    Φ = Φ2 Φ1,   W = Φ2 W1 + W2,   Z = Φ2 Z1 + Z2 + (c - a) W2,
+
+so a run of c cells is assembled from precomputed runs of 2^i cells
+(binary lifting, ⌈log2 c⌉ products), and the step data are
+``Γ0 = W``, ``Γ1 = Z / h_k`` (``_transition``).  The answer is exact to the
+integrator's tolerance, like the aligned path; only the number of
+integrations changes.  The march itself runs on chunks of steps with the
+block kernel of ``_march``, a chunk being one "period" of step data.
+"""
+
+import math
+from fractions import Fraction
+
+import numpy as np
+
+from .march import periodic_march
+from .transition import step_transitions
+
+__all__ = []
+
+_CHUNK_STEPS = 4000          # steps of step data held at a time
+_MAX_CELLS = 2 ** 15         # cells of the phase table
+_MAX_REPEAT = 4096           # longest repeating phase pattern used as a period
+_DEG = 8                     # degree of the partial-cell interpolants (equispaced nodes)
+_TABLE_TOL = 1e-13           # accepted interpolation error (relative to a cell's data)
+
+
+def grid_march(A, B, C, D, t, u, x0, hold, rtol, states=True):
+    """States and outputs of ``ẋ = Ax + Bu, y = Cx + Du`` on an arbitrary grid.
+
+    Parameters
+    ----------
+    A, B, C, D : PeriodicMatrix
+    t : ndarray, shape (L,)
+        Strictly increasing time points, L >= 2.
+    u : ndarray, shape (m, R, L)
+    x0 : ndarray, shape (n, R)
+    hold : {'foh', 'zoh'}
+    rtol : float
+    states : bool
+        Return the states (False: None, outputs only).
+
+    Returns
+    -------
+    x : ndarray, shape (n, R, L), or None
+    y : ndarray, shape (p, R, L)
+
+    Examples
+    --------
+    A grid whose step (0.3) does not divide the period (1):
+
+    >>> from ltpcontrol._core.gridmarch import grid_march
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> t = 0.3 * np.arange(11)
+    >>> x, y = grid_march(sys.A, sys.B, sys.C, sys.D, t, np.ones((1, 1, 11)),
+    ...                   np.zeros((1, 1)), 'foh', 1e-12)
+    >>> bool(np.allclose(y[0, 0], 1 - np.exp(-t)))
+    True
+    """
+    T = A.period
+    h = np.diff(t)
+    repeat = _repeat_length(t, h, T)
+    if repeat is not None:
+        # the step data repeat every q steps: march with period q
+        tk = t[0] + h[0] * np.arange(repeat)
+        Phi, G0, G1 = step_transitions(A, B, tk, h[0], rtol)
+        E, F = _hold(G0, G1, hold)
+        return periodic_march(Phi, E, F, C(tk), D(tk), u, x0, states=states)
+    steps = _table_steps(A, B, h, T, rtol) if len(h) > 2 * math.ceil(T / h.min()) else None
+    if steps is None:
+        def steps(k0, k1):
+            Phi, G0, G1 = step_transitions(A, B, t[k0:k1], h[k0:k1], rtol)
+            return Phi, G0, G1
+    else:
+        table = steps
+
+        def steps(k0, k1):
+            return table(t[k0:k1], h[k0:k1])
+    return _chunked_march(steps, C, D, t, u, x0, hold, states)
+
+
+def _repeat_length(t, h, T):
+    """q when the grid is uniform and ``q h = p T`` (q <= a bound), else None."""
+    if not np.allclose(h, h[0], rtol=1e-10, atol=0):
+        return None
+    ratio = Fraction(float(h[0] / T)).limit_denominator(_MAX_REPEAT)
+    q, p = ratio.denominator, ratio.numerator
+    if abs(q * h[0] - p * T) > 1e-9 * p * T or q > len(h):
+        return None
+    # worthwhile only when the pattern is a few periods' worth of steps
+    return q if q <= 4 * math.ceil(T / h[0]) else None
+
+
+def _hold(G0, G1, hold):
+    # x[k+1] = Φ x[k] + (Γ0 - Γ1) u[k] + Γ1 u[k+1] (first-order hold)
+    return (G0, None) if hold == 'zoh' else (G0 - G1, G1)
+
+
+def _chunked_march(steps, C, D, t, u, x0, hold, states):
+    """March chunk after chunk of step data, each chunk as one 'period'."""
+    L = len(t)
+    n, R = x0.shape
+    p = C.shape[0]
+    x = np.empty((n, R, L)) if states else None
+    y = np.empty((p, R, L))
+    xs = x0
+    for s0 in range(0, L, _CHUNK_STEPS):
+        s1 = min(L, s0 + _CHUNK_STEPS)
+        S = s1 - s0
+        k1 = min(s1, L - 1)                    # step data exist for samples < L - 1
+        Phi, G0, G1 = steps(s0, k1)
+        E, F = _hold(G0, G1, hold)
+        Nc = -(-S // 20) * 20                  # a multiple of the block length
+        Phi, E, F = _pad(Phi, Nc, eye=True), _pad(E, Nc), None if F is None else _pad(F, Nc)
+        tk = t[s0:s1]
+        Cs, Ds = _pad(C(tk), Nc), _pad(D(tk), Nc)
+        if s1 == L:
+            xc, yc = periodic_march(Phi, E, F, Cs, Ds, u[:, :, s0:s1], xs, states=states,
+                                    nsamples=S)
+        else:
+            # one more input sample: the state after the chunk starts the next one
+            xc, yc, xs = periodic_march(Phi, E, F, Cs, Ds, u[:, :, s0:s1 + 1], xs,
+                                        states=states, final=True, nsamples=S)
+        y[:, :, s0:s1] = yc
+        if states:
+            x[:, :, s0:s1] = xc
+    return x, y
+
+
+def _pad(a, N, eye=False):
+    """Step data padded to N steps (identity transitions, zero inputs and outputs)."""
+    if len(a) == N:
+        return a
+    out = np.zeros((N,) + a.shape[1:])
+    out[:len(a)] = a
+    if eye:
+        out[len(a):] = np.eye(a.shape[1])
+    return out
+
+
+def _table_steps(A, B, h, T, rtol):
+    """Step data from a phase table (module notes), or None when not exact enough."""
+    hmin, hmax = float(h.min()), float(h.max())
+    n, m = A.shape[0], B.shape[1]
+    for refine in (2, 4, 8):
+        # cells shorter than h_min / refine (so a step spans a cell boundary),
+        # split at the switching instants
+        N = math.floor(refine * T / hmin) + 1
+        if N > _MAX_CELLS:
+            return None
+        bps = np.mod(np.concatenate([A.breakpoints, B.breakpoints]), T)
+        edges = np.union1d(np.linspace(0, T, N + 1), bps)
+        edges = edges[np.concatenate([[True], np.diff(edges) > 1e-12 * T])]
+        edges[-1] = T
+        partial = _partial_table(A, B, edges, rtol)
+        if _partial_error(A, B, edges, partial, rtol) <= max(_TABLE_TOL, 0.1 * rtol):
+            break
+    else:
+        return None
+    lens = np.diff(edges)
+    N = len(lens)
+    cells = tuple(v[:, -1] for v in partial)            # whole cells (Φ, W, Z)
+    # runs of 2^i cells from every cell: (Φ, W, Z, length)
+    levels = max(1, int(math.ceil(hmax / lens.min()) + 1).bit_length())
+    lift = [cells + (lens,)]
+    for i in range(1, levels):
+        P, W, Z, ln = lift[-1]
+        nxt = (np.arange(N) + 2 ** (i - 1)) % N
+        lift.append(_compose((P, W, Z), (P[nxt], W[nxt], Z[nxt]), ln) + (ln + ln[nxt],))
+
+    def steps(tk, hk):
+        theta = tk - T * np.floor(tk / T)
+        j = np.clip(np.searchsorted(edges, theta, side='right') - 1, 0, N - 1)
+        phi = theta + hk
+        wraps = np.floor(phi / T)
+        jb = np.clip(np.searchsorted(edges, phi - wraps * T, side='right') - 1, 0, N - 1)
+        count = (jb + N * wraps.astype(int)) - j - 1
+        # head [θ, e_{j+1}] from [e_j, e_{j+1}] = [e_j, θ] then [θ, e_{j+1}]
+        lp = theta - edges[j]
+        Pp, Wp, Zp = _interpolate(partial, edges, j, lp)
+        Pc, Wc, Zc = (v[j] for v in cells)
+        Ph = np.linalg.solve(np.swapaxes(Pp, 1, 2), np.swapaxes(Pc, 1, 2)).swapaxes(1, 2)
+        Wh = Wc - Ph @ Wp
+        Zh = Zc - Ph @ Zp - lp[:, None, None] * Wh
+        data, start = (Ph, Wh, Zh), edges[j + 1] - theta
+        # the run of `count` cells after cell j, by the binary digits of count
+        pos = (j + 1) % N
+        for i, (P, W, Z, ln) in enumerate(lift):
+            sel = (count >> i) & 1 == 1
+            if np.any(sel):
+                data = _compose_sel(data, (P[pos[sel]], W[pos[sel]], Z[pos[sel]]), start, sel)
+                start = start + np.where(sel, ln[pos], 0.0)
+                pos = np.where(sel, (pos + 2 ** i) % N, pos)
+        tail = _interpolate(partial, edges, jb, phi - wraps * T - edges[jb])
+        P, W, Z = _compose(data, tail, start)
+        return P, W, Z / hk[:, None, None]
+    return steps
+
+
+def _partial_table(A, B, edges, rtol):
+    """(Φ, W, Z) of ``[e_j, e_j + ℓ_i]``, ``ℓ_i = i h_j / D``, for every cell j."""
+    n, m = A.shape[0], B.shape[1]
+    lens = np.diff(edges)
+    nodes = edges[:-1, None] + lens[:, None] * np.linspace(0.0, 1.0, _DEG + 1)       # (N, D+1)
+    a, d = nodes[:, :-1].ravel(), np.diff(nodes, axis=1).ravel()
+    Phi, G0, G1 = step_transitions(A, B, a, d, rtol)
+    shape = (len(lens), _DEG)
+    Phi, W1, Z1 = (v.reshape(shape + v.shape[1:]) for v in (Phi, G0, G1 * d[:, None, None]))
+    P = np.empty((len(lens), _DEG + 1, n, n))
+    W = np.zeros((len(lens), _DEG + 1, n, m))
+    Z = np.zeros((len(lens), _DEG + 1, n, m))
+    P[:, 0] = np.eye(n)
+    for i in range(_DEG):
+        P[:, i + 1], W[:, i + 1], Z[:, i + 1] = _compose(
+            (P[:, i], W[:, i], Z[:, i]), (Phi[:, i], W1[:, i], Z1[:, i]),
+            nodes[:, i] - nodes[:, 0])
+    return P, W, Z
+
+
+def _interpolate(partial, edges, j, length):
+    """(Φ, W, Z) of ``[e_j, e_j + length]`` by barycentric interpolation in the cell."""
+    xi = np.clip(length / (edges[j + 1] - edges[j]), 0.0, 1.0)
+    cheb = np.linspace(0.0, 1.0, _DEG + 1)
+    # barycentric weights of equispaced nodes: (-1)^j binom(D, j)
+    bary = np.array([(-1.0) ** k * math.comb(_DEG, k) for k in range(_DEG + 1)])
+    diff = xi[:, None] - cheb[None, :]
+    hit = diff == 0
+    with np.errstate(divide='ignore'):
+        w = np.where(hit.any(axis=1, keepdims=True), hit.astype(float), bary / diff)
+    w /= w.sum(axis=1, keepdims=True)
+    return tuple(np.einsum('sj,sj...->s...', w, v[j]) for v in partial)
+
+
+def _partial_error(A, B, edges, partial, rtol):
+    """Largest interpolation error at probe lengths of a few cells, against the integrator."""
+    N = len(edges) - 1
+    # short probe lengths keep the reference integration cheap
+    j = np.unique(np.linspace(0, N - 1, min(N, 5)).astype(int))
+    j = np.concatenate([j, j])
+    frac = np.concatenate([np.full(len(j) // 2, 0.0731), np.full(len(j) // 2, 0.2917)])
+    length = frac * (edges[j + 1] - edges[j])
+    exact = _pieces(A, B, edges[j], length, rtol, A.shape[0])
+    approx = _interpolate(partial, edges, j, length)
+    err = 0.0
+    for i, (e, a, whole) in enumerate(zip(exact, approx, partial)):
+        if e.size:
+            # Φ relative to max(1, |Φ|); W, Z relative to their size over a cell
+            scale = np.abs(whole[:, -1]).max()
+            scale = max(1.0, scale) if i == 0 else max(scale, 1e-300)
+            err = max(err, float(np.abs(e - a).max() / scale))
+    return err
+
+
+def _pieces(A, B, a, length, rtol, n):
+    """(Φ, W, Z) of the pieces [a, a + length]; zero length gives the identity."""
+    m = B.shape[1]
+    P = np.broadcast_to(np.eye(n), (len(a), n, n)).copy()
+    W, Z = np.zeros((len(a), n, m)), np.zeros((len(a), n, m))
+    live = length > 1e-14 * A.period
+    if np.any(live):
+        Pl, G0, G1 = step_transitions(A, B, a[live], length[live], rtol)
+        P[live], W[live], Z[live] = Pl, G0, G1 * length[live][:, None, None]
+    return P, W, Z
+
+
+def _compose(first, second, len1):
+    """Data of ``I1`` followed by ``I2`` (module notes); len1 the length of I1."""
+    P1, W1, Z1 = first
+    P2, W2, Z2 = second
+    len1 = np.broadcast_to(np.asarray(len1, float), (len(P1),))[:, None, None]
+    return P2 @ P1, P2 @ W1 + W2, P2 @ Z1 + Z2 + len1 * W2
+
+
+def _compose_sel(data, part, len1, sel):
+    """`_compose` on the rows `sel` of `data`; the other rows are kept."""
+    P, W, Z = (a.copy() for a in data)
+    P[sel], W[sel], Z[sel] = _compose((P[sel], W[sel], Z[sel]), part, len1[sel])
+    return P, W, Z
