@@ -47,7 +47,7 @@ def test_table_equals_per_step_integration(monkeypatch):
 def test_repeating_phase_pattern(monkeypatch):
     sys = switching_mathieu()
     t = 3 * sys.period / 50 * np.arange(900)              # 50 steps span three periods
-    assert gridmarch._repeat_length(t, np.diff(t), sys.period) == 50
+    assert gridmarch._repeat_length(t, np.diff(t), sys.period) == (50, 3)
     u = np.cos(3.0 * t)
     resp = ltp.forced_response(sys, t, u)
     ref = direct(monkeypatch, sys, t, u)

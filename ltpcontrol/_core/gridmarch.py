@@ -87,27 +87,33 @@ def grid_march(A, B, C, D, t, u, x0, hold, rtol, states=True):
     T = A.period
     h = np.diff(t)
     repeat = _repeat_length(t, h, T)
+    table = None
+    if repeat is None or repeat[1] > 1:
+        # steps longer than or not dividing the period: a cell table, when worthwhile
+        count = len(h) if repeat is None else repeat[0]
+        if count > 2 * math.ceil(T / h.min()) or (repeat is not None and repeat[1] > 1):
+            table = _table_steps(A, B, h, T, rtol)
     if repeat is not None:
         # the step data repeat every q steps: march with period q
-        tk = t[0] + h[0] * np.arange(repeat)
-        Phi, G0, G1 = step_transitions(A, B, tk, h[0], rtol)
+        q = repeat[0]
+        tk = t[0] + h[0] * np.arange(q)
+        if table is not None:
+            Phi, G0, G1 = table(tk, np.full(q, h[0]))
+        else:
+            Phi, G0, G1 = step_transitions(A, B, tk, h[0], rtol)
         E, F = _hold(G0, G1, hold)
         return periodic_march(Phi, E, F, C(tk), D(tk), u, x0, states=states)
-    steps = _table_steps(A, B, h, T, rtol) if len(h) > 2 * math.ceil(T / h.min()) else None
-    if steps is None:
+    if table is None:
         def steps(k0, k1):
-            Phi, G0, G1 = step_transitions(A, B, t[k0:k1], h[k0:k1], rtol)
-            return Phi, G0, G1
+            return step_transitions(A, B, t[k0:k1], h[k0:k1], rtol)
     else:
-        table = steps
-
         def steps(k0, k1):
             return table(t[k0:k1], h[k0:k1])
     return _chunked_march(steps, C, D, t, u, x0, hold, states)
 
 
 def _repeat_length(t, h, T):
-    """q when the grid is uniform and ``q h = p T`` (q <= a bound), else None."""
+    """``(q, p)`` when the grid is uniform and ``q h = p T`` (q <= a bound), else None."""
     if not np.allclose(h, h[0], rtol=1e-10, atol=0):
         return None
     ratio = Fraction(float(h[0] / T)).limit_denominator(_MAX_REPEAT)
@@ -115,7 +121,7 @@ def _repeat_length(t, h, T):
     if abs(q * h[0] - p * T) > 1e-9 * p * T or q > len(h):
         return None
     # worthwhile only when the pattern is a few periods' worth of steps
-    return q if q <= 4 * math.ceil(T / h[0]) else None
+    return (q, p) if q <= 4 * math.ceil(T / h[0]) else None
 
 
 def _hold(G0, G1, hold):
@@ -172,7 +178,7 @@ def _table_steps(A, B, h, T, rtol):
     for refine in (2, 4, 8):
         # cells shorter than h_min / refine (so a step spans a cell boundary),
         # split at the switching instants
-        N = math.floor(refine * T / hmin) + 1
+        N = max(16, math.floor(refine * T / hmin) + 1)
         if N > _MAX_CELLS:
             return None
         bps = np.mod(np.concatenate([A.breakpoints, B.breakpoints]), T)
