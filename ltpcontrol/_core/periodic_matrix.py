@@ -21,6 +21,7 @@ import numpy as np
 from control.exception import ControlDimension
 
 from .display import describe
+from .pm_ops import Block, Identity, Index, Scale, Transpose
 from .validation import check_period, check_positive_int, commensurate, real_array
 
 __all__ = ['PeriodicMatrix']
@@ -97,6 +98,19 @@ class PeriodicMatrix:
     @classmethod
     def _new(cls, period, shape, **kwargs):
         return cls.__new__(cls)._init(period, shape, **kwargs)
+
+    def __getstate__(self):
+        # a lambda or local function cannot be pickled: say how to get data
+        for f in _callables(self):
+            qual = getattr(f, '__qualname__', '')
+            if '<lambda>' in qual or '<locals>' in qual:
+                raise TypeError(
+                    f"cannot pickle a PeriodicMatrix defined by the local function "
+                    f"{qual}: define it at module level, or sample it, e.g. "
+                    "PeriodicMatrix.from_samples(P.sample(N), P.period)")
+        state = dict(self.__dict__)
+        state['_cache'] = {}
+        return state
 
     #
     # Alternative constructors
@@ -568,7 +582,7 @@ class PeriodicMatrix:
             coeffs[::r] = self._coeffs
             return PeriodicMatrix(coeffs, period)
         bps = (self.breakpoints[None, :] + self.period * np.arange(r)[:, None]).ravel()
-        return PeriodicMatrix._new(period, self.shape, combine=(lambda x: x, [self]),
+        return PeriodicMatrix._new(period, self.shape, combine=(Identity(), [self]),
                                    breakpoints=bps)
 
     def _binary(self, other, op, shape, fourier_op):
@@ -615,7 +629,7 @@ class PeriodicMatrix:
     def _scale(self, c):
         if self._coeffs is not None:
             return PeriodicMatrix(c * self._coeffs, self.period)
-        return PeriodicMatrix._new(self.period, self.shape, combine=(lambda x: c * x, [self]),
+        return PeriodicMatrix._new(self.period, self.shape, combine=(Scale(c), [self]),
                                    breakpoints=self.breakpoints)
 
     def __matmul__(self, other):
@@ -637,7 +651,7 @@ class PeriodicMatrix:
         if self._coeffs is not None:
             return PeriodicMatrix(np.swapaxes(self._coeffs, 1, 2), self.period)
         return PeriodicMatrix._new(self.period, self.shape[::-1],
-                                   combine=(lambda x: np.swapaxes(x, 1, 2), [self]),
+                                   combine=(Transpose(), [self]),
                                    breakpoints=self.breakpoints)
 
     def __getitem__(self, index):
@@ -648,7 +662,7 @@ class PeriodicMatrix:
         if self._coeffs is not None:
             return PeriodicMatrix(self._coeffs[:, rows, cols], self.period)
         return PeriodicMatrix._new(self.period, probe.shape,
-                                   combine=(lambda x: x[:, rows, cols], [self]),
+                                   combine=(Index(rows, cols), [self]),
                                    breakpoints=self.breakpoints)
 
     @staticmethod
@@ -684,11 +698,7 @@ class PeriodicMatrix:
             K = max(m._coeffs.shape[0] // 2 for m in operands)
             coeffs = np.block([[m.fourier(K) for m in row] for row in mats])
             return PeriodicMatrix(coeffs, period)
-        widths = [len(row) for row in mats]
-
-        def assemble(*values):
-            it = iter(values)
-            return np.block([[next(it) for _ in range(w)] for w in widths])
+        assemble = Block([len(row) for row in mats])
         shape = assemble(*[np.zeros((1,) + m.shape) for m in operands]).shape[1:]
         return PeriodicMatrix._new(period, shape, combine=(assemble, operands),
                                    breakpoints=np.concatenate([m.breakpoints for m in operands]))
@@ -719,6 +729,18 @@ def as_periodic(value, period, name, shape=None):
     if shape is not None and value.shape != tuple(shape):
         raise ControlDimension(f"{name} must have shape {tuple(shape)}, got {value.shape}")
     return value
+
+
+def _callables(P):
+    """The callables a periodic matrix and its operands are made of."""
+    out = [] if P._func is None else [P._func]
+    if P._combine is not None:
+        out.append(P._combine[0])
+        for o in P._combine[1]:
+            out += _callables(o)
+    for piece in P._pieces or ():
+        out += _callables(piece)
+    return out
 
 
 def _as_matrix(value, name):
