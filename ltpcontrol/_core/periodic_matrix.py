@@ -21,7 +21,7 @@ import numpy as np
 from control.exception import ControlDimension
 
 from .display import describe
-from .pm_ops import Block, Identity, Index, Scale, Transpose
+from .pm_ops import Block, Identity, Index, Scale, Transpose, add_series, mul_series
 from .validation import check_period, check_positive_int, commensurate, real_array
 
 __all__ = ['PeriodicMatrix']
@@ -98,6 +98,22 @@ class PeriodicMatrix:
     @classmethod
     def _new(cls, period, shape, **kwargs):
         return cls.__new__(cls)._init(period, shape, **kwargs)
+
+    def _parts(self):
+        """``(form, data)`` of the storage form (the file format of `ltpcontrol.save`)."""
+        if self._coeffs is not None:
+            return 'fourier', self._coeffs
+        if self._pieces is not None:
+            return 'switching', (list(self._pieces), self._times)
+        return ('function', self._func) if self._func is not None else ('combine', self._combine)
+
+    @classmethod
+    def _assemble(cls, period, shape, breakpoints, form, data):
+        """Inverse of `_parts` (data validated by the caller)."""
+        keys = {'fourier': ('coeffs',), 'switching': ('pieces', 'times'),
+                'function': ('func',), 'combine': ('combine',)}[form]
+        data = data if len(keys) > 1 else (data,)
+        return cls._new(period, shape, breakpoints=breakpoints, **dict(zip(keys, data)))
 
     def __getstate__(self):
         # a lambda or local function cannot be pickled: say how to get data
@@ -604,7 +620,7 @@ class PeriodicMatrix:
         shape = self.shape if isinstance(other, PeriodicMatrix) else _as_matrix(other, 'operand').shape
         if shape != self.shape:
             raise ValueError(f"cannot add shapes {self.shape} and {shape}")
-        return self._binary(other, np.add, self.shape, _add_series)
+        return self._binary(other, np.add, self.shape, add_series)
 
     __radd__ = __add__
 
@@ -638,7 +654,7 @@ class PeriodicMatrix:
         oshape = other.shape if isinstance(other, PeriodicMatrix) else _as_matrix(other, 'operand').shape
         if self.shape[1] != oshape[0]:
             raise ValueError(f"cannot multiply shapes {self.shape} and {oshape}")
-        return self._binary(other, np.matmul, (self.shape[0], oshape[1]), _mul_series)
+        return self._binary(other, np.matmul, (self.shape[0], oshape[1]), mul_series)
 
     def __rmatmul__(self, other):
         if not _is_operand(other):
@@ -764,21 +780,3 @@ def _call_vectorised(func, t, shape):
     except Exception:
         pass
     return np.array([np.asarray(func(ti), float).reshape(shape) for ti in t])
-
-
-def _add_series(a, b):
-    Ka, Kb = a.shape[0] // 2, b.shape[0] // 2
-    K = max(Ka, Kb)
-    out = np.zeros((2 * K + 1,) + a.shape[1:], complex)
-    out[K - Ka:K + Ka + 1] += a
-    out[K - Kb:K + Kb + 1] += b
-    return out
-
-
-def _mul_series(a, b):
-    # (PQ)_k = Σ_l P_l Q_{k-l}: a discrete convolution over harmonics
-    Ka, Kb = a.shape[0] // 2, b.shape[0] // 2
-    out = np.zeros((2 * (Ka + Kb) + 1, a.shape[1], b.shape[2]), complex)
-    for i in range(2 * Ka + 1):
-        out[i:i + 2 * Kb + 1] += np.einsum('ij,kjl->kil', a[i], b)
-    return out

@@ -135,6 +135,26 @@ class Block:
         return cls(params['widths'])
 
 
+def add_series(a, b):
+    """Fourier coefficients of a sum."""
+    Ka, Kb = a.shape[0] // 2, b.shape[0] // 2
+    K = max(Ka, Kb)
+    out = np.zeros((2 * K + 1,) + a.shape[1:], complex)
+    out[K - Ka:K + Ka + 1] += a
+    out[K - Kb:K + Kb + 1] += b
+    return out
+
+
+def mul_series(a, b):
+    """Fourier coefficients of a product."""
+    # (PQ)_k = Σ_l P_l Q_{k-l}: a discrete convolution over harmonics
+    Ka, Kb = a.shape[0] // 2, b.shape[0] // 2
+    out = np.zeros((2 * (Ka + Kb) + 1, a.shape[1], b.shape[2]), complex)
+    for i in range(2 * Ka + 1):
+        out[i:i + 2 * Kb + 1] += np.einsum('ij,kjl->kil', a[i], b)
+    return out
+
+
 def _encode_index(ix):
     if isinstance(ix, slice):
         return {'slice': [ix.start, ix.stop, ix.step]}
