@@ -119,6 +119,7 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
         input_labels=sys.input_labels, state_labels=sys.state_labels if len(x) else [],
         title="Forced response for " + sys.name, transpose=transpose,
         return_x=return_states, squeeze=squeeze, multi_trace=multi,
+        trace_types=['forced'] * u.shape[1] if multi else None,
         sysname=sys.name, plot_inputs=True)
 
 
