@@ -9,13 +9,16 @@ there are samples.  Instead:
 * **Repeating phases.**  When ``q h = p T`` for small integers (a uniform
   grid commensurate with the period), the step data repeat every q steps:
   q steps are computed and the periodic march runs with period q.
-* **Phase table.**  Otherwise one period is cut into N equal cells of
-  length ``g = T/N <= h_min / r`` and a step is split into a head piece
-  ``[t_k, a_k]``, c whole cells ``[a_k, b_k]`` and a tail piece
-  ``[b_k, t_k + h_k]`` (a, b on the cell grid).  The cells' data are
-  computed once per period; the pieces are shorter than a cell, so their
-  Magnus integration needs few sub-steps (r is chosen from the sub-steps a
-  whole step needs, so that a piece needs about four).
+* **Phase table.**  Otherwise one period is cut into N cells
+  ``[e_j, e_{j+1}]`` shorter than the shortest step (uniform, split at the
+  switching instants), and a step is split into a head piece
+  ``[t_k, e_{j+1}]``, c whole cells and a tail piece ``[e_J, t_k + h_k]``.
+  The data of every cell, and of its first part ``[e_j, e_j + ℓ]`` at
+  D + 1 equispaced lengths ℓ, are integrated once; a step's head and tail
+  come from the first part interpolated in ℓ (degree D, checked against
+  the integrator at probe lengths: cells are halved until the error is
+  below 1e-13, or the steps are integrated one by one), the head by the
+  composition rule below solved for its second part.
 
 The data of an interval ``I = [a, b]`` with a linear input
 ``u(τ) = u_k + (τ - t_k)/h_k Δu`` are
@@ -48,7 +51,7 @@ __all__ = []
 _CHUNK_STEPS = 4000          # steps of step data held at a time
 _MAX_CELLS = 2 ** 15         # cells of the phase table
 _MAX_REPEAT = 4096           # longest repeating phase pattern used as a period
-_DEG = 8                     # degree of the partial-cell interpolants (equispaced nodes)
+_DEG = 10                    # degree of the partial-cell interpolants (equispaced nodes)
 _TABLE_TOL = 1e-13           # accepted interpolation error (relative to a cell's data)
 
 
@@ -175,7 +178,7 @@ def _table_steps(A, B, h, T, rtol):
     """Step data from a phase table (module notes), or None when not exact enough."""
     hmin, hmax = float(h.min()), float(h.max())
     n, m = A.shape[0], B.shape[1]
-    for refine in (2, 4, 8):
+    for refine in (1, 2, 4):
         # cells shorter than h_min / refine (so a step spans a cell boundary),
         # split at the switching instants
         N = max(16, math.floor(refine * T / hmin) + 1)
