@@ -93,3 +93,21 @@ def test_outputs_only():
         ltp.forced_response(sys, t, U, compute_states='no')
     with pytest.raises(ValueError, match='return_states'):
         ltp.forced_response(sys, t, U, compute_states=False, return_states=True)
+
+
+@pytest.mark.parametrize("few", [0, 16])
+def test_both_chunk_marches(monkeypatch, few):
+    # few traces: state by state; many: the block kernel of the periodic march
+    monkeypatch.setattr(gridmarch, '_FEW_TRACES', few)
+    monkeypatch.setattr(gridmarch, '_CHUNK_STEPS', 140)
+    sys = switching_mathieu()
+    t = np.linspace(0.1, 12 * sys.period, 1001)
+    U = np.cos(np.outer([1.0, 2.5, 4.0], t))[None]
+    x0 = np.array([[0.3, 0.0, -1.0], [0.0, 1.0, 0.5]])
+    resp = ltp.forced_response(sys, t, U, x0)
+    monkeypatch.setattr(gridmarch, '_CHUNK_STEPS', 4000)
+    ref = direct(monkeypatch, sys, t, U, initial_state=x0)
+    assert rel(resp.states, ref.states) < 1e-12
+    assert rel(resp.outputs, ref.outputs) < 1e-12
+    fast = ltp.forced_response(sys, t, U, x0, compute_states=False)
+    assert rel(fast.outputs, ref.outputs) < 1e-12

@@ -13,12 +13,12 @@ there are samples.  Instead:
   ``[e_j, e_{j+1}]`` shorter than the shortest step (uniform, split at the
   switching instants), and a step is split into a head piece
   ``[t_k, e_{j+1}]``, c whole cells and a tail piece ``[e_J, t_k + h_k]``.
-  The data of every cell, and of its first part ``[e_j, e_j + ℓ]`` at
-  D + 1 equispaced lengths ℓ, are integrated once; a step's head and tail
-  come from the first part interpolated in ℓ (degree D, checked against
+  The data of every cell, and of its first and last parts at D + 1
+  equispaced lengths ℓ, are integrated once; a step's head and tail
+  come from the first and last parts ``[e_j, e_j + ℓ]``,
+  ``[e_{j+1} - ℓ, e_{j+1}]`` interpolated in ℓ (degree D, checked against
   the integrator at probe lengths: cells are halved until the error is
-  below 1e-13, or the steps are integrated one by one), the head by the
-  composition rule below solved for its second part.
+  below 1e-13, or the steps are integrated one by one).
 
 The data of an interval ``I = [a, b]`` with a linear input
 ``u(τ) = u_k + (τ - t_k)/h_k Δu`` are
@@ -49,6 +49,8 @@ from .transition import step_transitions
 __all__ = []
 
 _CHUNK_STEPS = 4000          # steps of step data held at a time
+_FEW_TRACES = 16             # up to this many traces: march state by state
+_SEQ_BLOCK = 32              # block length of that march
 _MAX_CELLS = 2 ** 15         # cells of the phase table
 _MAX_REPEAT = 4096           # longest repeating phase pattern used as a period
 _DEG = 10                    # degree of the partial-cell interpolants (equispaced nodes)
@@ -150,7 +152,10 @@ def _chunked_march(steps, C, D, t, u, x0, hold, states):
         Phi, E, F = _pad(Phi, Nc, eye=True), _pad(E, Nc), None if F is None else _pad(F, Nc)
         tk = t[s0:s1]
         Cs, Ds = _pad(C(tk), Nc), _pad(D(tk), Nc)
-        if s1 == L:
+        if R <= _FEW_TRACES:
+            xc, yc, xs = _sequence_march(Phi, E, F, Cs, Ds, u[:, :, s0:s1 + 1], xs, S)
+            xc = xc if states else None
+        elif s1 == L:
             xc, yc = periodic_march(Phi, E, F, Cs, Ds, u[:, :, s0:s1], xs, states=states,
                                     nsamples=S)
         else:
@@ -161,6 +166,44 @@ def _chunked_march(steps, C, D, t, u, x0, hold, states):
         if states:
             x[:, :, s0:s1] = xc
     return x, y
+
+
+def _sequence_march(Phi, E, F, C, D, u, x0, S):
+    """States, outputs and final state of one chunk for a few traces.
+
+    With the forcing ``w_k = E_k u[k] + F_k u[k+1]`` computed for all steps
+    at once, ``x[k+1] = Φ_k x[k] + w_k`` is unrolled inside blocks of b
+    steps (``x[s+j] = Φ(j, 0) x[s] + σ_j``, a loop over j for all blocks at
+    once) and the block starts are marched block by block.
+    """
+    N, n, m = E.shape
+    R = u.shape[1]
+    Lu = u.shape[2]
+    b = _SEQ_BLOCK
+    Np = -(-N // b) * b
+    uk = np.zeros((m, R, Np + 1))
+    uk[:, :, :Lu] = u
+    uk[:, :, Lu:] = u[:, :, -1:]
+    w = np.einsum('kni,irk->knr', E, uk[:, :, :N])
+    if F is not None:
+        w += np.einsum('kni,irk->knr', F, uk[:, :, 1:N + 1])
+    Phi, w = _pad(Phi, Np, eye=True), _pad(w, Np)
+    nb = Np // b
+    Phi, w = Phi.reshape(nb, b, n, n), w.reshape(nb, b, n, R)
+    P = np.broadcast_to(np.eye(n), (nb, n, n)).copy()
+    sig = np.zeros((nb, n, R))
+    Ploc, sloc = np.empty((nb, b, n, n)), np.empty((nb, b, n, R))
+    for j in range(b):
+        Ploc[:, j], sloc[:, j] = P, sig
+        P, sig = Phi[:, j] @ P, Phi[:, j] @ sig + w[:, j]
+    starts = np.empty((nb + 1, n, R))
+    starts[0] = x0
+    for i in range(nb):
+        starts[i + 1] = P[i] @ starts[i] + sig[i]
+    x = (Ploc @ starts[:nb, None] + sloc).reshape(Np, n, R)[:S]
+    Ck, Dk = C[:S], D[:S]
+    y = np.einsum('kpn,knr->prk', Ck, x) + np.einsum('kpi,irk->prk', Dk, uk[:, :, :S])
+    return x.transpose(1, 2, 0), y, starts[nb]
 
 
 def _pad(a, N, eye=False):
@@ -195,7 +238,8 @@ def _table_steps(A, B, h, T, rtol):
         return None
     lens = np.diff(edges)
     N = len(lens)
-    cells = tuple(v[:, -1] for v in partial)            # whole cells (Φ, W, Z)
+    fwd, bwd = partial
+    cells = tuple(v[:, -1] for v in fwd)                # whole cells (Φ, W, Z)
     # runs of 2^i cells from every cell: (Φ, W, Z, length)
     levels = max(1, int(math.ceil(hmax / lens.min()) + 1).bit_length())
     lift = [cells + (lens,)]
@@ -211,14 +255,8 @@ def _table_steps(A, B, h, T, rtol):
         wraps = np.floor(phi / T)
         jb = np.clip(np.searchsorted(edges, phi - wraps * T, side='right') - 1, 0, N - 1)
         count = (jb + N * wraps.astype(int)) - j - 1
-        # head [θ, e_{j+1}] from [e_j, e_{j+1}] = [e_j, θ] then [θ, e_{j+1}]
-        lp = theta - edges[j]
-        Pp, Wp, Zp = _interpolate(partial, edges, j, lp)
-        Pc, Wc, Zc = (v[j] for v in cells)
-        Ph = np.linalg.solve(np.swapaxes(Pp, 1, 2), np.swapaxes(Pc, 1, 2)).swapaxes(1, 2)
-        Wh = Wc - Ph @ Wp
-        Zh = Zc - Ph @ Zp - lp[:, None, None] * Wh
-        data, start = (Ph, Wh, Zh), edges[j + 1] - theta
+        # head [θ, e_{j+1}] and tail [e_J, t_k + h_k] from the partial cells
+        data, start = _interpolate(bwd, edges, j, edges[j + 1] - theta), edges[j + 1] - theta
         # the run of `count` cells after cell j, by the binary digits of count
         pos = (j + 1) % N
         for i, (P, W, Z, ln) in enumerate(lift):
@@ -227,14 +265,14 @@ def _table_steps(A, B, h, T, rtol):
                 data = _compose_sel(data, (P[pos[sel]], W[pos[sel]], Z[pos[sel]]), start, sel)
                 start = start + np.where(sel, ln[pos], 0.0)
                 pos = np.where(sel, (pos + 2 ** i) % N, pos)
-        tail = _interpolate(partial, edges, jb, phi - wraps * T - edges[jb])
+        tail = _interpolate(fwd, edges, jb, phi - wraps * T - edges[jb])
         P, W, Z = _compose(data, tail, start)
         return P, W, Z / hk[:, None, None]
     return steps
 
 
 def _partial_table(A, B, edges, rtol):
-    """(Φ, W, Z) of ``[e_j, e_j + ℓ_i]``, ``ℓ_i = i h_j / D``, for every cell j."""
+    """(Φ, W, Z) of ``[e_j, e_j + ℓ_i]`` and of ``[e_{j+1} - ℓ_i, e_{j+1}]``, ``ℓ_i = i h_j / D``."""
     n, m = A.shape[0], B.shape[1]
     lens = np.diff(edges)
     nodes = edges[:-1, None] + lens[:, None] * np.linspace(0.0, 1.0, _DEG + 1)       # (N, D+1)
@@ -246,15 +284,22 @@ def _partial_table(A, B, edges, rtol):
     W = np.zeros((len(lens), _DEG + 1, n, m))
     Z = np.zeros((len(lens), _DEG + 1, n, m))
     P[:, 0] = np.eye(n)
+    Pb, Wb, Zb = P.copy(), W.copy(), Z.copy()
+    dd = d.reshape(shape)
     for i in range(_DEG):
+        # forward: [e_j, e_j + ℓ_i] then node interval i
         P[:, i + 1], W[:, i + 1], Z[:, i + 1] = _compose(
             (P[:, i], W[:, i], Z[:, i]), (Phi[:, i], W1[:, i], Z1[:, i]),
             nodes[:, i] - nodes[:, 0])
-    return P, W, Z
+        # backward: node interval D-1-i then [e_{j+1} - ℓ_i, e_{j+1}]
+        k = _DEG - 1 - i
+        Pb[:, i + 1], Wb[:, i + 1], Zb[:, i + 1] = _compose(
+            (Phi[:, k], W1[:, k], Z1[:, k]), (Pb[:, i], Wb[:, i], Zb[:, i]), dd[:, k])
+    return (P, W, Z), (Pb, Wb, Zb)
 
 
 def _interpolate(partial, edges, j, length):
-    """(Φ, W, Z) of ``[e_j, e_j + length]`` by barycentric interpolation in the cell."""
+    """(Φ, W, Z) at `length` in cells `j`, by barycentric interpolation in each cell."""
     xi = np.clip(length / (edges[j + 1] - edges[j]), 0.0, 1.0)
     cheb = np.linspace(0.0, 1.0, _DEG + 1)
     # barycentric weights of equispaced nodes: (-1)^j binom(D, j)
@@ -264,7 +309,17 @@ def _interpolate(partial, edges, j, length):
     with np.errstate(divide='ignore'):
         w = np.where(hit.any(axis=1, keepdims=True), hit.astype(float), bary / diff)
     w /= w.sum(axis=1, keepdims=True)
-    return tuple(np.einsum('sj,sj...->s...', w, v[j]) for v in partial)
+    # one matrix product per cell: weights (samples, D+1) times values (D+1, all entries)
+    sizes = [int(np.prod(v.shape[2:])) for v in partial]
+    table = np.concatenate([v.reshape(v.shape[0], v.shape[1], -1) for v in partial], axis=2)
+    out = np.empty((len(j), table.shape[2]))
+    order = np.argsort(j, kind='stable')
+    cells, first = np.unique(j[order], return_index=True)
+    for c, a, b in zip(cells, first, np.append(first[1:], len(j))):
+        idx = order[a:b]
+        out[idx] = w[idx] @ table[c]
+    parts = np.split(out, np.cumsum(sizes)[:-1], axis=1)
+    return tuple(q.reshape((len(j),) + v.shape[2:]) for q, v in zip(parts, partial))
 
 
 def _partial_error(A, B, edges, partial, rtol):
@@ -275,15 +330,17 @@ def _partial_error(A, B, edges, partial, rtol):
     j = np.concatenate([j, j])
     frac = np.concatenate([np.full(len(j) // 2, 0.0731), np.full(len(j) // 2, 0.2917)])
     length = frac * (edges[j + 1] - edges[j])
-    exact = _pieces(A, B, edges[j], length, rtol, A.shape[0])
-    approx = _interpolate(partial, edges, j, length)
+    fwd, bwd = partial
     err = 0.0
-    for i, (e, a, whole) in enumerate(zip(exact, approx, partial)):
-        if e.size:
-            # Φ relative to max(1, |Φ|); W, Z relative to their size over a cell
-            scale = np.abs(whole[:, -1]).max()
-            scale = max(1.0, scale) if i == 0 else max(scale, 1e-300)
-            err = max(err, float(np.abs(e - a).max() / scale))
+    for start, table in ((edges[j], fwd), (edges[j + 1] - length, bwd)):
+        exact = _pieces(A, B, start, length, rtol, A.shape[0])
+        approx = _interpolate(table, edges, j, length)
+        for i, (e, a, whole) in enumerate(zip(exact, approx, table)):
+            if e.size:
+                # Φ relative to max(1, |Φ|); W, Z relative to their size over a cell
+                scale = np.abs(whole[:, -1]).max()
+                scale = max(1.0, scale) if i == 0 else max(scale, 1e-300)
+                err = max(err, float(np.abs(e - a).max() / scale))
     return err
 
 
