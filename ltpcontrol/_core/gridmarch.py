@@ -272,7 +272,7 @@ def _table_steps(A, B, h, T, rtol):
 
 
 def _partial_table(A, B, edges, rtol):
-    """(Φ, W, Z) of ``[e_j, e_j + ℓ_i]`` and of ``[e_{j+1} - ℓ_i, e_{j+1}]``, ``ℓ_i = i h_j / D``."""
+    """(Φ, W, Z) of ``[e_j, e_j + ℓ_i]`` and ``[e_{j+1} - ℓ_i, e_{j+1}]``, ``ℓ_i = i h_j/D``."""
     n, m = A.shape[0], B.shape[1]
     lens = np.diff(edges)
     nodes = edges[:-1, None] + lens[:, None] * np.linspace(0.0, 1.0, _DEG + 1)       # (N, D+1)

@@ -207,7 +207,8 @@ def _block_operators(Phi, E, F, C, D, b, states=True):
     # O[:, k] = Φ(k, 0), k = 0..b
     O = np.empty((nb, b + 1, n, n))
     O[:, 0] = np.eye(n)
-    # V[:, k, j]: coefficient of u[s+j] in x[s+k]; x[s+k+1] = Φ_k x[s+k] + E_k u[s+k] + F_k u[s+k+1]
+    # V[:, k, j]: coefficient of u[s+j] in x[s+k], from
+    # x[s+k+1] = Φ_k x[s+k] + E_k u[s+k] + F_k u[s+k+1]
     V = np.zeros((nb, b + 1, b + 1, n, m))
     for k in range(b):
         O[:, k + 1] = Phi[:, k] @ O[:, k]

@@ -438,8 +438,8 @@ class PeriodicMatrix:
             # P(t) = P_0 + 2 Re Σ_{k>0} P_k e^{jkω_p t}
             ks = np.arange(1, K + 1)
             phase = np.exp(1j * self.omega_p * np.outer(t, ks))
-            return self._coeffs[K].real + 2 * np.einsum(
-                'tk,kij->tij', phase, self._coeffs[K + 1:]).real
+            series = (phase @ self._coeffs[K + 1:].reshape(K, -1)).real
+            return self._coeffs[K].real + 2 * series.reshape((len(t),) + self.shape)
         if self._func is not None:
             return _call_vectorised(self._func, t, self.shape)
         if self._pieces is not None:
