@@ -147,20 +147,21 @@ def _array(value, arrays):
 
 
 def _encode(obj, arrays):
-    if isinstance(obj, PeriodicMatrix):
+    # exact types: a subclass would come back as its base class
+    if type(obj) is PeriodicMatrix:
         return _encode_matrix(obj, arrays)
-    if isinstance(obj, LTPStateSpace):
+    if type(obj) is LTPStateSpace:
         return {'kind': 'LTPStateSpace', 'period': obj.period, 'dt': float(obj.dt),
                 'name': obj.name, 'inputs': list(obj.input_labels),
                 'outputs': list(obj.output_labels), 'states': list(obj.state_labels),
                 **{k: _encode_matrix(getattr(obj, k), arrays) for k in 'ABCD'}}
-    if isinstance(obj, HTFData):
+    if type(obj) is HTFData:
         return {'kind': 'HTFData', 'period': obj.period, 'name': obj.name,
                 'inputs': list(obj.input_labels), 'outputs': list(obj.output_labels),
                 'components': _array(obj._components, arrays),
                 'omega': _array(obj.omega, arrays),
                 'std': None if obj.std is None else _array(obj.std, arrays)}
-    if isinstance(obj, HTFModel):
+    if type(obj) is HTFModel:
         sys, internal, method = obj._source
         return {'kind': 'HTFModel', 'nharmonics': obj.nharmonics,
                 'internal_harmonics': internal, 'method': method,
