@@ -320,12 +320,15 @@ def _interpolate(partial, edges, j, length):
     # one matrix product per cell: weights (samples, D+1) times values (D+1, all entries)
     sizes = [int(np.prod(v.shape[2:])) for v in partial]
     table = np.concatenate([v.reshape(v.shape[0], v.shape[1], -1) for v in partial], axis=2)
-    out = np.empty((len(j), table.shape[2]))
     order = np.argsort(j, kind='stable')
-    cells, first = np.unique(j[order], return_index=True)
-    for c, a, b in zip(cells, first, np.append(first[1:], len(j))):
-        idx = order[a:b]
-        out[idx] = w[idx] @ table[c]
+    js, ws = j[order], w[order]
+    bounds = np.flatnonzero(np.diff(js)) + 1
+    starts, ends = np.concatenate([[0], bounds]), np.concatenate([bounds, [len(j)]])
+    sorted_out = np.empty((len(j), table.shape[2]))
+    for a, b in zip(starts, ends):
+        np.matmul(ws[a:b], table[js[a]], out=sorted_out[a:b])
+    out = np.empty_like(sorted_out)
+    out[order] = sorted_out
     parts = np.split(out, np.cumsum(sizes)[:-1], axis=1)
     return tuple(q.reshape((len(j),) + v.shape[2:]) for q, v in zip(parts, partial))
 
@@ -373,7 +376,7 @@ def _compose(first, second, len1):
 
 
 def _compose_sel(data, part, len1, sel):
-    """`_compose` on the rows `sel` of `data`; the other rows are kept."""
-    P, W, Z = (a.copy() for a in data)
+    """`_compose` on the rows `sel` of `data` (in place); the other rows are kept."""
+    P, W, Z = data
     P[sel], W[sel], Z[sel] = _compose((P[sel], W[sel], Z[sel]), part, len1[sel])
     return P, W, Z
