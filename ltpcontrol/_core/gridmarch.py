@@ -324,6 +324,8 @@ def _interpolate(partial, edges, j, length):
     js, ws = j[order], w[order]
     bounds = np.flatnonzero(np.diff(js)) + 1
     starts, ends = np.concatenate([[0], bounds]), np.concatenate([bounds, [len(j)]])
+    if len(j) == 0:
+        starts = ends = []
     sorted_out = np.empty((len(j), table.shape[2]))
     for a, b in zip(starts, ends):
         np.matmul(ws[a:b], table[js[a]], out=sorted_out[a:b])
