@@ -87,7 +87,8 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
     Notes
     -----
     Any time grid runs at about the speed of a uniform grid whose step
-    divides the period: the transition data are computed once per phase
+    divides the period (within 2x on the benchmark records, up to about 3x
+    for one long trace): the transition data are computed once per phase
     pattern, or from a table of one period's cells (see the Performance
     page).
 
