@@ -246,15 +246,18 @@ def _table_steps(A, B, h, T, rtol):
         return None
     lens = np.diff(edges)
     N = len(lens)
-    fwd, bwd = partial
-    cells = tuple(v[:, -1] for v in fwd)                # whole cells (Φ, W, Z)
-    # runs of 2^i cells from every cell: (Φ, W, Z, length)
+    n, m = A.shape[0], B.shape[1]
+    # the composition rule as a product of augmented matrices
+    # [[Φ, W, Z], [0, I, ℓI], [0, 0, I]] (ℓ the interval's length)
+    nodes = lens[:, None] * np.linspace(0.0, 1.0, _DEG + 1)
+    fwd, bwd = (_augment(*v, nodes) for v in partial)
+    cells = fwd[:, -1]
+    # runs of 2^i cells from every cell
     levels = max(1, int(math.ceil(hmax / lens.min()) + 1).bit_length())
-    lift = [cells + (lens,)]
+    lift = [cells]
     for i in range(1, levels):
-        P, W, Z, ln = lift[-1]
         nxt = (np.arange(N) + 2 ** (i - 1)) % N
-        lift.append(_compose((P, W, Z), (P[nxt], W[nxt], Z[nxt]), ln) + (ln + ln[nxt],))
+        lift.append(lift[-1][nxt] @ lift[-1])
 
     def steps(tk, hk):
         theta = tk - T * np.floor(tk / T)
@@ -264,19 +267,28 @@ def _table_steps(A, B, h, T, rtol):
         jb = np.clip(np.searchsorted(edges, phi - wraps * T, side='right') - 1, 0, N - 1)
         count = (jb + N * wraps.astype(int)) - j - 1
         # head [θ, e_{j+1}] and tail [e_J, t_k + h_k] from the partial cells
-        data, start = _interpolate(bwd, edges, j, edges[j + 1] - theta), edges[j + 1] - theta
+        (M,) = _interpolate((bwd,), edges, j, edges[j + 1] - theta)
         # the run of `count` cells after cell j, by the binary digits of count
         pos = (j + 1) % N
-        for i, (P, W, Z, ln) in enumerate(lift):
+        for i, run in enumerate(lift):
             sel = (count >> i) & 1 == 1
             if np.any(sel):
-                data = _compose_sel(data, (P[pos[sel]], W[pos[sel]], Z[pos[sel]]), start, sel)
-                start = start + np.where(sel, ln[pos], 0.0)
+                M[sel] = run[pos[sel]] @ M[sel]
                 pos = np.where(sel, (pos + 2 ** i) % N, pos)
-        tail = _interpolate(fwd, edges, jb, phi - wraps * T - edges[jb])
-        P, W, Z = _compose(data, tail, start)
-        return P, W, Z / hk[:, None, None]
+        (tail,) = _interpolate((fwd,), edges, jb, phi - wraps * T - edges[jb])
+        M = tail @ M
+        return M[:, :n, :n], M[:, :n, n:n + m], M[:, :n, n + m:] / hk[:, None, None]
     return steps
+
+
+def _augment(P, W, Z, lengths):
+    """``[[Φ, W, Z], [0, I, ℓI], [0, 0, I]]`` of a table (cells, nodes)."""
+    n, m = W.shape[-2:]
+    M = np.zeros(P.shape[:2] + (n + 2 * m, n + 2 * m))
+    M[..., :n, :n], M[..., :n, n:n + m], M[..., :n, n + m:] = P, W, Z
+    M[..., n:n + m, n:n + m] = M[..., n + m:, n + m:] = np.eye(m)
+    M[..., n:n + m, n + m:] = lengths[..., None, None] * np.eye(m)
+    return M
 
 
 def _partial_table(A, B, edges, rtol):
@@ -375,10 +387,3 @@ def _compose(first, second, len1):
     P2, W2, Z2 = second
     len1 = np.broadcast_to(np.asarray(len1, float), (len(P1),))[:, None, None]
     return P2 @ P1, P2 @ W1 + W2, P2 @ Z1 + Z2 + len1 * W2
-
-
-def _compose_sel(data, part, len1, sel):
-    """`_compose` on the rows `sel` of `data` (in place); the other rows are kept."""
-    P, W, Z = data
-    P[sel], W[sel], Z[sel] = _compose((P[sel], W[sel], Z[sel]), part, len1[sel])
-    return P, W, Z
