@@ -53,6 +53,7 @@ from ._analysis.reduction import hsvd, balred, minreal
 from ._identification.refine import refine_ltp, RefineInfo
 from ._identification.montecarlo import monte_carlo, MonteCarloResult
 from ._identification.scenarios import sample_models
+from .storage import save, load
 
 __version__ = "0.1.0"
 
@@ -98,6 +99,8 @@ __all__ = [
     # rotors and wind turbines
     'floquet_modes', 'FloquetModes', 'RotorStateSpace', 'mbc', 'coleman_matrix', 'read_lin',
     'campbell', 'CampbellDiagram',
+    # files
+    'save', 'load',
 ]
 
 # python-control's entry points dispatch LTP systems to ltpcontrol (see interop)

@@ -37,6 +37,8 @@ LAYERS = {
     'rotors': ['_rotors'],
     # python-control's entry points
     'interop': ['interop'],
+    # portable files of systems, periodic matrices and HTFs
+    'storage': ['storage'],
 }
 
 #: Method aliases: methods of a class that call a public function of a higher

@@ -50,8 +50,10 @@ import numpy as np
 import scipy.linalg as la
 from control.exception import ControlArgument, ControlDimension
 
-from .._core.floquet import _log_multipliers, chebyshev_nodes, lti_representatives, piecewise_chebyshev
+from .._core.floquet import (PiecewiseChebyshev, _log_multipliers, chebyshev_nodes,
+                             lti_representatives, piecewise_chebyshev)
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
+from .._core.pm_ops import register_op, register_func
 from .._core.steps import step_grid
 from .._core.transition import step_transitions
 from .._core.validation import check_period, real_array
@@ -152,28 +154,64 @@ def care(A, B, Q, R, S=None, period=None, nsteps=None):
         return Xg, (Psi @ _stack(Xg[:-1]))[:, :n]
     Xg, factors = _refine(X0, sweep)
     L = _exponents(factors, period=period)
-    cache = []
+    solution = _RiccatiSolution(H, grid, Xg)
+    X = PeriodicMatrix.from_function(solution, period, (n, n), breakpoints=grid[:-1],
+                                     check=False)
+    G = PeriodicMatrix.pointwise(_gain, [B, R, S, X], (m, n), breakpoints=breaks)
+    if all(M.is_constant for M in ops):          # LTI data: the eigenvalues of A - BG
+        L = lti_representatives(L, A(0.0) - B(0.0) @ G(0.0), period=period)
+    return X, L, G
 
-    def solution(t):
+
+def _gain(b, r, s, x):
+    # G = R⁻¹(BᵀX + Sᵀ), pointwise
+    return np.linalg.solve(r, np.swapaxes(b, 1, 2) @ x + np.swapaxes(s, 1, 2))
+
+
+register_op('riccati_gain', _gain)
+
+
+class _RiccatiSolution:
+    """X(t) of `care`: exact at the step boundaries, interpolated inside the steps.
+
+    The interpolant is built on first use from the Hamiltonian flow, or
+    when the solution is pickled or saved, so that it is data-backed.
+    """
+
+    def __init__(self, H, grid, Xg, interp=None):
+        self.H, self.grid, self.Xg, self.interp = H, grid, Xg, interp
+
+    def __call__(self, t):
+        grid = self.grid
+        period = grid[-1]
         tau = np.mod(np.atleast_1d(np.asarray(t, float)), period)
         k = np.searchsorted(grid, tau)
         on = np.abs(grid[np.minimum(k, len(grid) - 1)] - tau) <= 1e-14 * period
         if np.all(on):                      # step boundaries: no interpolant needed
-            return Xg[k]
-        if not cache:
-            cache.append(_interpolant(H, grid, Xg))
-        return cache[0](t)
+            return self.Xg[k]
+        return self._interpolant()(t)
 
-    X = PeriodicMatrix.from_function(solution, period, (n, n), breakpoints=grid[:-1],
-                                     check=False)
+    def _interpolant(self):
+        if self.interp is None:
+            self.interp = _interpolant(self.H, self.grid, self.Xg)
+        return self.interp
 
-    def gain(b, r, s, x):
-        return np.linalg.solve(r, np.swapaxes(b, 1, 2) @ x + np.swapaxes(s, 1, 2))
+    def __getstate__(self):
+        self._interpolant()
+        return {'H': None, 'grid': self.grid, 'Xg': self.Xg, 'interp': self.interp}
 
-    G = PeriodicMatrix.pointwise(gain, [B, R, S, X], (m, n), breakpoints=breaks)
-    if all(M.is_constant for M in ops):          # LTI data: the eigenvalues of A - BG
-        L = lti_representatives(L, A(0.0) - B(0.0) @ G(0.0), period=period)
-    return X, L, G
+    def _portable(self):
+        it = self._interpolant()
+        return 'riccati_solution', {}, {'grid': self.grid, 'Xg': self.Xg,
+                                        'interp_grid': it.grid, 'interp_values': it.values}
+
+    @classmethod
+    def _from_portable(cls, params, arrays):
+        return cls(None, arrays['grid'], arrays['Xg'],
+                   PiecewiseChebyshev(arrays['interp_grid'], arrays['interp_values']))
+
+
+register_func('riccati_solution', _RiccatiSolution)
 
 
 def dare(A, B, Q, R, S=None):

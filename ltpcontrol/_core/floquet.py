@@ -30,6 +30,7 @@ from control.exception import ControlArgument
 from .ltpsys import ltpss
 from .periodic_matrix import PeriodicMatrix
 from .periodic_schur import product_eigenvalues
+from .pm_ops import register_func
 from .steps import step_grid
 from .transition import expm_batch, step_transitions
 from .validation import as_ltp, check_kwargs, check_positive_int, steps_per_period
@@ -560,13 +561,22 @@ def piecewise_chebyshev(grid, values):
     >>> bool(np.allclose(f([0.4, 2.5, 3.4]), [0.4 ** 3, 2.5 ** 3, 0.4 ** 3]))
     True
     """
-    period, starts, h = grid[-1], grid[:-1], np.diff(grid)
-    degree = values.shape[1] - 1
-    cheb = chebyshev_nodes(degree)
-    bary = (-1.0) ** np.arange(degree + 1)
-    bary[[0, -1]] *= 0.5
+    return PiecewiseChebyshev(grid, values)
 
-    def evaluate(t):
+
+class PiecewiseChebyshev:
+    """Data-backed callable of `piecewise_chebyshev` (picklable, storable)."""
+
+    def __init__(self, grid, values):
+        self.grid, self.values = np.asarray(grid, float), np.asarray(values)
+
+    def __call__(self, t):
+        grid, values = self.grid, self.values
+        period, starts, h = grid[-1], grid[:-1], np.diff(grid)
+        degree = values.shape[1] - 1
+        cheb = chebyshev_nodes(degree)
+        bary = (-1.0) ** np.arange(degree + 1)
+        bary[[0, -1]] *= 0.5
         tau = np.mod(np.atleast_1d(np.asarray(t, float)), period)
         k = np.clip(np.searchsorted(starts, tau, side='right') - 1, 0, len(starts) - 1)
         xi = np.clip((tau - starts[k]) / h[k], 0.0, 1.0)
@@ -576,7 +586,16 @@ def piecewise_chebyshev(grid, values):
             weights = np.where(hit.any(axis=1, keepdims=True), hit.astype(float), bary / diff)
         weights /= weights.sum(axis=1, keepdims=True)
         return np.einsum('sj,sj...->s...', weights, values[k])
-    return evaluate
+
+    def _portable(self):
+        return 'chebyshev', {}, {'grid': self.grid, 'values': self.values}
+
+    @classmethod
+    def _from_portable(cls, params, arrays):
+        return cls(arrays['grid'], arrays['values'])
+
+
+register_func('chebyshev', PiecewiseChebyshev)
 
 
 def _chebyshev_transform(A, grid, G, E, R):

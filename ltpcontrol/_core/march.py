@@ -61,7 +61,7 @@ def block_length(N, L):
     return min(cands, key=lambda b: (abs(math.log(b / _TARGET_BLOCK)), -b))
 
 
-def periodic_march(Phi, E, F, C, D, u, x0):
+def periodic_march(Phi, E, F, C, D, u, x0, *, states=True, final=False, nsamples=None):
     """States and outputs of the N-periodic recurrence (module docstring).
 
     Parameters
@@ -72,14 +72,24 @@ def periodic_march(Phi, E, F, C, D, u, x0):
         Coefficient of ``u[k+1]`` (None: zero).
     C : ndarray, shape (N, p, n)
     D : ndarray, shape (N, p, m)
-    u : ndarray, shape (m, R, L)
+    u : ndarray, shape (m, R, L) or (m, R, L + 1)
         Inputs of R traces at L samples; sample 0 has phase 0.
     x0 : ndarray, shape (n, R)
+    states : bool
+        Compute the states (False: outputs only, less work and memory).
+    final : bool
+        Also return the state at sample ``Q N``, ``Q = ceil(L / N)`` (the
+        start of the period after the record; meant for ``L = Q N``).  With
+        F given it needs ``u[Q N]``: pass it as an extra sample of `u`
+        beyond `nsamples` (otherwise the last sample is held).
+    nsamples : int, optional
+        Number L of samples to return (default ``u.shape[2]``).
 
     Returns
     -------
-    x : ndarray, shape (n, R, L)
+    x : ndarray, shape (n, R, L), or None when not `states`
     y : ndarray, shape (p, R, L)
+    xend : ndarray, shape (n, R), only when `final`
 
     Examples
     --------
@@ -92,105 +102,132 @@ def periodic_march(Phi, E, F, C, D, u, x0):
     """
     N, n, m = E.shape
     p = C.shape[1]
-    R, L = u.shape[1], u.shape[2]
-    b = block_length(N, L)
+    R, Lu = u.shape[1], u.shape[2]
+    b = block_length(N, Lu)
     if b > N:                                   # a block of b/N whole periods
         reps = b // N
         Phi, E, C, D = (np.tile(a, (reps, 1, 1)) for a in (Phi, E, C, D))
         F = None if F is None else np.tile(F, (reps, 1, 1))
         N = b
-    ops = [_block_operators(Phi, E, F, C, D, c * b, b) for c in range(N // b)]
-    P = max(1, -(-(L - 1) // N))                # periods covering the record
-    rows = R * (P + 1)                          # (trace, period) pairs, one spare period
+    L = Lu if nsamples is None else int(nsamples)
+    ops = _block_operators(Phi, E, F, C, D, b, states)
+    nph = N // b
+    Q = max(1, -(-L // N))                      # periods covering the samples
+    rows = R * Q                                # (trace, period) pairs
 
     # input laid out as rows of one period, padded with the last sample; the
     # window of b + 1 samples of block c in row r starts at r N + c b
     buf = np.empty((m, rows * N + N))
-    padded = buf[:, :rows * N].reshape(m, R, (P + 1) * N)
-    padded[:, :, :L] = u
-    padded[:, :, L:] = u[:, :, -1:]
+    padded = buf[:, :rows * N].reshape(m, R, Q * N)
+    keep = min(Lu, Q * N)
+    padded[:, :, :keep] = u[:, :, :keep]
+    padded[:, :, keep:] = u[:, :, keep - 1:keep]
     buf[:, rows * N:] = 0.0
+    if final and Lu > Q * N:
+        # the sample after the last row of each trace is the next row's first
+        # one (other traces) or the tail of the buffer (last trace)
+        nxt = np.empty((m, R))
+        nxt[:] = u[:, :, Q * N]
+    else:
+        nxt = None
 
     def windows(c, r0, r1):
         return as_strided(buf[:, r0 * N + c * b:], shape=(m, r1 - r0, b + 1),
                           strides=(buf.strides[0], N * buf.strides[1], buf.strides[1]),
                           writeable=False)
 
-    # forcing over each block from a zero start, z_c = Σ_j V_bj u[s+j]: (rows, n)
-    z = []
-    for c, op in enumerate(ops):
-        w = windows(c, 0, rows)
-        z.append(sum(w[i] @ op.last[i] for i in range(m)))
+    def forcing(c, r0, r1):
+        # forcing over block c from a zero start, Σ_j V_bj u[s+j]: (r1 - r0, n)
+        w = windows(c, r0, r1)
+        return sum(w[i] @ ops.last[c, i] for i in range(m))
+    z = [forcing(c, 0, rows) for c in range(nph)]
+    if nxt is not None:
+        # the last block of every trace's last row ends at sample Q N
+        w_last = np.array(windows(nph - 1, 0, rows))
+        w_last.reshape(m, R, Q, b + 1)[:, :, -1, -1] = nxt
+        z[-1] = sum(w_last[i] @ ops.last[nph - 1, i] for i in range(m))
     # 1. period starts: x[(q+1)N] = Ψ x[qN] + z_q (row vectors: x Ψᵀ)
     zper = np.zeros((rows, n))
-    for c, op in enumerate(ops):
-        zper = zper @ op.Phi_b.T + z[c]
-    zper = zper.reshape(R, P + 1, n)
+    for c in range(nph):
+        zper = zper @ ops.Phi_b[c].T + z[c]
+    zper = zper.reshape(R, Q, n)
     Psi = np.eye(n)
-    for op in ops:
-        Psi = op.Phi_b @ Psi
-    starts = np.empty((R, P + 1, n))
+    for c in range(nph):
+        Psi = ops.Phi_b[c] @ Psi
+    starts = np.empty((R, Q, n))
     xq = x0.T
-    for q in range(P + 1):
+    for q in range(Q):
         starts[:, q] = xq
         xq = xq @ Psi.T + zper[:, q]
     # 2.-3. block starts and all samples of each phase, in row chunks: the rows
     # [u window of every input, x[s]] times the phase operator, written in place
-    out = np.empty((n + p, rows, N))
+    nsig = ops.operator.shape[1]
+    out = np.empty((nsig, rows, N))
     xb = starts.reshape(rows, n)
     K = m * (b + 1) + n
     step = max(1, _CHUNK_BYTES // (8 * K))
-    for c, op in enumerate(ops):
+    lhs_full = np.empty((min(step, rows), K))
+    for c in range(nph):
         for r0 in range(0, rows, step):
             r1 = min(rows, r0 + step)
-            lhs = np.empty((r1 - r0, K))
+            lhs = lhs_full[:r1 - r0]
             w = windows(c, r0, r1)
             for i in range(m):
                 lhs[:, i * (b + 1):(i + 1) * (b + 1)] = w[i]
             lhs[:, m * (b + 1):] = xb[r0:r1]
-            np.matmul(lhs[None], op.operator, out=out[:, r0:r1, c * b:(c + 1) * b])
-        xb = xb @ op.Phi_b.T + z[c]
-    out = out.reshape(n + p, R, (P + 1) * N)
-    return out[:n, :, :L], out[n:, :, :L]
+            np.matmul(lhs[None], ops.operator[c], out=out[:, r0:r1, c * b:(c + 1) * b])
+        xb = xb @ ops.Phi_b[c].T + z[c]
+    out = out.reshape(nsig, R, Q * N)
+    x = out[:n, :, :L] if states else None
+    y = out[nsig - p:, :, :L]
+    if final:
+        return x, y, xq.T.copy()
+    return x, y
 
 
 class _BlockOperators:
-    """Matrices of one block phase (see the module docstring)."""
+    """Matrices of the block phases (see the module docstring)."""
 
     __slots__ = ('operator', 'last', 'Phi_b')
 
     def __init__(self, operator, last, Phi_b):
-        # operator (signal, K, k): coefficients of [u windows, x[s]] in x[s+k], y[s+k]
-        # last (input, j, state): coefficients of the window in x[s+b]; Phi_b = Φ(b, 0)
+        # operator (phase, signal, K, k): coefficients of [u windows, x[s]] in
+        # x[s+k] (when states are kept) and y[s+k]; last (phase, input, j, state):
+        # coefficients of the window in x[s+b]; Phi_b (phase) = Φ(b, 0)
         self.operator, self.last, self.Phi_b = operator, last, Phi_b
 
 
-def _block_operators(Phi, E, F, C, D, s, b):
-    n, m = E.shape[1], E.shape[2]
+def _block_operators(Phi, E, F, C, D, b, states=True):
+    """Operators of all N/b block phases at once (loops over k only)."""
+    N, n, m = E.shape
     p = C.shape[1]
-    ks = s + np.arange(b)
-    # O[k] = Φ(k, 0), k = 0..b
-    O = np.empty((b + 1, n, n))
-    O[0] = np.eye(n)
+    nb = N // b
+    Phi, E, C, D = (a.reshape((nb, b) + a.shape[1:]) for a in (Phi, E, C, D))
+    F = None if F is None else F.reshape((nb, b) + F.shape[1:])
+    # O[:, k] = Φ(k, 0), k = 0..b
+    O = np.empty((nb, b + 1, n, n))
+    O[:, 0] = np.eye(n)
+    # V[:, k, j]: coefficient of u[s+j] in x[s+k], from
+    # x[s+k+1] = Φ_k x[s+k] + E_k u[s+k] + F_k u[s+k+1]
+    V = np.zeros((nb, b + 1, b + 1, n, m))
     for k in range(b):
-        O[k + 1] = Phi[ks[k]] @ O[k]
-    # V[k, j]: coefficient of u[s+j] in x[s+k]
-    V = np.zeros((b + 1, b + 1, n, m))
-    for j in range(b):
-        M = np.eye(n)                               # Φ(k, j+1), built up over k
-        for k in range(j + 1, b + 1):
-            if k > j + 1:
-                M = Phi[ks[k - 1]] @ M
-            V[k, j] += M @ E[ks[j]]
-            if F is not None:
-                V[k, j + 1] += M @ F[ks[j]]
-    Ck, Dk = C[ks], D[ks]
-    Vy = np.einsum('kps,kjsi->kjpi', Ck, V[:b])     # y[s+k] = C_k x[s+k] + D_k u[s+k]
-    Vy[np.arange(b), np.arange(b)] += Dk
-    Vxy = np.concatenate([V[:b], Vy], axis=2)      # (k, j, signal, i)
-    Oxy = np.concatenate([O[:b], np.einsum('kps,ksq->kpq', Ck, O[:b])], axis=1)  # (k, signal, q)
-    window = Vxy.transpose(2, 3, 1, 0).reshape(n + p, m * (b + 1), b)
-    start = Oxy.transpose(1, 2, 0)
-    operator = np.ascontiguousarray(np.concatenate([window, start], axis=1))
-    last = np.ascontiguousarray(V[b].transpose(2, 0, 1))      # (i, j, n)
-    return _BlockOperators(operator, last, O[b])
+        O[:, k + 1] = Phi[:, k] @ O[:, k]
+        V[:, k + 1, :k + 1] = Phi[:, k, None] @ V[:, k, :k + 1]
+        V[:, k + 1, k] += E[:, k]
+        if F is not None:
+            V[:, k + 1, k + 1] += F[:, k]
+    # y[s+k] = C_k x[s+k] + D_k u[s+k]
+    Vy = np.einsum('ckps,ckjsi->ckjpi', C, V[:, :b])
+    Vy[:, np.arange(b), np.arange(b)] += D
+    Oy = np.einsum('ckps,cksq->ckpq', C, O[:, :b])
+    if states:
+        Vxy = np.concatenate([V[:, :b], Vy], axis=3)          # (c, k, j, signal, i)
+        Oxy = np.concatenate([O[:, :b], Oy], axis=2)          # (c, k, signal, q)
+    else:
+        Vxy, Oxy = Vy, Oy
+    nsig = Vxy.shape[3]
+    window = Vxy.transpose(0, 3, 4, 2, 1).reshape(nb, nsig, m * (b + 1), b)
+    start = Oxy.transpose(0, 2, 3, 1)
+    operator = np.ascontiguousarray(np.concatenate([window, start], axis=2))
+    last = np.ascontiguousarray(V[:, b].transpose(0, 3, 1, 2))      # (c, i, j, n)
+    return _BlockOperators(operator, last, O[:, b])

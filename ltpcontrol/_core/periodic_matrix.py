@@ -21,6 +21,7 @@ import numpy as np
 from control.exception import ControlDimension
 
 from .display import describe
+from .pm_ops import Block, Identity, Index, Scale, Transpose, add_series, mul_series
 from .validation import check_period, check_positive_int, commensurate, real_array
 
 __all__ = ['PeriodicMatrix']
@@ -97,6 +98,35 @@ class PeriodicMatrix:
     @classmethod
     def _new(cls, period, shape, **kwargs):
         return cls.__new__(cls)._init(period, shape, **kwargs)
+
+    def _parts(self):
+        """``(form, data)`` of the storage form (the file format of `ltpcontrol.save`)."""
+        if self._coeffs is not None:
+            return 'fourier', self._coeffs
+        if self._pieces is not None:
+            return 'switching', (list(self._pieces), self._times)
+        return ('function', self._func) if self._func is not None else ('combine', self._combine)
+
+    @classmethod
+    def _assemble(cls, period, shape, breakpoints, form, data):
+        """Inverse of `_parts` (data validated by the caller)."""
+        keys = {'fourier': ('coeffs',), 'switching': ('pieces', 'times'),
+                'function': ('func',), 'combine': ('combine',)}[form]
+        data = data if len(keys) > 1 else (data,)
+        return cls._new(period, shape, breakpoints=breakpoints, **dict(zip(keys, data)))
+
+    def __getstate__(self):
+        # a lambda or local function cannot be pickled: say how to get data
+        for f in _callables(self):
+            qual = getattr(f, '__qualname__', '')
+            if '<lambda>' in qual or '<locals>' in qual:
+                raise TypeError(
+                    f"cannot pickle a PeriodicMatrix defined by the local function "
+                    f"{qual}: define it at module level, or sample it, e.g. "
+                    "PeriodicMatrix.from_samples(P.sample(N), P.period)")
+        state = dict(self.__dict__)
+        state['_cache'] = {}
+        return state
 
     #
     # Alternative constructors
@@ -408,8 +438,8 @@ class PeriodicMatrix:
             # P(t) = P_0 + 2 Re Σ_{k>0} P_k e^{jkω_p t}
             ks = np.arange(1, K + 1)
             phase = np.exp(1j * self.omega_p * np.outer(t, ks))
-            return self._coeffs[K].real + 2 * np.einsum(
-                'tk,kij->tij', phase, self._coeffs[K + 1:]).real
+            series = (phase @ self._coeffs[K + 1:].reshape(K, -1)).real
+            return self._coeffs[K].real + 2 * series.reshape((len(t),) + self.shape)
         if self._func is not None:
             return _call_vectorised(self._func, t, self.shape)
         if self._pieces is not None:
@@ -568,7 +598,7 @@ class PeriodicMatrix:
             coeffs[::r] = self._coeffs
             return PeriodicMatrix(coeffs, period)
         bps = (self.breakpoints[None, :] + self.period * np.arange(r)[:, None]).ravel()
-        return PeriodicMatrix._new(period, self.shape, combine=(lambda x: x, [self]),
+        return PeriodicMatrix._new(period, self.shape, combine=(Identity(), [self]),
                                    breakpoints=bps)
 
     def _binary(self, other, op, shape, fourier_op):
@@ -590,7 +620,7 @@ class PeriodicMatrix:
         shape = self.shape if isinstance(other, PeriodicMatrix) else _as_matrix(other, 'operand').shape
         if shape != self.shape:
             raise ValueError(f"cannot add shapes {self.shape} and {shape}")
-        return self._binary(other, np.add, self.shape, _add_series)
+        return self._binary(other, np.add, self.shape, add_series)
 
     __radd__ = __add__
 
@@ -615,7 +645,7 @@ class PeriodicMatrix:
     def _scale(self, c):
         if self._coeffs is not None:
             return PeriodicMatrix(c * self._coeffs, self.period)
-        return PeriodicMatrix._new(self.period, self.shape, combine=(lambda x: c * x, [self]),
+        return PeriodicMatrix._new(self.period, self.shape, combine=(Scale(c), [self]),
                                    breakpoints=self.breakpoints)
 
     def __matmul__(self, other):
@@ -624,7 +654,7 @@ class PeriodicMatrix:
         oshape = other.shape if isinstance(other, PeriodicMatrix) else _as_matrix(other, 'operand').shape
         if self.shape[1] != oshape[0]:
             raise ValueError(f"cannot multiply shapes {self.shape} and {oshape}")
-        return self._binary(other, np.matmul, (self.shape[0], oshape[1]), _mul_series)
+        return self._binary(other, np.matmul, (self.shape[0], oshape[1]), mul_series)
 
     def __rmatmul__(self, other):
         if not _is_operand(other):
@@ -637,7 +667,7 @@ class PeriodicMatrix:
         if self._coeffs is not None:
             return PeriodicMatrix(np.swapaxes(self._coeffs, 1, 2), self.period)
         return PeriodicMatrix._new(self.period, self.shape[::-1],
-                                   combine=(lambda x: np.swapaxes(x, 1, 2), [self]),
+                                   combine=(Transpose(), [self]),
                                    breakpoints=self.breakpoints)
 
     def __getitem__(self, index):
@@ -648,7 +678,7 @@ class PeriodicMatrix:
         if self._coeffs is not None:
             return PeriodicMatrix(self._coeffs[:, rows, cols], self.period)
         return PeriodicMatrix._new(self.period, probe.shape,
-                                   combine=(lambda x: x[:, rows, cols], [self]),
+                                   combine=(Index(rows, cols), [self]),
                                    breakpoints=self.breakpoints)
 
     @staticmethod
@@ -684,11 +714,7 @@ class PeriodicMatrix:
             K = max(m._coeffs.shape[0] // 2 for m in operands)
             coeffs = np.block([[m.fourier(K) for m in row] for row in mats])
             return PeriodicMatrix(coeffs, period)
-        widths = [len(row) for row in mats]
-
-        def assemble(*values):
-            it = iter(values)
-            return np.block([[next(it) for _ in range(w)] for w in widths])
+        assemble = Block([len(row) for row in mats])
         shape = assemble(*[np.zeros((1,) + m.shape) for m in operands]).shape[1:]
         return PeriodicMatrix._new(period, shape, combine=(assemble, operands),
                                    breakpoints=np.concatenate([m.breakpoints for m in operands]))
@@ -721,6 +747,18 @@ def as_periodic(value, period, name, shape=None):
     return value
 
 
+def _callables(P):
+    """The callables a periodic matrix and its operands are made of."""
+    out = [] if P._func is None else [P._func]
+    if P._combine is not None:
+        out.append(P._combine[0])
+        for o in P._combine[1]:
+            out += _callables(o)
+    for piece in P._pieces or ():
+        out += _callables(piece)
+    return out
+
+
 def _as_matrix(value, name):
     arr = real_array(value, name, ndim=(0, 1, 2))
     if arr.ndim == 0:
@@ -742,21 +780,3 @@ def _call_vectorised(func, t, shape):
     except Exception:
         pass
     return np.array([np.asarray(func(ti), float).reshape(shape) for ti in t])
-
-
-def _add_series(a, b):
-    Ka, Kb = a.shape[0] // 2, b.shape[0] // 2
-    K = max(Ka, Kb)
-    out = np.zeros((2 * K + 1,) + a.shape[1:], complex)
-    out[K - Ka:K + Ka + 1] += a
-    out[K - Kb:K + Kb + 1] += b
-    return out
-
-
-def _mul_series(a, b):
-    # (PQ)_k = Σ_l P_l Q_{k-l}: a discrete convolution over harmonics
-    Ka, Kb = a.shape[0] // 2, b.shape[0] // 2
-    out = np.zeros((2 * (Ka + Kb) + 1, a.shape[1], b.shape[2]), complex)
-    for i in range(2 * Ka + 1):
-        out[i:i + 2 * Kb + 1] += np.einsum('ij,kjl->kil', a[i], b)
-    return out

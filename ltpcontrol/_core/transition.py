@@ -29,7 +29,7 @@ __all__ = []
 _C1, _C2 = 0.5 - np.sqrt(3) / 6, 0.5 + np.sqrt(3) / 6
 
 
-def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=4096):
+def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=4096, info=None):
     """Transition data of many steps ``[t0[k], t0[k] + h[k]]``.
 
     Parameters
@@ -42,6 +42,9 @@ def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=4096):
         Step starts and lengths (1D, same length).
     rtol : float
         Relative accuracy target.
+    info : dict, optional
+        Receives ``'substeps'``, the number of Magnus sub-steps per segment
+        that met `rtol` (1 for exact exponentials).
 
     Returns
     -------
@@ -66,9 +69,12 @@ def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=4096):
     if m == 0 and A._piecewise_constant:
         # A is constant on every segment: the transition is e^{A h}
         E = expm_batch((seg_b - seg_a)[:, None, None] * A._eval(0.5 * (seg_a + seg_b)))
+        nsub = 1
     else:
-        E = _segment_transitions(A, B, seg_a, seg_b, t0[seg_step], h[seg_step],
-                                 rtol, max_substeps)
+        E, nsub = _segment_transitions(A, B, seg_a, seg_b, t0[seg_step], h[seg_step],
+                                       rtol, max_substeps)
+    if info is not None:
+        info['substeps'] = nsub
     if len(seg_step) > len(t0):
         # compose the segments of each step in time order: E_last ... E_first
         d = n + 2 * m
@@ -122,12 +128,12 @@ def _segment_transitions(A, B, a, b, step_t0, step_h, rtol, max_substeps):
             scale = np.maximum(1.0, np.abs(E).max(axis=(1, 2)))
             # fourth-order method: the error of E is about (E - prev)/15
             if np.all(err / 15 <= rtol * scale):
-                return E + (E - prev) / 15
+                return E + (E - prev) / 15, nsub
         if nsub >= max_substeps:
             warnings.warn("transition matrices did not reach the requested accuracy "
                           f"with {nsub} sub-steps per step; use a finer time grid",
                           UserWarning, stacklevel=4)
-            return E
+            return E, nsub
         prev = E
         nsub *= 2
 

@@ -375,6 +375,7 @@ class HTFModel(HTF):
         self._set_signals(sys.period, K, sys.noutputs, sys.ninputs, sys.dt, sys.name,
                          sys.input_labels, sys.output_labels)
         self._states = list(sys.state_labels)
+        self._source = (sys, internal_harmonics, method)       # what `save` stores
         # user -> htf -> HTFModel -> build
         self._hss = build(sys, K, internal_harmonics, method, 'htf', stacklevel=3)
 

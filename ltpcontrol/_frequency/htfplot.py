@@ -71,14 +71,20 @@ def htf_response(htfs, omega=None, harmonics=(-1, 0, 1), *, omega_limits=None,
     return out
 
 
-def bode_htf(htfs, omega=None, *fmt, harmonics=(-1, 0, 1), omega_limits=None,
+def bode_htf(htfs, omega=None, *fmt, harmonics=None, omega_limits=None,
              omega_num=None, plot_phase=None, label=None, ax=None, title=None,
              progress=None, **kwargs):
     """Bode plot of selected HTF components ``G_k(jω)``.
 
-    Magnitude and phase of components k (default -1, 0, 1) of one or several
-    HTFs on one figure, as the thesis's Figs. 3.5/3.6 and 4.2.  Several
-    HTFs (for example true and estimated) are overlaid with a legend.
+    Magnitude and phase of components k (by default every component the
+    HTFs have, ``-K..K`` with K the smallest `nharmonics` among them) of one
+    or several HTFs on one figure, as the thesis's Figs. 3.5/3.6 and 4.2.
+    Several HTFs (for example true and estimated) are overlaid with a
+    legend: as in python-control, colors cycle per system (one color per
+    HTF) and the components of an HTF differ by line style; a single HTF
+    gets one color per component.  Phases are wrapped to [-180°, 180°)
+    unless ``wrap_phase=False`` is passed (then python-control unwraps each
+    component continuously from its first frequency).
 
     Parameters
     ----------
@@ -88,8 +94,8 @@ def bode_htf(htfs, omega=None, *fmt, harmonics=(-1, 0, 1), omega_limits=None,
         Frequencies in rad/s (see `htf_response`).
     *fmt : str, optional
         Matplotlib format string applied to every line.
-    harmonics : sequence of int
-        Components to draw.
+    harmonics : sequence of int, optional
+        Components to draw (default: all, ``-K..K``).
     omega_limits, omega_num : optional
         Default grid for an `HTFModel` (see `htf_response`).
     plot_phase : bool, optional
@@ -118,16 +124,20 @@ def bode_htf(htfs, omega=None, *fmt, harmonics=(-1, 0, 1), omega_limits=None,
     'ControlPlot'
     """
     htfs = _htf_list(htfs)
+    if harmonics is None:
+        K = min(H.nharmonics for H in htfs)
+        harmonics = list(range(-K, K + 1))
     harmonics = _harmonic_list(harmonics)
     resp = htf_response(htfs, omega, harmonics, omega_limits=omega_limits,
                         omega_num=omega_num, progress=progress)
-    frds, labels = [], []
-    for H, comps in zip(htfs, resp):
-        for k, frd in zip(harmonics, comps):
+    frds, labels, styles = [], [], []
+    for i, (H, comps) in enumerate(zip(htfs, resp)):
+        for j, (k, frd) in enumerate(zip(harmonics, comps)):
             if np.all(frd.frdata == 0):
                 continue            # an identically zero component has no Bode plot
             frds.append(frd)
             labels.append(f"{H.name}: G_{k}" if len(htfs) > 1 else f"G_{k}")
+            styles.append((i, j))
     if not frds:
         raise ValueError("all requested HTF components are identically zero")
     if label is not None:
@@ -138,8 +148,37 @@ def bode_htf(htfs, omega=None, *fmt, harmonics=(-1, 0, 1), omega_limits=None,
         title = "HTF components of " + ", ".join(H.name for H in htfs)
     if label is None and frds[0].noutputs * frds[0].ninputs > 1:
         labels = None           # MIMO: python-control's labels from the FRD names (G_k)
-    return ct.bode_plot(frds, None, *fmt, plot_phase=plot_phase, label=labels, ax=ax,
+    kwargs.setdefault('wrap_phase', True)
+    cplt = ct.bode_plot(frds, None, *fmt, plot_phase=plot_phase, label=labels, ax=ax,
                         title=title, **kwargs)
+    if len(htfs) > 1 and not fmt and not {'color', 'c', 'linestyle', 'ls'} & set(kwargs):
+        _style_per_system(cplt, styles)
+    return cplt
+
+
+# line styles of the components of one HTF when several HTFs are overlaid
+_LINESTYLES = ['-', '--', '-.', ':', (0, (5, 1)), (0, (3, 1, 1, 1, 1, 1)), (0, (1, 3)),
+               (0, (8, 2, 2, 2)), (0, (3, 3)), (0, (6, 1, 1, 1))]
+
+
+def _style_per_system(cplt, styles):
+    """One color per HTF (python-control's cycle), one line style per component."""
+    import matplotlib.pyplot as plt
+    colors = plt.rcParams['axes.prop_cycle'].by_key().get('color', ['C0'])
+    for lines in cplt.lines.flat:
+        for line, (i, j) in zip(lines, styles):
+            line.set_color(colors[i % len(colors)])
+            line.set_linestyle(_LINESTYLES[j % len(_LINESTYLES)])
+    # rebuild the legends from the restyled lines
+    for ax, legend in zip(cplt.axes.flat, np.ravel(cplt.legend)
+                          if cplt.legend is not None else []):
+        if legend is not None:
+            handles, texts = ax.get_legend_handles_labels()
+            loc = legend._loc
+            legend.remove()
+            new = ax.legend(handles, texts, loc=loc)
+            cplt.legend[np.unravel_index(list(np.ravel(cplt.legend)).index(legend),
+                                         cplt.legend.shape)] = new
 
 
 def htf_map_plot(htf, omega, *, dB=True, ax=None, title=None, cmap='viridis'):

@@ -1,0 +1,389 @@
+"""Exact simulation on time grids whose steps do not divide the period.
+
+On a uniform grid whose step divides the period the step data repeat and
+one period of them is computed (``_march``).  On any other grid every step
+``[t_k, t_k + h_k]`` has its own phase, and computing every step's
+transition data afresh costs as many fourth-order Magnus integrations as
+there are samples.  Instead:
+
+* **Repeating phases.**  When ``q h = p T`` for small integers (a uniform
+  grid commensurate with the period), the step data repeat every q steps:
+  q steps are computed and the periodic march runs with period q.
+* **Phase table.**  Otherwise one period is cut into N cells
+  ``[e_j, e_{j+1}]`` shorter than the shortest step (uniform, split at the
+  switching instants), and a step is split into a head piece
+  ``[t_k, e_{j+1}]``, c whole cells and a tail piece ``[e_J, t_k + h_k]``.
+  The data of every cell, and of its first and last parts at D + 1
+  equispaced lengths ℓ, are integrated once; a step's head and tail
+  come from the first and last parts ``[e_j, e_j + ℓ]``,
+  ``[e_{j+1} - ℓ, e_{j+1}]`` interpolated in ℓ (degree D, checked against
+  the integrator at probe lengths: cells are halved until the error is
+  below 1e-13, or the steps are integrated one by one).
+
+The data of an interval ``I = [a, b]`` with a linear input
+``u(τ) = u_k + (τ - t_k)/h_k Δu`` are
+
+    Φ_I = Φ(b, a),   W_I = ∫_I Φ(b, s) B(s) ds,   Z_I = ∫_I Φ(b, s) B(s) (s - a) ds,
+
+and the input enters as ``W_I (u_k + (a - t_k)/h_k Δu) + Z_I Δu / h_k``.  They
+compose exactly: for ``I1 = [a, c]`` followed by ``I2 = [c, b]``
+
+    Φ = Φ2 Φ1,   W = Φ2 W1 + W2,   Z = Φ2 Z1 + Z2 + (c - a) W2,
+
+so a run of c cells is assembled from precomputed runs of 2^i cells
+(binary lifting, ⌈log2 c⌉ products), and the step data are
+``Γ0 = W``, ``Γ1 = Z / h_k`` (``_transition``).  The answer is exact to the
+integrator's tolerance, like the aligned path; only the number of
+integrations changes.  The march itself runs on chunks of steps with the
+block kernel of ``_march``, a chunk being one "period" of step data.
+"""
+
+import math
+from fractions import Fraction
+
+import numpy as np
+
+from .march import periodic_march
+from .transition import step_transitions
+
+__all__ = []
+
+_CHUNK_STEPS = 4000          # steps of step data held at a time
+_FEW_TRACES = 16             # up to this many traces: march state by state
+_SEQ_BLOCK = 32              # block length of that march
+_MAX_CELLS = 2 ** 15         # cells of the phase table
+_MAX_REPEAT = 4096           # longest repeating phase pattern used as a period
+_DEG = 10                    # degree of the partial-cell interpolants (equispaced nodes)
+_TABLE_TOL = 1e-13           # accepted interpolation error (relative to a cell's data)
+
+
+def grid_march(A, B, C, D, t, u, x0, hold, rtol, states=True):
+    """States and outputs of ``ẋ = Ax + Bu, y = Cx + Du`` on an arbitrary grid.
+
+    Parameters
+    ----------
+    A, B, C, D : PeriodicMatrix
+    t : ndarray, shape (L,)
+        Strictly increasing time points, L >= 2.
+    u : ndarray, shape (m, R, L)
+    x0 : ndarray, shape (n, R)
+    hold : {'foh', 'zoh'}
+    rtol : float
+    states : bool
+        Return the states (False: None, outputs only).
+
+    Returns
+    -------
+    x : ndarray, shape (n, R, L), or None
+    y : ndarray, shape (p, R, L)
+
+    Examples
+    --------
+    A grid whose step (0.3) does not divide the period (1):
+
+    >>> from ltpcontrol._core.gridmarch import grid_march
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> t = 0.3 * np.arange(11)
+    >>> x, y = grid_march(sys.A, sys.B, sys.C, sys.D, t, np.ones((1, 1, 11)),
+    ...                   np.zeros((1, 1)), 'foh', 1e-12)
+    >>> bool(np.allclose(y[0, 0], 1 - np.exp(-t)))
+    True
+    """
+    T = A.period
+    h = np.diff(t)
+    repeat = _repeat_length(t, h, T)
+    table = None
+    if repeat is None or repeat[1] > 1:
+        # steps longer than or not dividing the period: a cell table, when worthwhile
+        count = len(h) if repeat is None else repeat[0]
+        if count > 2 * math.ceil(T / h.min()) or (repeat is not None and repeat[1] > 1):
+            table = _table_steps(A, B, h, T, rtol)
+    if repeat is not None:
+        # the step data repeat every q steps: march with period q
+        q = repeat[0]
+        tk = t[0] + h[0] * np.arange(q)
+        if table is not None:
+            Phi, G0, G1 = table(tk, np.full(q, h[0]))
+        else:
+            Phi, G0, G1 = step_transitions(A, B, tk, h[0], rtol)
+        E, F = _hold(G0, G1, hold)
+        return periodic_march(Phi, E, F, C(tk), D(tk), u, x0, states=states)
+    if table is None:
+        def steps(k0, k1):
+            return step_transitions(A, B, t[k0:k1], h[k0:k1], rtol)
+    else:
+        def steps(k0, k1):
+            return table(t[k0:k1], h[k0:k1])
+    return _chunked_march(steps, C, D, t, u, x0, hold, states)
+
+
+def _repeat_length(t, h, T):
+    """``(q, p)`` when the grid is uniform and ``q h = p T`` (q <= a bound), else None."""
+    if not np.allclose(h, h[0], rtol=1e-10, atol=0):
+        return None
+    ratio = Fraction(float(h[0] / T)).limit_denominator(_MAX_REPEAT)
+    q, p = ratio.denominator, ratio.numerator
+    if abs(q * h[0] - p * T) > 1e-9 * p * T or q > len(h):
+        return None
+    # worthwhile only when the pattern is a few periods' worth of steps
+    return (q, p) if q <= 4 * math.ceil(T / h[0]) else None
+
+
+def _hold(G0, G1, hold):
+    # x[k+1] = Φ x[k] + (Γ0 - Γ1) u[k] + Γ1 u[k+1] (first-order hold)
+    return (G0, None) if hold == 'zoh' else (G0 - G1, G1)
+
+
+def _chunked_march(steps, C, D, t, u, x0, hold, states):
+    """March chunk after chunk of step data, each chunk as one 'period'."""
+    L = len(t)
+    n, R = x0.shape
+    p = C.shape[0]
+    x = np.empty((n, R, L)) if states else None
+    y = np.empty((p, R, L))
+    xs = x0
+    for s0 in range(0, L, _CHUNK_STEPS):
+        s1 = min(L, s0 + _CHUNK_STEPS)
+        S = s1 - s0
+        k1 = min(s1, L - 1)                    # step data exist for samples < L - 1
+        Phi, G0, G1 = steps(s0, k1)
+        E, F = _hold(G0, G1, hold)
+        Nc = -(-S // 20) * 20                  # a multiple of the block length
+        Phi, E, F = _pad(Phi, Nc, eye=True), _pad(E, Nc), None if F is None else _pad(F, Nc)
+        tk = t[s0:s1]
+        Cs, Ds = _pad(C(tk), Nc), _pad(D(tk), Nc)
+        if R <= _FEW_TRACES:
+            xc, yc, xs = _sequence_march(Phi, E, F, Cs, Ds, u[:, :, s0:s1 + 1], xs, S)
+            xc = xc if states else None
+        elif s1 == L:
+            xc, yc = periodic_march(Phi, E, F, Cs, Ds, u[:, :, s0:s1], xs, states=states,
+                                    nsamples=S)
+        else:
+            # one more input sample: the state after the chunk starts the next one
+            xc, yc, xs = periodic_march(Phi, E, F, Cs, Ds, u[:, :, s0:s1 + 1], xs,
+                                        states=states, final=True, nsamples=S)
+        y[:, :, s0:s1] = yc
+        if states:
+            x[:, :, s0:s1] = xc
+    return x, y
+
+
+def _sequence_march(Phi, E, F, C, D, u, x0, S):
+    """States, outputs and final state of one chunk for a few traces.
+
+    With the forcing ``w_k = E_k u[k] + F_k u[k+1]`` computed for all steps
+    at once, ``x[k+1] = Φ_k x[k] + w_k`` is unrolled inside blocks of b
+    steps (``x[s+j] = Φ(j, 0) x[s] + σ_j``, a loop over j for all blocks at
+    once) and the block starts are marched block by block.
+    """
+    N, n, m = E.shape
+    R = u.shape[1]
+    Lu = u.shape[2]
+    b = _SEQ_BLOCK
+    Np = -(-N // b) * b
+    uk = np.zeros((m, R, Np + 1))
+    uk[:, :, :Lu] = u
+    uk[:, :, Lu:] = u[:, :, -1:]
+    w = np.einsum('kni,irk->knr', E, uk[:, :, :N])
+    if F is not None:
+        w += np.einsum('kni,irk->knr', F, uk[:, :, 1:N + 1])
+    Phi, w = _pad(Phi, Np, eye=True), _pad(w, Np)
+    nb = Np // b
+    Phi, w = Phi.reshape(nb, b, n, n), w.reshape(nb, b, n, R)
+    P = np.broadcast_to(np.eye(n), (nb, n, n)).copy()
+    sig = np.zeros((nb, n, R))
+    Ploc, sloc = np.empty((nb, b, n, n)), np.empty((nb, b, n, R))
+    for j in range(b):
+        Ploc[:, j], sloc[:, j] = P, sig
+        P, sig = Phi[:, j] @ P, Phi[:, j] @ sig + w[:, j]
+    starts = np.empty((nb + 1, n, R))
+    starts[0] = x0
+    for i in range(nb):
+        starts[i + 1] = P[i] @ starts[i] + sig[i]
+    x = (Ploc @ starts[:nb, None] + sloc).reshape(Np, n, R)[:S]
+    Ck, Dk = C[:S], D[:S]
+    y = np.einsum('kpn,knr->prk', Ck, x) + np.einsum('kpi,irk->prk', Dk, uk[:, :, :S])
+    return x.transpose(1, 2, 0), y, starts[nb]
+
+
+def _pad(a, N, eye=False):
+    """Step data padded to N steps (identity transitions, zero inputs and outputs)."""
+    if len(a) == N:
+        return a
+    out = np.zeros((N,) + a.shape[1:])
+    out[:len(a)] = a
+    if eye:
+        out[len(a):] = np.eye(a.shape[1])
+    return out
+
+
+def _table_steps(A, B, h, T, rtol):
+    """Step data from a phase table (module notes), or None when not exact enough."""
+    hmin, hmax = float(h.min()), float(h.max())
+    n, m = A.shape[0], B.shape[1]
+    # cells shorter than the shortest step (so that a step spans a cell
+    # boundary), made shorter when their node intervals would need more than
+    # four Magnus sub-steps (cheaper in total: the error per interval is ∝ δ⁵)
+    N0 = max(16, math.floor(T / hmin) + 1)
+    info = {}
+    step_transitions(A, B, np.linspace(0, T, 8, endpoint=False),
+                     np.full(8, T / N0 / _DEG), rtol, info=info)
+    if info['substeps'] > 4:
+        N0 = math.ceil(N0 * (info['substeps'] / 4) ** 0.8)
+    for refine in (1, 2, 4):
+        # split at the switching instants
+        N = refine * N0
+        if N > _MAX_CELLS:
+            return None
+        bps = np.mod(np.concatenate([A.breakpoints, B.breakpoints]), T)
+        edges = np.union1d(np.linspace(0, T, N + 1), bps)
+        edges = edges[np.concatenate([[True], np.diff(edges) > 1e-12 * T])]
+        edges[-1] = T
+        partial = _partial_table(A, B, edges, rtol)
+        if _partial_error(A, B, edges, partial, rtol) <= max(_TABLE_TOL, 0.1 * rtol):
+            break
+    else:
+        return None
+    lens = np.diff(edges)
+    N = len(lens)
+    n, m = A.shape[0], B.shape[1]
+    # the composition rule as a product of augmented matrices
+    # [[Φ, W, Z], [0, I, ℓI], [0, 0, I]] (ℓ the interval's length)
+    nodes = lens[:, None] * np.linspace(0.0, 1.0, _DEG + 1)
+    fwd, bwd = (_augment(*v, nodes) for v in partial)
+    cells = fwd[:, -1]
+    # runs of 2^i cells from every cell
+    levels = max(1, int(math.ceil(hmax / lens.min()) + 1).bit_length())
+    lift = [cells]
+    for i in range(1, levels):
+        nxt = (np.arange(N) + 2 ** (i - 1)) % N
+        lift.append(lift[-1][nxt] @ lift[-1])
+
+    def steps(tk, hk):
+        theta = tk - T * np.floor(tk / T)
+        j = np.clip(np.searchsorted(edges, theta, side='right') - 1, 0, N - 1)
+        phi = theta + hk
+        wraps = np.floor(phi / T)
+        jb = np.clip(np.searchsorted(edges, phi - wraps * T, side='right') - 1, 0, N - 1)
+        count = (jb + N * wraps.astype(int)) - j - 1
+        # head [θ, e_{j+1}] and tail [e_J, t_k + h_k] from the partial cells
+        (M,) = _interpolate((bwd,), edges, j, edges[j + 1] - theta)
+        # the run of `count` cells after cell j, by the binary digits of count
+        pos = (j + 1) % N
+        for i, run in enumerate(lift):
+            sel = (count >> i) & 1 == 1
+            if np.any(sel):
+                M[sel] = run[pos[sel]] @ M[sel]
+                pos = np.where(sel, (pos + 2 ** i) % N, pos)
+        (tail,) = _interpolate((fwd,), edges, jb, phi - wraps * T - edges[jb])
+        M = tail @ M
+        return M[:, :n, :n], M[:, :n, n:n + m], M[:, :n, n + m:] / hk[:, None, None]
+    return steps
+
+
+def _augment(P, W, Z, lengths):
+    """``[[Φ, W, Z], [0, I, ℓI], [0, 0, I]]`` of a table (cells, nodes)."""
+    n, m = W.shape[-2:]
+    M = np.zeros(P.shape[:2] + (n + 2 * m, n + 2 * m))
+    M[..., :n, :n], M[..., :n, n:n + m], M[..., :n, n + m:] = P, W, Z
+    M[..., n:n + m, n:n + m] = M[..., n + m:, n + m:] = np.eye(m)
+    M[..., n:n + m, n + m:] = lengths[..., None, None] * np.eye(m)
+    return M
+
+
+def _partial_table(A, B, edges, rtol):
+    """(Φ, W, Z) of ``[e_j, e_j + ℓ_i]`` and ``[e_{j+1} - ℓ_i, e_{j+1}]``, ``ℓ_i = i h_j/D``."""
+    n, m = A.shape[0], B.shape[1]
+    lens = np.diff(edges)
+    nodes = edges[:-1, None] + lens[:, None] * np.linspace(0.0, 1.0, _DEG + 1)       # (N, D+1)
+    a, d = nodes[:, :-1].ravel(), np.diff(nodes, axis=1).ravel()
+    Phi, G0, G1 = step_transitions(A, B, a, d, rtol)
+    shape = (len(lens), _DEG)
+    Phi, W1, Z1 = (v.reshape(shape + v.shape[1:]) for v in (Phi, G0, G1 * d[:, None, None]))
+    P = np.empty((len(lens), _DEG + 1, n, n))
+    W = np.zeros((len(lens), _DEG + 1, n, m))
+    Z = np.zeros((len(lens), _DEG + 1, n, m))
+    P[:, 0] = np.eye(n)
+    Pb, Wb, Zb = P.copy(), W.copy(), Z.copy()
+    dd = d.reshape(shape)
+    for i in range(_DEG):
+        # forward: [e_j, e_j + ℓ_i] then node interval i
+        P[:, i + 1], W[:, i + 1], Z[:, i + 1] = _compose(
+            (P[:, i], W[:, i], Z[:, i]), (Phi[:, i], W1[:, i], Z1[:, i]),
+            nodes[:, i] - nodes[:, 0])
+        # backward: node interval D-1-i then [e_{j+1} - ℓ_i, e_{j+1}]
+        k = _DEG - 1 - i
+        Pb[:, i + 1], Wb[:, i + 1], Zb[:, i + 1] = _compose(
+            (Phi[:, k], W1[:, k], Z1[:, k]), (Pb[:, i], Wb[:, i], Zb[:, i]), dd[:, k])
+    return (P, W, Z), (Pb, Wb, Zb)
+
+
+def _interpolate(partial, edges, j, length):
+    """(Φ, W, Z) at `length` in cells `j`, by barycentric interpolation in each cell."""
+    xi = np.clip(length / (edges[j + 1] - edges[j]), 0.0, 1.0)
+    cheb = np.linspace(0.0, 1.0, _DEG + 1)
+    # barycentric weights of equispaced nodes: (-1)^j binom(D, j)
+    bary = np.array([(-1.0) ** k * math.comb(_DEG, k) for k in range(_DEG + 1)])
+    diff = xi[:, None] - cheb[None, :]
+    hit = diff == 0
+    with np.errstate(divide='ignore'):
+        w = np.where(hit.any(axis=1, keepdims=True), hit.astype(float), bary / diff)
+    w /= w.sum(axis=1, keepdims=True)
+    # one matrix product per cell: weights (samples, D+1) times values (D+1, all entries)
+    sizes = [int(np.prod(v.shape[2:])) for v in partial]
+    table = np.concatenate([v.reshape(v.shape[0], v.shape[1], -1) for v in partial], axis=2)
+    order = np.argsort(j, kind='stable')
+    js, ws = j[order], w[order]
+    bounds = np.flatnonzero(np.diff(js)) + 1
+    starts, ends = np.concatenate([[0], bounds]), np.concatenate([bounds, [len(j)]])
+    if len(j) == 0:
+        starts = ends = []
+    sorted_out = np.empty((len(j), table.shape[2]))
+    for a, b in zip(starts, ends):
+        np.matmul(ws[a:b], table[js[a]], out=sorted_out[a:b])
+    out = np.empty_like(sorted_out)
+    out[order] = sorted_out
+    parts = np.split(out, np.cumsum(sizes)[:-1], axis=1)
+    return tuple(q.reshape((len(j),) + v.shape[2:]) for q, v in zip(parts, partial))
+
+
+def _partial_error(A, B, edges, partial, rtol):
+    """Largest interpolation error at probe lengths of a few cells, against the integrator."""
+    N = len(edges) - 1
+    # short probe lengths keep the reference integration cheap
+    j = np.unique(np.linspace(0, N - 1, min(N, 5)).astype(int))
+    j = np.concatenate([j, j])
+    frac = np.concatenate([np.full(len(j) // 2, 0.0731), np.full(len(j) // 2, 0.2917)])
+    length = frac * (edges[j + 1] - edges[j])
+    fwd, bwd = partial
+    err = 0.0
+    for start, table in ((edges[j], fwd), (edges[j + 1] - length, bwd)):
+        exact = _pieces(A, B, start, length, rtol, A.shape[0])
+        approx = _interpolate(table, edges, j, length)
+        for i, (e, a, whole) in enumerate(zip(exact, approx, table)):
+            if e.size:
+                # Φ relative to max(1, |Φ|); W, Z relative to their size over a cell
+                scale = np.abs(whole[:, -1]).max()
+                scale = max(1.0, scale) if i == 0 else max(scale, 1e-300)
+                err = max(err, float(np.abs(e - a).max() / scale))
+    return err
+
+
+def _pieces(A, B, a, length, rtol, n):
+    """(Φ, W, Z) of the pieces [a, a + length]; zero length gives the identity."""
+    m = B.shape[1]
+    P = np.broadcast_to(np.eye(n), (len(a), n, n)).copy()
+    W, Z = np.zeros((len(a), n, m)), np.zeros((len(a), n, m))
+    live = length > 1e-14 * A.period
+    if np.any(live):
+        Pl, G0, G1 = step_transitions(A, B, a[live], length[live], rtol)
+        P[live], W[live], Z[live] = Pl, G0, G1 * length[live][:, None, None]
+    return P, W, Z
+
+
+def _compose(first, second, len1):
+    """Data of ``I1`` followed by ``I2`` (module notes); len1 the length of I1."""
+    P1, W1, Z1 = first
+    P2, W2, Z2 = second
+    len1 = np.broadcast_to(np.asarray(len1, float), (len(P1),))[:, None, None]
+    return P2 @ P1, P2 @ W1 + W2, P2 @ Z1 + Z2 + len1 * W2

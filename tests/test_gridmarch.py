@@ -1,0 +1,113 @@
+"""Simulation on grids whose step does not divide the period: exact, like the aligned grid."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+import ltpcontrol as ltp
+import ltpcontrol._core.gridmarch as gridmarch
+from systems import damped_mathieu, mathieu, switching_mathieu
+
+
+def rel(a, b):
+    return float(np.abs(np.asarray(a) - np.asarray(b)).max() / np.abs(np.asarray(b)).max())
+
+
+def direct(monkeypatch, sys, t, u, **kw):
+    """The same exact discretization with every step integrated on its own."""
+    with monkeypatch.context() as mp:
+        mp.setattr(gridmarch, '_table_steps', lambda *a: None)
+        mp.setattr(gridmarch, '_repeat_length', lambda *a: None)
+        return ltp.forced_response(sys, t, u, **kw)
+
+
+@pytest.mark.parametrize("plant, hold", [(damped_mathieu, 'foh'), (switching_mathieu, 'foh'),
+                                         (switching_mathieu, 'zoh'), (mathieu, 'foh')])
+def test_linspace_grid_equals_independent_integration(plant, hold):
+    sys = plant()
+    t = np.linspace(0, 2.3 * sys.period, 41)               # step does not divide T
+    u = np.sin(2.1 * t) + 0.3 * np.cos(5.0 * t)
+    resp = ltp.forced_response(sys, t, u, input_hold=hold)
+    ref = ltp.forced_response(sys, t, u, input_hold=hold, method='solve_ivp', rtol=1e-10)
+    assert rel(resp.outputs, ref.outputs) < 1e-7          # the reference's accuracy
+    assert rel(resp.states, ref.states) < 1e-7
+
+
+def test_table_equals_per_step_integration(monkeypatch):
+    sys = damped_mathieu()
+    t = np.linspace(0, 40 * sys.period, 2001)
+    U = np.array([np.cos(1.7 * t), np.sin(0.4 * t) ** 2])[None]
+    x0 = np.array([[1.0, -0.5], [0.2, 0.0]])
+    resp = ltp.forced_response(sys, t, U, x0)
+    ref = direct(monkeypatch, sys, t, U, initial_state=x0)
+    assert rel(resp.states, ref.states) < 1e-12
+    assert rel(resp.outputs, ref.outputs) < 1e-12
+
+
+def test_repeating_phase_pattern(monkeypatch):
+    sys = switching_mathieu()
+    t = 3 * sys.period / 50 * np.arange(900)              # 50 steps span three periods
+    assert gridmarch._repeat_length(t, np.diff(t), sys.period) == (50, 3)
+    u = np.cos(3.0 * t)
+    resp = ltp.forced_response(sys, t, u)
+    ref = direct(monkeypatch, sys, t, u)
+    assert rel(resp.outputs, ref.outputs) < 1e-12
+
+
+def test_nonuniform_grid_and_chunks(monkeypatch):
+    rng = np.random.default_rng(3)
+    sys = switching_mathieu()
+    t = np.cumsum(np.concatenate([[0.3], rng.uniform(0.004, 0.011, 1500)]))
+    u = np.sin(4.0 * t)
+    resp = ltp.forced_response(sys, t, u)
+    monkeypatch.setattr(gridmarch, '_CHUNK_STEPS', 60)     # chunk boundaries inside
+    chunked = ltp.forced_response(sys, t, u)
+    ref = direct(monkeypatch, sys, t, u)
+    assert rel(resp.outputs, ref.outputs) < 1e-12
+    assert rel(chunked.outputs, ref.outputs) < 1e-12
+    short = ltp.forced_response(sys, t[:40], u[:40], method='solve_ivp', rtol=1e-10)
+    assert rel(resp.outputs[:40], short.outputs) < 1e-8
+
+
+@settings(derandomize=True, max_examples=12, deadline=None, database=None)
+@given(ratio=st.floats(0.011, 0.3), t0=st.floats(0.0, 3.0), n=st.integers(20, 400))
+def test_any_uniform_grid_matches_per_step_data(ratio, t0, n):
+    sys = damped_mathieu()
+    t = t0 + ratio * sys.period * np.arange(n)
+    u = np.cos(2.3 * t)
+    resp = ltp.forced_response(sys, t, u)
+    with pytest.MonkeyPatch.context() as mp:
+        ref = direct(mp, sys, t, u)
+    assert rel(resp.outputs, ref.outputs) < 1e-11
+
+
+def test_outputs_only():
+    sys = mathieu()
+    t = np.linspace(0, 3, 401)
+    U = np.cos(np.outer([1.0, 2.0, 3.0], t))[None]
+    full = ltp.forced_response(sys, t, U)
+    fast = ltp.forced_response(sys, t, U, compute_states=False)
+    assert fast.states.shape == (0, 3, len(t))
+    np.testing.assert_allclose(fast.outputs, full.outputs, rtol=0, atol=1e-14)
+    with pytest.raises(ValueError, match='compute_states'):
+        ltp.forced_response(sys, t, U, compute_states='no')
+    with pytest.raises(ValueError, match='return_states'):
+        ltp.forced_response(sys, t, U, compute_states=False, return_states=True)
+
+
+@pytest.mark.parametrize("few", [0, 16])
+def test_both_chunk_marches(monkeypatch, few):
+    # few traces: state by state; many: the block kernel of the periodic march
+    monkeypatch.setattr(gridmarch, '_FEW_TRACES', few)
+    monkeypatch.setattr(gridmarch, '_CHUNK_STEPS', 140)
+    sys = switching_mathieu()
+    t = np.linspace(0.1, 12 * sys.period, 1001)
+    U = np.cos(np.outer([1.0, 2.5, 4.0], t))[None]
+    x0 = np.array([[0.3, 0.0, -1.0], [0.0, 1.0, 0.5]])
+    resp = ltp.forced_response(sys, t, U, x0)
+    monkeypatch.setattr(gridmarch, '_CHUNK_STEPS', 4000)
+    ref = direct(monkeypatch, sys, t, U, initial_state=x0)
+    assert rel(resp.states, ref.states) < 1e-12
+    assert rel(resp.outputs, ref.outputs) < 1e-12
+    fast = ltp.forced_response(sys, t, U, x0, compute_states=False)
+    assert rel(fast.outputs, ref.outputs) < 1e-12
