@@ -223,4 +223,7 @@ def _block_eigenvalues(W, R):
     mu = np.linalg.eigvals(prod)
     arg = np.angle(mu)
     arg[(mu.imag == 0) & (mu.real < 0)] = np.pi
-    return np.log(np.abs(mu)) + logscale, arg
+    logmod = np.log(np.abs(mu)) + logscale
+    # a fixed order, so that successive sweeps compare
+    order = np.lexsort((-arg, -logmod))
+    return logmod[order], arg[order]

@@ -85,12 +85,12 @@ class _Problem:
         self.hp, self.u0, self.params, self.opts = hp, u0, params, opts
         self.deadline = deadline
 
-    def flow(self, x, mode, duration, variational=False, options=None):
+    def flow(self, x, mode, duration, variational=False, options=None, factored=False):
         if self.deadline is not None and time.monotonic() > self.deadline:
             raise TimeoutError("the time limit (timeout) was reached")
         u0 = self.u0
         return Flow(self.hp, 0.0, duration, x, mode, lambda t: u0, self.params,
-                     variational=variational, **(options or self.opts))
+                     variational=variational, factored=factored, **(options or self.opts))
 
     def f(self, mode, x):
         return self.hp.dynamics(0.0, x, self.u0, self.params, mode=mode)
@@ -492,6 +492,8 @@ def _finish(prob, sec, fl, x, T, npoints, res, iterations, returns):
     if sec.direction * (grad @ f0) <= 0:
         raise RuntimeError("limit_cycle converged to an orbit that crosses the section in the "
                            "other direction; use direction=-1 or another section")
+    # the multipliers from the product form of the period map
+    fl = prob.flow(x, sec.mode, T, variational=True, factored=True)
     orbit = PeriodicOrbit(prob.hp, float(T), fl, x, sec.mode, npoints, prob.params, prob.u0, res,
                           iterations, returns, phase_direction=f0)
     orbit.section = sec

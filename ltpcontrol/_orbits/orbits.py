@@ -19,7 +19,8 @@ from control import NonlinearIOSystem
 from control.exception import ControlArgument, ControlDimension
 
 from .hybrid import (HybridMode, HybridPlant, central_jacobian, constant_input,
-                      Flow, IntegrationError, plant_params, solver_settings)
+                      Flow, IntegrationError, plant_params, solver_settings, _RESTART)
+from .multipliers import product_multipliers
 from .._core.ltpsys import ltpss
 from .._core.periodic_matrix import PeriodicMatrix
 from .._core.validation import check_period, check_positive_int, real_array
@@ -57,9 +58,26 @@ class PeriodicOrbit:
         Saltation matrix of each event.
     monodromy : ndarray, shape (n, n)
         Jacobian of the period map at ``x0``: the exact linearised return
-        map, including the saltation matrices of hybrid events.
+        map, including the saltation matrices of hybrid events, formed as
+        one matrix (its small eigenvalues are not accurate; see
+        `multipliers`).
     multipliers : ndarray
-        Eigenvalues of `monodromy` (Floquet multipliers).
+        Floquet multipliers (eigenvalues of the period map's Jacobian),
+        sorted by decreasing modulus.  They are computed from the product
+        form of the Jacobian — transition matrices of short intervals and
+        saltation matrices, combined by QR sweeps — so that each one is
+        accurate relative to its own size (a multiplier of 1e-38 of a stiff
+        orbit included); moduli below 1e-308 underflow to 0 (see
+        `log_multipliers`).
+    log_multipliers : ndarray
+        ``log|μ|`` of `multipliers`, finite far below the float range.
+    multiplier_error : float
+        Estimated relative error of every multiplier: the mismatch of
+        Liouville's formula ``Σ log|μ_i| = ∮ tr ∂f/∂x dt + Σ log|det S_j|``
+        (trace integrated with the variational equations), plus the error
+        estimate of the QR sweeps, plus ``K · 8 · rtol`` for K factors.
+        Errors of central-difference Jacobians (about 1e-10 relative) are
+        not included.
     is_stable : bool
         True when all `stability_multipliers` lie strictly inside the unit
         circle.
@@ -119,15 +137,15 @@ class PeriodicOrbit:
         self.mode_sequence = [mode0] + [e[2] for e in flow.events]
         self.saltation_matrices = list(flow.saltations)
         self.monodromy = flow.phi
-        self.multipliers = np.linalg.eigvals(self.monodromy)
+        mult = flow_multipliers(flow, phase_direction)
+        self.multipliers, self.log_multipliers = mult.values, mult.log_moduli
+        self.multiplier_error = mult.error
         self.autonomous = phase_direction is not None
-        self.phase_multiplier, self.stability_multipliers = None, self.multipliers
+        self.phase_multiplier, self.stability_multipliers = None, mult.stability
         self.section = self.poincare_jacobian = None
         if self.autonomous:
-            k = _phase_index(self.monodromy, self.multipliers, phase_direction)
-            self.phase_multiplier = float(self.multipliers[k].real)
-            self.stability_multipliers = np.delete(self.multipliers, k)
-        self.is_stable = bool(np.all(np.abs(self.stability_multipliers) < 1))
+            self.phase_multiplier = float(np.real(mult.values[mult.phase]))
+        self.is_stable = bool(np.all(mult.stability_log_moduli < 0))
         self.residual, self.iterations, self.periods_simulated = residual, iterations, periods
 
     def __call__(self, t):
@@ -142,20 +160,12 @@ class PeriodicOrbit:
                 f"|multipliers|=[{mags}], stable={self.is_stable}>")
 
 
-def _phase_index(monodromy, multipliers, direction):
-    """Index of the multiplier whose eigenvector is the flow direction.
-
-    ``Φ f(x̄(0)) = f(x̄(0))``: among the multipliers near 1 take the one whose
-    eigenvector is best aligned with the vector field (several multipliers
-    equal 1 when the plant conserves a quantity, e.g. energy).
-    """
-    near = np.flatnonzero(np.abs(multipliers - 1) < 1e-3)
-    if near.size <= 1:
-        return int(np.argmin(np.abs(multipliers - 1)))
-    _, vecs = np.linalg.eig(monodromy)
-    unit = direction / np.linalg.norm(direction)
-    align = np.abs(vecs[:, near].conj().T @ unit) / np.linalg.norm(vecs[:, near], axis=0)
-    return int(near[np.argmax(align)])
+def flow_multipliers(flow, phase_direction=None):
+    """`OrbitMultipliers` of a variational `Flow` over one period (product form)."""
+    return product_multipliers(
+        flow.factors or [flow.phi], rtol=flow.rtol, restart=_RESTART,
+        trace_integral=flow.trace_integral if flow.factored else None,
+        saltations=flow.saltations, phase_direction=phase_direction, monodromy=flow.phi)
 
 
 def as_hybrid(plant, jacobian):
@@ -395,6 +405,8 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
         found = shooter.newton(x, mode, tol, max_iter, f"Newton from t={periods}T", tried)
         if found is not None:
             fl, x, res, iterations = found
+            # the multipliers from the product form of the period map
+            fl = shooter.flow(x, mode, True, factored=True)
             return _finish(hp, period, fl, x, mode, npoints, params, u0, res, iterations,
                            periods)
         if periods >= warmup + max_periods:
@@ -438,10 +450,10 @@ class _PeriodShooter:
         # forward simulation only supplies starting guesses: moderate tolerances
         self.loose = dict(opts, rtol=max(opts['rtol'], 1e-8), atol=max(opts['atol'], 1e-10))
 
-    def flow(self, x, mode, variational, options=None):
+    def flow(self, x, mode, variational, options=None, factored=False):
         u0 = self.u0
         return Flow(self.hp, 0.0, self.period, x, mode, lambda t: u0, self.params,
-                     variational=variational, **(options or self.opts))
+                     variational=variational, factored=factored, **(options or self.opts))
 
     def simulate(self, x, mode, nper):
         """State, mode and last-period residual after `nper` simulated periods."""
