@@ -105,7 +105,6 @@ def design():
     return orbit, K
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize('analytic', [False, True])
 def test_kink_both_sides_reported(design, analytic):
     orbit, K = design

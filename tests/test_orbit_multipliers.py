@@ -96,7 +96,8 @@ def test_stiff_hybrid_orbit_multiplier_relative_accuracy():
     assert abs(orbit.log_multipliers[1] - logmu) <= 10 * orbit.multiplier_error
     assert orbit.multiplier_error < 1e-6
     # the formed monodromy cannot resolve it
-    assert abs(np.linalg.eigvals(orbit.monodromy)).min() > 1e-30
+    formed = np.abs(np.linalg.eigvals(orbit.monodromy)).min()
+    assert not abs(formed / np.exp(logmu) - 1) < 0.5
 
 
 def test_forced_stiff_orbit():

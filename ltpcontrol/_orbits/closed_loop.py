@@ -36,7 +36,8 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 from tqdm.auto import tqdm
 
-from .hybrid import Flow, input_function, IntegrationError, solver_settings, _RESTART
+from .hybrid import (Flow, input_function, IntegrationError, newton_solver_settings,
+                     solver_settings, _RESTART)
 from .kinks import one_sided_saltations, side_factor_lists
 from .multipliers import product_multipliers
 from .loop import FeedbackLoop, SampledLoop
@@ -421,7 +422,7 @@ def _run_continuous(loop, opts, rec, z, mode, vfun, bar, bound):
 
 
 def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_state=None,
-                      tol=1e-10, max_iter=20, max_periods=20, rtol=1e-10, atol=1e-12,
+                      tol=1e-10, max_iter=20, max_periods=20, rtol=None, atol=None,
                       method='DOP853', max_events=10000):
     """Periodic orbit of the closed hybrid loop and its Floquet multipliers.
 
@@ -447,9 +448,12 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
         controllers); discrete
         controllers use `tol` and `max_iter` for Newton and fall back to
         `max_periods` periods of simulation.
-    rtol, atol, method, max_events : optional
-        Integration settings, as in `simulate_hybrid` (defaults 1e-10,
-        1e-12, 'DOP853', 10000).
+    rtol, atol : float, optional
+        `solve_ivp` tolerances; by default ``rtol = min(1e-10, tol/100)``
+        and ``atol = rtol/100`` (below the Newton tolerance).
+    method, max_events : optional
+        Integration settings, as in `simulate_hybrid` (defaults 'DOP853',
+        10000).
 
     Returns
     -------
@@ -490,7 +494,7 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
     >>> cl.is_stable, bool(np.isclose(cl.dominant_multiplier, np.exp(4 * np.pi)))
     (False, True)
     """
-    opts = solver_settings('closed_loop_orbit', rtol, atol, method, max_events)
+    opts = newton_solver_settings('closed_loop_orbit', tol, rtol, atol, method, max_events)
     loop = FeedbackLoop(plant, controller, orbit, saturation)
     z0, mode0 = _initial(loop, orbit.x0, 0.0 if controller_state is None else controller_state,
                          orbit.mode0, 0.0)

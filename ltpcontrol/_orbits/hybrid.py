@@ -582,7 +582,8 @@ class Flow:
                 events.append(event)
             if variational and factored:
                 events.append(_restart_event(n))
-            sol = solve_ivp(rhs, (t, tf), z0, method=method, rtol=rtol, atol=atol,
+            sol = solve_ivp(rhs, (t, tf), z0, method=method, rtol=rtol,
+                            atol=_variational_atol(atol, n, len(z0)) if variational else atol,
                             events=events or None, dense_output=True)
             if sol.status == -1:
                 raise IntegrationError(f"integration failed in mode {plant.mode_names[i]!r} "
@@ -650,6 +651,23 @@ class Flow:
         return states, modes
 
 
+#: absolute tolerance floor of the transition factors (entries of order 1)
+_PHI_ATOL = 1e-10
+
+
+def _variational_atol(atol, n, size):
+    """Absolute tolerances: `atol` for the state, at least `_PHI_ATOL` for the rest.
+
+    The transition factors are driven by ``∂f/∂x``, which central
+    differences give to about 1e-10 only; asking more of them makes the
+    step-size control chase that noise.  Restarted factors have entries of
+    order 1, so this is a relative accuracy of about 1e-10 per factor.
+    """
+    out = np.full(size, max(atol, _PHI_ATOL))
+    out[:n] = atol
+    return out
+
+
 def _restart_event(n):
     """Terminal event: a singular value of the transition factor leaves [1/c, c]."""
     limit = np.log(_RESTART)
@@ -684,6 +702,48 @@ def solver_settings(where, rtol=1e-10, atol=1e-12, method='DOP853', max_events=1
         raise ControlArgument(f"{where}: method must be a solve_ivp method name, got {method!r}")
     return dict(rtol=float(rtol), atol=float(atol), method=method,
                 max_events=check_positive_int(max_events, 'max_events'))
+
+
+def newton_solver_settings(where, tol, rtol, atol, method, max_events):
+    """`solver_settings` for a Newton solve to `tol`: integration tolerances below it.
+
+    The residual of a shooting Newton iteration cannot drop below the
+    integration error of the period map, so by default ``rtol = min(1e-10,
+    tol/100)`` and ``atol = rtol/100``.
+
+    Examples
+    --------
+    >>> from ltpcontrol._orbits.hybrid import newton_solver_settings
+    >>> opts = newton_solver_settings('periodic_orbit', 1e-10, None, None, 'DOP853', 10)
+    >>> opts['rtol'], opts['atol']
+    (1e-12, 1e-14)
+    """
+    if rtol is None:
+        valid = isinstance(tol, numbers.Real) and not isinstance(tol, bool) and 0 < tol < 1
+        rtol = min(1e-10, 1e-2 * tol) if valid else 1e-12
+    if atol is None and isinstance(rtol, numbers.Real) and not isinstance(rtol, bool):
+        atol = 1e-2 * rtol
+    return solver_settings(where, rtol, atol, method, max_events)
+
+
+def inexact_options(opts, residual):
+    """Integration settings for a Newton step at `residual` (inexact Newton).
+
+    Far from the solution the period map need not be accurate to `rtol`:
+    ``rtol_k = min(max(rtol, 1e-3 residual), max(rtol, 1e-8))`` (``atol``
+    scaled alike), reaching the requested `rtol` as the residual falls.
+
+    Examples
+    --------
+    >>> from ltpcontrol._orbits.hybrid import inexact_options
+    >>> opts = dict(rtol=1e-12, atol=1e-14, method='DOP853', max_events=10)
+    >>> inexact_options(opts, float('inf'))['rtol'], inexact_options(opts, 1e-7)['rtol']
+    (1e-08, 1e-10)
+    >>> inexact_options(opts, 1e-11)['atol']
+    1e-14
+    """
+    rtol = min(max(opts['rtol'], 1e-3 * residual), max(opts['rtol'], 1e-8))
+    return dict(opts, rtol=rtol, atol=opts['atol'] * rtol / opts['rtol'])
 
 
 def simulate_hybrid(plant, timepts, initial_state, mode0=0, inputs=0.0, params=None, *,

@@ -19,7 +19,8 @@ from control import NonlinearIOSystem
 from control.exception import ControlArgument, ControlDimension
 
 from .hybrid import (HybridMode, HybridPlant, central_jacobian, constant_input,
-                      Flow, IntegrationError, plant_params, solver_settings, _RESTART)
+                      Flow, IntegrationError, plant_params, solver_settings,
+                      inexact_options, newton_solver_settings, _RESTART)
 from .multipliers import product_multipliers
 from .tabulate import tabulate
 from .._core.ltpsys import ltpss
@@ -76,9 +77,12 @@ class PeriodicOrbit:
         Estimated relative error of every multiplier: the mismatch of
         Liouville's formula ``Σ log|μ_i| = ∮ tr ∂f/∂x dt + Σ log|det S_j|``
         (trace integrated with the variational equations), plus the error
-        estimate of the QR sweeps, plus ``K · 8 · rtol`` for K factors.
-        Errors of central-difference Jacobians (about 1e-10 relative) are
-        not included.
+        estimate of the QR sweeps, plus ``K · 8 · rtol`` for K factors;
+        for an autonomous orbit also the effect of the period's
+        uncertainty (residual over the speed ``|f(x0)|``) through
+        ``tr ∂f/∂x(x0)``.  Errors of central-difference Jacobians (about
+        1e-10 relative) and, for forced orbits, of the orbit's location
+        (the residual `tol`) are not included.
     is_stable : bool
         True when all `stability_multipliers` lie strictly inside the unit
         circle.
@@ -313,7 +317,7 @@ def period_map(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=Fal
 
 def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=None,
                    warmup=0, tol=1e-10, max_iter=20, max_periods=200, npoints=200,
-                   rtol=1e-10, atol=1e-12, method='DOP853', max_events=10000):
+                   rtol=None, atol=None, method='DOP853', max_events=10000):
     """T-periodic steady state (limit cycle) of a periodically forced plant.
 
     Solves ``P(x) = x`` for the period map ``P`` by Newton's method
@@ -358,7 +362,11 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
         (200).
     npoints : int, optional
         Number of grid points of the stored orbit (200).
-    rtol, atol, method, max_events : optional
+    rtol, atol : float, optional
+        `solve_ivp` tolerances; by default ``rtol = min(1e-10, tol/100)``
+        and ``atol = rtol/100``, so that the integration error of the
+        period map stays below the Newton tolerance.
+    method, max_events : optional
         Integration settings, as in `simulate_hybrid`.
 
     Returns
@@ -390,7 +398,7 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
     >>> bool(np.allclose(orbit.x0, [0.0, 1.0], atol=1e-9)), orbit.is_stable
     (True, True)
     """
-    opts = solver_settings('periodic_orbit', rtol, atol, method, max_events)
+    opts = newton_solver_settings('periodic_orbit', tol, rtol, atol, method, max_events)
     hp, period, x0, mode0, u0, params = _prepare(plant, period, x0, mode0, u0, params, jacobian)
     tol, max_iter, max_periods, warmup, npoints = _shooting_options(
         tol, max_iter, max_periods, warmup, npoints)
@@ -407,7 +415,8 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
         if found is not None:
             fl, x, res, iterations = found
             # the multipliers from the product form of the period map
-            fl = shooter.flow(x, mode, True, factored=True)
+            if not fl.factored:
+                fl = shooter.flow(x, mode, True, factored=True)
             return _finish(hp, period, fl, x, mode, npoints, params, u0, res, iterations,
                            periods)
         if periods >= warmup + max_periods:
@@ -468,10 +477,15 @@ class _PeriodShooter:
     def newton(self, x, mode, tol, max_iter, where, tried):
         """Newton on ``P(x) − x = 0``: (flow, x, residual, iterations) or None."""
         names, n = self.hp.mode_names, self.hp.nstates
-        last, stalled = np.inf, 0
+        last, stalled, tight, start = np.inf, 0, False, x
         for it in range(max_iter + 1):
+            # inexact Newton: loose integration while the residual is large,
+            # the requested accuracy once it is small or a loose step misled
+            options = self.opts if tight else inexact_options(self.opts, last)
+            exact = options['rtol'] == self.opts['rtol']
             try:
-                fl = self.flow(x, mode, True)
+                # at full accuracy in product form: the multipliers of the last one
+                fl = self.flow(x, mode, True, options, factored=exact)
             except IntegrationError as err:
                 tried.append(f"{where}: {err}")
                 return None
@@ -480,12 +494,17 @@ class _PeriodShooter:
                              f"not {names[mode]!r}")
                 return None
             res = _relres(x, fl.x_final)
-            if res <= tol:
+            if res <= tol and exact:
                 return fl, x, res, it
+            if not exact and res > 0.9 * last:
+                # no progress with loose integration: restart at full accuracy
+                tight, x, last, stalled = True, start, np.inf, 0
+                continue
             stalled = stalled + 1 if res > 0.9 * last else 0
             if res > 1e3 * last or stalled >= 3 or it == max_iter:
                 tried.append(f"{where}: residual {res:.3g} after {it} iterations"
-                             + (" (no progress)" if stalled >= 3 else ""))
+                             + (" (no progress)" if stalled >= 3 else "")
+                             + _floor_hint(res, self.opts['rtol']))
                 return None
             last = res
             # (∂P/∂x − I) δ = −(P(x) − x); least squares handles neutral
@@ -496,11 +515,22 @@ class _PeriodShooter:
                              "(all multipliers 1)")
                 return None
             if np.max(np.abs(step)) > 10 * (1 + np.max(np.abs(x))):
+                if not exact:
+                    tight, x, last, stalled = True, start, np.inf, 0
+                    continue
                 tried.append(f"{where}: step of size {np.max(np.abs(step)):.3g} rejected "
                              "(divergence)")
                 return None
             x = x + step
         return None  # pragma: no cover - the loop always returns
+
+
+def _floor_hint(res, rtol):
+    """Hint when a stalled residual is at the integration error's level."""
+    if res <= 1e4 * rtol:
+        return (f" (at the level of the integration tolerance rtol={rtol:g}: lower rtol or "
+                "raise tol)")
+    return ""
 
 
 def _finish(hp, period, fl, x, mode, npoints, params, u0, res, iterations, periods):
