@@ -57,6 +57,7 @@ def main(argv=None):
     import p7_riccati
     import p8_analysis
     import p9_htf_memory
+    import p10_orbits
 
     if args.wall:
         _common.use_wall_clock()
@@ -65,6 +66,7 @@ def main(argv=None):
     suites['P7'] = p7_riccati
     suites['P8'] = p8_analysis
     suites['P9'] = p9_htf_memory
+    suites['P10'] = p10_orbits
     only = [s.strip().upper() for s in args.only.split(',')] if args.only else list(suites)
     unknown = set(only) - set(suites)
     if unknown:

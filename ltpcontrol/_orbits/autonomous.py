@@ -521,5 +521,5 @@ def _finish(prob, sec, fl, x, T, npoints, res, iterations, returns):
     # ∮ tr ∂f/∂x dt changes with it at the rate tr ∂f/∂x(x)
     trace = np.trace(prob.hp.state_jacobian(0.0, x, prob.u0, prob.params, mode=sec.mode))
     dT = res * (1 + np.max(np.abs(x))) / max(np.max(np.abs(f0)), 1e-300)
-    orbit.multiplier_error += abs(trace) * dT
+    orbit.multiplier_error = float(orbit.multiplier_error + abs(trace) * dT)
     return orbit
