@@ -23,8 +23,8 @@ from .._core.validation import check_positive_int, real_array
 
 __all__ = ['HybridMode', 'HybridPlant', 'simulate_hybrid', 'saltation_matrix']
 
-#: a transition factor restarts when a singular value leaves [1/c, c]
-_RESTART = 8.0
+#: a transition factor restarts when its condition number exceeds c (or its norm leaves [1e-2, c])
+_RESTART = 1e5
 # relative step of central differences: eps^(1/3) balances truncation and roundoff
 _FD_STEP = np.finfo(float).eps ** (1 / 3)
 
@@ -556,10 +556,10 @@ class Flow:
     so that `phi` is the Jacobian of the flow map ``x(t0) -> x(tf)``.  It is
     also kept in product form, `factors` (first to last): one transition
     matrix per mode interval and the saltation matrices.  With
-    ``factored=True`` ``Φ`` also restarts from the identity whenever one of
-    its singular values leaves ``[1/c, c]`` (``c = _RESTART``), so that every
-    factor is well conditioned and computed to the integration tolerance
-    relative to each of its singular values (multipliers of stiff orbits).
+    ``factored=True`` ``Φ`` also restarts from the identity whenever its
+    condition number exceeds ``c = _RESTART`` or its norm leaves ``[1e-2,
+    c]``, so that every factor is computed to about ``c rtol`` relative to
+    each of its singular values (multipliers of stiff orbits).
     """
 
     def __init__(self, plant, t0, tf, x0, mode, ufun, params, rtol, atol, method,
@@ -652,7 +652,7 @@ class Flow:
 
 
 #: absolute tolerance floor of the transition factors (entries of order 1)
-_PHI_ATOL = 1e-10
+_PHI_ATOL = 1e-12
 
 
 def _variational_atol(atol, n, size):
@@ -669,14 +669,20 @@ def _variational_atol(atol, n, size):
 
 
 def _restart_event(n):
-    """Terminal event: a singular value of the transition factor leaves [1/c, c]."""
+    """Terminal event: the transition factor becomes ill-conditioned or leaves scale.
+
+    Fires when ``σ_1/σ_n`` exceeds ``c = _RESTART`` or ``σ_1`` leaves
+    ``[1e-2, c]`` (the absolute tolerance then stays small relative to the
+    factor).  Rotations and oscillations of moderate stiffness do not fire it.
+    """
     limit = np.log(_RESTART)
 
     def restart(s, z):
         sv = np.linalg.svd(z[n:n + n * n].reshape(n, n), compute_uv=False)
         if not np.all(np.isfinite(sv)) or sv[-1] <= 0:
             return -limit
-        return limit - max(abs(np.log(sv[0])), abs(np.log(sv[-1])))
+        top = np.log(sv[0])
+        return min(limit - (top - np.log(sv[-1])), top - np.log(1e-2), limit - top)
     restart.terminal, restart.direction = True, -1
     return restart
 

@@ -5,7 +5,7 @@ The Jacobian of the period (or return) map of a hybrid orbit is the product
     Φ = Φ_{K-1} ... S_j ... Φ_1 Φ_0
 
 of transition matrices of short intervals (each restarted from the identity
-while its singular values stay within ``[1/c, c]``) and saltation matrices
+before its condition number exceeds ``c``) and saltation matrices
 of the events.  Its eigenvalues come from `product_eigenvalues` (QR sweeps
 over the factors), so a multiplier of 1e-38 next to the phase multiplier 1
 keeps its relative accuracy; formed as one matrix, it would be lost below
@@ -17,10 +17,12 @@ independently of the factors' eigen-structure,
     Σ_i log|μ_i| = ∮ tr ∂f/∂x dt + Σ_j log|det S_j|,
 
 with the trace integrated alongside the variational equations.  The
-mismatch between both sides, plus the estimated error of the QR sweeps,
-plus ``K c rtol`` (K factors, each accurate to about ``c rtol`` relative
-to its smallest singular value) is reported as the estimated relative
-error of every multiplier.
+mismatch between both sides (the integration error of the factors in
+volume), plus ``rtol |∮ tr ∂f/∂x dt|``, plus the estimated error of the QR
+sweeps is reported as the estimated relative error of every multiplier.
+Without the trace integral, the a-priori bound ``K c rtol`` (K factors,
+each accurate to about ``c rtol`` relative to its smallest singular value)
+replaces the first two terms.
 """
 
 from dataclasses import dataclass
@@ -31,6 +33,8 @@ from .._core.periodic_schur import product_eigenvalues
 
 __all__ = []
 
+#: singular values of a factor below this (relative) are zero
+_RANK_TOL = 1e-13
 #: multipliers this close to 1 are candidates for the phase multiplier
 _PHASE_NEAR = 1e-3
 
@@ -111,21 +115,28 @@ def product_multipliers(factors, *, rtol, restart, trace_integral=None, saltatio
     Factors whose product has the eigenvalues 1 and 1e-200:
 
     >>> from ltpcontrol._orbits.multipliers import product_multipliers
-    >>> F = [np.diag([1.0, 1e-100])] * 2
-    >>> m = product_multipliers(F, rtol=1e-12, restart=8.0)
+    >>> F = [np.diag([1.0, 1e-5])] * 40
+    >>> m = product_multipliers(F, rtol=1e-12, restart=1e5)
     >>> np.round(m.log_moduli / np.log(10), 12) + 0.0, m.values
     (array([   0., -200.]), array([1.e+000, 1.e-200]))
     """
     n = len(factors[0])
     if n == 0:
         return OrbitMultipliers(np.zeros(0), np.zeros(0), None, 0.0)
-    logmod, arg, qr_error = product_eigenvalues(factors, error=True)
+    # transition factors are well conditioned: a numerically singular factor
+    # is a saltation matrix that removes dimensions (exact zero multipliers)
+    logmod, arg, qr_error = product_eigenvalues(factors, error=True, rank_tol=_RANK_TOL)
     scale = 1 + np.abs(logmod[np.isfinite(logmod)]).max(initial=0.0)
-    error = qr_error * scale + len(factors) * restart * rtol
-    if trace_integral is not None:
+    error = qr_error * scale
+    if trace_integral is None:
+        # no Liouville check: the a-priori bound of the factors' errors
+        error += len(factors) * restart * rtol
+    else:
+        error += rtol * abs(trace_integral)
         # Liouville: Σ log|μ| = ∮ tr A dt + Σ log|det S|
-        volume = trace_integral + sum(np.log(abs(np.linalg.det(S))) for S in saltations)
-        if np.all(np.isfinite(logmod)) and np.isfinite(volume):
+        dets = np.array([abs(np.linalg.det(S)) for S in saltations])
+        if np.all(dets > 0) and np.all(np.isfinite(logmod)):
+            volume = trace_integral + np.sum(np.log(dets))
             error += abs(np.sum(logmod) - volume)
     phase = None
     if phase_direction is not None:

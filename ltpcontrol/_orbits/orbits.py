@@ -76,8 +76,8 @@ class PeriodicOrbit:
     multiplier_error : float
         Estimated relative error of every multiplier: the mismatch of
         Liouville's formula ``Σ log|μ_i| = ∮ tr ∂f/∂x dt + Σ log|det S_j|``
-        (trace integrated with the variational equations), plus the error
-        estimate of the QR sweeps, plus ``K · 8 · rtol`` for K factors;
+        (trace integrated with the variational equations), plus ``rtol``
+        times the trace integral, plus the error estimate of the QR sweeps;
         for an autonomous orbit also the effect of the period's
         uncertainty (residual over the speed ``|f(x0)|``) through
         ``tr ∂f/∂x(x0)``.  Errors of central-difference Jacobians (about
