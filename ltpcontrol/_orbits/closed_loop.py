@@ -36,8 +36,8 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 from tqdm.auto import tqdm
 
-from .hybrid import (Flow, input_function, IntegrationError, newton_solver_settings,
-                     solver_settings, _RESTART)
+from .hybrid import Flow, input_function, IntegrationError, solver_settings, _RESTART
+from .settings import newton_solver_settings
 from .kinks import one_sided_saltations, side_factor_lists
 from .multipliers import product_multipliers
 from .loop import FeedbackLoop, SampledLoop

@@ -19,8 +19,8 @@ from control import NonlinearIOSystem
 from control.exception import ControlArgument, ControlDimension
 
 from .hybrid import (HybridMode, HybridPlant, central_jacobian, constant_input,
-                      Flow, IntegrationError, plant_params, solver_settings,
-                      inexact_options, newton_solver_settings, _RESTART)
+                      Flow, IntegrationError, plant_params, solver_settings, _RESTART)
+from .settings import inexact_options, newton_solver_settings
 from .multipliers import product_multipliers
 from .tabulate import tabulate
 from .._core.ltpsys import ltpss
