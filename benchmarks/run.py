@@ -5,7 +5,7 @@ Usage::
     python benchmarks/run.py [--quick] [--json PATH] [--only P1,P3] [--wall]
                              [--blas-threads N]
 
-Runs the workloads P1-P10 (one module each, see their docstrings), prints a
+Runs the workloads P1-P11 (one module each, see their docstrings), prints a
 table and writes the results as JSON (default ``benchmarks/results.json``).
 Every workload checks the accuracy both sides reached against an
 independent reference; a speed ratio is only claimed when both reached the
@@ -58,6 +58,7 @@ def main(argv=None):
     import p8_analysis
     import p9_htf_memory
     import p10_grids
+    import p11_orbits
 
     if args.wall:
         _common.use_wall_clock()
@@ -67,6 +68,7 @@ def main(argv=None):
     suites['P8'] = p8_analysis
     suites['P9'] = p9_htf_memory
     suites['P10'] = p10_grids
+    suites['P11'] = p11_orbits
     only = [s.strip().upper() for s in args.only.split(',')] if args.only else list(suites)
     unknown = set(only) - set(suites)
     if unknown:

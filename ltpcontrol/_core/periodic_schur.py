@@ -33,7 +33,7 @@ from control.exception import ControlDimension
 __all__ = ['product_eigenvalues']
 
 
-def product_eigenvalues(factors, *, error=False):
+def product_eigenvalues(factors, *, error=False, rank_tol=None):
     """Eigenvalues of ``F_{K-1} ... F_1 F_0`` in log form, by periodic Schur.
 
     Parameters
@@ -44,6 +44,13 @@ def product_eigenvalues(factors, *, error=False):
         steps).  At least one factor.
     error : bool, optional
         Also return the estimated error (keyword only, default False).
+    rank_tol : float, optional
+        Singular values of a factor below ``rank_tol σ_max`` count as zero:
+        the product then has as many exact zero eigenvalues (``-inf``
+        log-moduli), which are not left as rounding noise.  Use it when
+        factors are well conditioned unless genuinely singular (a reset
+        that removes a dimension); by default (None) no factor is rank
+        reduced, and tiny singular values of graded factors are kept.
 
     Returns
     -------
@@ -110,7 +117,8 @@ def product_eigenvalues(factors, *, error=False):
     if not np.all(np.isfinite(H)):
         raise ValueError("factors must be finite")
     n = H.shape[1]
-    logmod, arg, err = (np.zeros(0), np.zeros(0), 0.0) if n == 0 else _product_qr(H)
+    zeros = 0 if rank_tol is None or n == 0 else _rank_deficiency(H, float(rank_tol))
+    logmod, arg, err = (np.zeros(0), np.zeros(0), 0.0) if n == 0 else _product_qr(H, zeros)
     return (logmod, arg, err) if error else (logmod, arg)
 
 
@@ -124,8 +132,21 @@ _MIN_SWEEPS, _MAX_SWEEPS, _FLOOR_SWEEPS = 3, 60, 3
 _WARN_ERROR = 1e-6
 
 
-def _product_qr(F):
-    """Block periodic Schur form by QR sweeps: sorted (log|μ|, arg μ, error)."""
+def _rank_deficiency(F, tol):
+    """Largest numerical rank deficiency of a factor (singular values <= tol σ_max).
+
+    The product then has at least that many zero eigenvalues.
+    """
+    sv = np.linalg.svd(F, compute_uv=False)
+    small = sv <= tol * sv[:, :1]
+    return int(np.max(np.count_nonzero(small, axis=1)))
+
+
+def _product_qr(F, zeros=0):
+    """Block periodic Schur form by QR sweeps: sorted (log|μ|, arg μ, error).
+
+    The `zeros` smallest eigenvalues are exact zeros (singular factors).
+    """
     n = F.shape[1]
     Q0, previous, changes = np.eye(n), None, []
     for sweep in range(_MAX_SWEEPS):
@@ -138,6 +159,9 @@ def _product_qr(F):
         with np.errstate(divide='ignore', invalid='ignore', over='ignore', under='ignore'):
             for a, b in blocks:
                 logmod[a:b], arg[a:b] = _block_eigenvalues(W[a:b, a:b], R[:, a:b, a:b])
+        if zeros:
+            smallest = np.lexsort((-arg, -logmod))[n - zeros:]
+            logmod[smallest], arg[smallest] = -np.inf, 0.0
         changes.append(_change(previous, blocks, logmod, arg))
         previous, Q0 = (blocks, logmod, arg), Q
         if sweep + 1 >= _MIN_SWEEPS and (changes[-1] <= _SETTLE_TOL or _at_floor(changes)):
@@ -223,4 +247,7 @@ def _block_eigenvalues(W, R):
     mu = np.linalg.eigvals(prod)
     arg = np.angle(mu)
     arg[(mu.imag == 0) & (mu.real < 0)] = np.pi
-    return np.log(np.abs(mu)) + logscale, arg
+    logmod = np.log(np.abs(mu)) + logscale
+    # a fixed order, so that successive sweeps compare
+    order = np.lexsort((-arg, -logmod))
+    return logmod[order], arg[order]

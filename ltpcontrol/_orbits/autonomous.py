@@ -27,7 +27,8 @@ from control.exception import ControlArgument, ControlDimension
 from scipy.optimize import brentq
 
 from .hybrid import central_jacobian, constant_input, Flow, plant_params, solver_settings
-from .orbits import PeriodicOrbit, as_hybrid, time_mismatch
+from .settings import inexact_options, newton_solver_settings
+from .orbits import PeriodicOrbit, as_hybrid, time_mismatch, _floor_hint
 from .._core.validation import check_period, check_positive, check_positive_int, real_array
 
 __all__ = ['limit_cycle', 'poincare_map']
@@ -85,12 +86,12 @@ class _Problem:
         self.hp, self.u0, self.params, self.opts = hp, u0, params, opts
         self.deadline = deadline
 
-    def flow(self, x, mode, duration, variational=False, options=None):
+    def flow(self, x, mode, duration, variational=False, options=None, factored=False):
         if self.deadline is not None and time.monotonic() > self.deadline:
             raise TimeoutError("the time limit (timeout) was reached")
         u0 = self.u0
         return Flow(self.hp, 0.0, duration, x, mode, lambda t: u0, self.params,
-                     variational=variational, **(options or self.opts))
+                     variational=variational, factored=factored, **(options or self.opts))
 
     def f(self, mode, x):
         return self.hp.dynamics(0.0, x, self.u0, self.params, mode=mode)
@@ -243,7 +244,7 @@ def _prepare(plant, x0, mode0, u0, params, jacobian):
 
 def limit_cycle(plant, period, x0, mode0=0, *, section=None, direction=1, u0=None,
                 params=None, jacobian=None, tol=1e-10, max_iter=20, max_periods=200,
-                timeout=None, npoints=200, rtol=1e-10, atol=1e-12, method='DOP853',
+                timeout=None, npoints=200, rtol=None, atol=None, method='DOP853',
                 max_events=10000):
     """Periodic orbit of an autonomous plant, with its period as an unknown.
 
@@ -298,7 +299,11 @@ def limit_cycle(plant, period, x0, mode0=0, *, section=None, direction=1, u0=Non
         Wall-clock limit in seconds (none by default).
     npoints : int, optional
         Number of grid points of the stored orbit (200).
-    rtol, atol, method, max_events : optional
+    rtol, atol : float, optional
+        `solve_ivp` tolerances; by default ``rtol = min(1e-10, tol/100)``
+        and ``atol = rtol/100``, so that the integration error of the
+        period map stays below the Newton tolerance.
+    method, max_events : optional
         Integration settings, as in `simulate_hybrid`.
 
     Returns
@@ -341,7 +346,7 @@ def limit_cycle(plant, period, x0, mode0=0, *, section=None, direction=1, u0=Non
     >>> bool(abs(orbit.phase_multiplier - 1) < 1e-8), bool(orbit.stability_multipliers[0] < 1e-3)
     (True, True)
     """
-    opts = solver_settings('limit_cycle', rtol, atol, method, max_events)
+    opts = newton_solver_settings('limit_cycle', tol, rtol, atol, method, max_events)
     hp, x0, mode0, u0, params = _prepare(plant, x0, mode0, u0, params, jacobian)
     if period is not None:
         period = check_period(period)
@@ -443,13 +448,18 @@ def _newton(prob, sec, x, T, tol, max_iter, npoints, returns, tried):
     """One Newton attempt on [φ_T(x) − x; s(x)] = 0; a PeriodicOrbit or None."""
     hp, n, mode = prob.hp, prob.hp.nstates, sec.mode
     where = f"Newton after {returns} returns"
-    last, stalled = np.inf, 0
+    last, stalled, tight, start = np.inf, 0, False, (x, T)
     for it in range(max_iter + 1):
         if not 0 < T < np.inf:
             tried.append(f"{where}: the period left (0, ∞)")
             return None
+        # inexact Newton: loose integration while the residual is large,
+        # the requested accuracy once it is small or a loose step misled
+        options = prob.opts if tight else inexact_options(prob.opts, last)
+        exact = options['rtol'] == prob.opts['rtol']
         try:
-            fl = prob.flow(x, mode, T, variational=True)
+            # at full accuracy in product form: the multipliers of the last one
+            fl = prob.flow(x, mode, T, variational=True, options=options, factored=exact)
         except RuntimeError as err:
             tried.append(f"{where}: {err}")
             return None
@@ -460,13 +470,18 @@ def _newton(prob, sec, x, T, tol, max_iter, npoints, returns, tried):
         scale = 1 + np.max(np.abs(x))
         gap, phase = fl.x_final - x, sec(x)
         res = max(np.max(np.abs(gap)), abs(phase)) / scale
-        if res <= tol:
+        if res <= tol and exact:
             _check_not_equilibrium(prob, mode, x, T, "Newton")
             return _finish(prob, sec, fl, x, T, npoints, res, it, returns)
+        if not exact and res > 0.9 * last:
+            # no progress with loose integration: restart at full accuracy
+            tight, (x, T), last, stalled = True, start, np.inf, 0
+            continue
         stalled = stalled + 1 if res > 0.9 * last else 0
         if res > 1e3 * last or stalled >= 3 or it == max_iter:
             tried.append(f"{where}: residual {res:.3g} after {it} iterations"
-                         + (" (no progress)" if stalled >= 3 else ""))
+                         + (" (no progress)" if stalled >= 3 else "")
+                         + _floor_hint(res, prob.opts['rtol']))
             return None
         last = res
         # bordered system [[Φ − I, f(φ_T(x))], [∇s, 0]] [δx; δT] = −[φ_T(x) − x; s(x)]
@@ -477,6 +492,9 @@ def _newton(prob, sec, x, T, tol, max_iter, npoints, returns, tried):
         # least squares handles further neutral directions (e.g. conserved energy)
         step = np.linalg.lstsq(jac, -np.append(gap, phase), rcond=None)[0]
         if np.max(np.abs(step[:n])) > 10 * scale:
+            if not exact:
+                tight, (x, T), last, stalled = True, start, np.inf, 0
+                continue
             tried.append(f"{where}: step of size {np.max(np.abs(step[:n])):.3g} "
                          "rejected (divergence)")
             return None
@@ -492,8 +510,16 @@ def _finish(prob, sec, fl, x, T, npoints, res, iterations, returns):
     if sec.direction * (grad @ f0) <= 0:
         raise RuntimeError("limit_cycle converged to an orbit that crosses the section in the "
                            "other direction; use direction=-1 or another section")
+    # the multipliers from the product form of the period map
+    if not fl.factored:
+        fl = prob.flow(x, sec.mode, T, variational=True, factored=True)
     orbit = PeriodicOrbit(prob.hp, float(T), fl, x, sec.mode, npoints, prob.params, prob.u0, res,
                           iterations, returns, phase_direction=f0)
     orbit.section = sec
     orbit.poincare_jacobian = fl.phi - np.outer(f0, grad @ fl.phi) / (grad @ f0)
+    # the period is known to about res (1 + |x|) / |f(x)|, and Σ log|μ| =
+    # ∮ tr ∂f/∂x dt changes with it at the rate tr ∂f/∂x(x)
+    trace = np.trace(prob.hp.state_jacobian(0.0, x, prob.u0, prob.params, mode=sec.mode))
+    dT = res * (1 + np.max(np.abs(x))) / max(np.max(np.abs(f0)), 1e-300)
+    orbit.multiplier_error = float(orbit.multiplier_error + abs(trace) * dT)
     return orbit

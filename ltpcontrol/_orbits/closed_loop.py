@@ -27,7 +27,7 @@ samples, with the Jacobian composed alike.
 
 import numbers
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import SimpleNamespace
 from typing import Optional
 
@@ -36,9 +36,12 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 from tqdm.auto import tqdm
 
-from .hybrid import Flow, input_function, IntegrationError, solver_settings
+from .hybrid import Flow, input_function, IntegrationError, solver_settings, _RESTART
+from .settings import newton_solver_settings
+from .kinks import one_sided_saltations, side_factor_lists
+from .multipliers import product_multipliers
 from .loop import FeedbackLoop, SampledLoop
-from .orbits import PeriodicOrbit, periodic_orbit
+from .orbits import PeriodicOrbit, flow_multipliers, periodic_orbit
 from .._core.validation import check_positive_int, real_array
 
 __all__ = ['ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit']
@@ -63,13 +66,17 @@ class ClosedLoopOrbit:
         Plant mode at t = 0.
     monodromy : ndarray, shape (n + n_c, n + n_c)
         Jacobian of the closed-loop period map at ``[x0, controller_state]``,
-        saltation matrices of the hybrid events included.
+        saltation matrices of the hybrid events included (for a kinked
+        map, the one-sided Jacobian with the largest spectral radius).
     multipliers : ndarray
-        Its eigenvalues, sorted by decreasing magnitude.
+        Its eigenvalues, sorted by decreasing magnitude.  For continuous
+        controllers they come from the product form of the period map
+        (accurate relative to their own size, see `PeriodicOrbit`).
     dominant_multiplier : float
-        Largest multiplier magnitude.
+        Largest multiplier magnitude (the worst side of a kinked map).
     is_stable : bool
-        True when all multipliers lie strictly inside the unit circle.
+        True when all multipliers lie strictly inside the unit circle (for
+        a kinked map: those of every one-sided Jacobian).
     orbit : PeriodicOrbit or None
         The orbit of the loop as a hybrid plant with states ``[x, x_c]``
         (continuous controllers), for plotting and evaluation; None for a
@@ -82,6 +89,20 @@ class ClosedLoopOrbit:
         period map at the starting point (see `closed_loop_orbit`).
     message : str
         Outcome of the orbit search.
+    one_sided_multipliers : tuple of ndarray
+        Empty when the period map is smooth at the orbit.  When a plant
+        event on the orbit coincides with a time discontinuity of the
+        loop's field (the controller acts on ``e = y − ȳ(t)`` and ``ȳ``
+        jumps at the orbit's events, or its gain switches there), the map
+        has a kink: a perturbed event before or after the nominal instant
+        gives different Jacobians.  Then this holds the multipliers of each
+        one-sided Jacobian (every combination of sides, early before late,
+        in the order of `kink_times`), and a warning is issued.  The
+        spectral radii of the sides bound the local behaviour only
+        loosely: a piecewise-linear map may be unstable with every side
+        stable; verify with `closed_loop_response`.
+    kink_times : ndarray
+        Times of the kinked events (empty for a smooth map).
 
     Examples
     --------
@@ -106,6 +127,8 @@ class ClosedLoopOrbit:
     residual: float
     converged: bool = True
     message: str = "the closed-loop orbit converged"
+    one_sided_multipliers: tuple = ()
+    kink_times: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __repr__(self):
         diverged = "" if self.converged else ", diverges"
@@ -121,12 +144,49 @@ def _multipliers(monodromy):
     return mult[np.argsort(-np.abs(mult), kind='stable')]
 
 
-def _result(period, z0, n, mode0, monodromy, orbit, residual, **outcome):
+def _result(period, z0, n, mode0, monodromy, orbit, residual, multipliers=None,
+            stable=None, **outcome):
     """`ClosedLoopOrbit` with the multipliers sorted by decreasing magnitude."""
-    mult = _multipliers(monodromy)
+    mult = _multipliers(monodromy) if multipliers is None else multipliers
     dominant = float(np.abs(mult[0]))
+    stable = bool(dominant < 1) if stable is None else stable
     return ClosedLoopOrbit(period, np.array(z0[:n]), np.array(z0[n:]), mode0, monodromy, mult,
-                           dominant, bool(dominant < 1), orbit, residual, **outcome)
+                           dominant, stable, orbit, residual, **outcome)
+
+
+def _loop_multipliers(loop, lp, flow):
+    """Multipliers of the continuous loop's period map from a variational `Flow`.
+
+    Returns the keywords of `_result`: multipliers and monodromy (the worst
+    side of a kinked map), stability and the one-sided multipliers.
+    """
+    breaks = [loop.orbit.switching_times]
+    if loop.linear:
+        breaks += [M.breakpoints for M in (loop.ctrl.A, loop.ctrl.B, loop.ctrl.C, loop.ctrl.D)]
+    kinks = one_sided_saltations(lp, flow, np.concatenate(breaks), loop.T, np.zeros(loop.p))
+    if not all(np.all(np.isfinite(F)) for F in flow.factors):
+        return dict(monodromy=flow.phi)
+    if not kinks:
+        return dict(monodromy=flow.phi, multipliers=flow_multipliers(flow).values)
+    sides = side_factor_lists(flow.factors, kinks)
+    mults = [product_multipliers(fac, rtol=flow.rtol, restart=_RESTART).values
+             for _, fac in sides]
+    radii = [float(np.abs(m[0])) for m in mults]
+    worst = int(np.argmax(radii))
+    times = np.array([k[3] for k in kinks])
+    summary = ", ".join(f"{'/'.join(sd)}: {r:.4g}" for (sd, _), r in zip(sides, radii))
+    warnings.warn(f"closed_loop_orbit: the period map has a kink (events at t = "
+                  f"{np.array2string(times, precision=6)} coincide with jumps of the loop's "
+                  f"field in t, e.g. of the reference ȳ(t)): its one-sided Jacobians differ, "
+                  f"spectral radii {summary}; the worst is reported.  Stability of a kinked "
+                  "map is not decided by these radii alone: verify with closed_loop_response",
+                  UserWarning, stacklevel=3)
+    monodromy = np.eye(len(flow.phi))
+    for F in sides[worst][1]:
+        monodromy = F @ monodromy
+    return dict(monodromy=monodromy, multipliers=mults[worst],
+                stable=bool(max(radii) < 1), one_sided_multipliers=tuple(mults),
+                kink_times=times)
 
 
 def _initial(loop, initial_state, controller_state, mode0, t0):
@@ -362,7 +422,7 @@ def _run_continuous(loop, opts, rec, z, mode, vfun, bar, bound):
 
 
 def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_state=None,
-                      tol=1e-10, max_iter=20, max_periods=20, rtol=1e-10, atol=1e-12,
+                      tol=1e-10, max_iter=20, max_periods=20, rtol=None, atol=None,
                       method='DOP853', max_events=10000):
     """Periodic orbit of the closed hybrid loop and its Floquet multipliers.
 
@@ -388,9 +448,12 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
         controllers); discrete
         controllers use `tol` and `max_iter` for Newton and fall back to
         `max_periods` periods of simulation.
-    rtol, atol, method, max_events : optional
-        Integration settings, as in `simulate_hybrid` (defaults 1e-10,
-        1e-12, 'DOP853', 10000).
+    rtol, atol : float, optional
+        `solve_ivp` tolerances; by default ``rtol = min(1e-10, tol/100)``
+        and ``atol = rtol/100`` (below the Newton tolerance).
+    method, max_events : optional
+        Integration settings, as in `simulate_hybrid` (defaults 'DOP853',
+        10000).
 
     Returns
     -------
@@ -431,7 +494,7 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
     >>> cl.is_stable, bool(np.isclose(cl.dominant_multiplier, np.exp(4 * np.pi)))
     (False, True)
     """
-    opts = solver_settings('closed_loop_orbit', rtol, atol, method, max_events)
+    opts = newton_solver_settings('closed_loop_orbit', tol, rtol, atol, method, max_events)
     loop = FeedbackLoop(plant, controller, orbit, saturation)
     z0, mode0 = _initial(loop, orbit.x0, 0.0 if controller_state is None else controller_state,
                          orbit.mode0, 0.0)
@@ -448,7 +511,8 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
         def search(iterations, periods):
             cl = periodic_orbit(lp, loop.T, z0, mode0, tol=tol, max_iter=iterations,
                                 max_periods=periods, **opts)
-            return _result(loop.T, cl.x0, loop.n, cl.mode0, cl.monodromy, cl, cl.residual)
+            return _result(loop.T, cl.x0, loop.n, cl.mode0, orbit=cl, residual=cl.residual,
+                           **_loop_multipliers(loop, lp, cl._flow))
     mult = _multipliers(start[2])
     if np.abs(mult[0]) < 1:
         return search(max_iter, max_periods)
@@ -467,8 +531,13 @@ def closed_loop_orbit(plant, controller, orbit, *, saturation=None, controller_s
                f"converges; the multipliers are those of the loop linearised there "
                f"(orbit search: {why})")
     warnings.warn(f"closed_loop_orbit: {message}", UserWarning, stacklevel=2)
-    return _result(loop.T, z0, loop.n, mode0, start[2], None, start[3], converged=False,
-                   message=message)
+    if loop.dt or start[5] is None:
+        return _result(loop.T, z0, loop.n, mode0, start[2], None, start[3], converged=False,
+                       message=message)
+    found = _loop_multipliers(loop, lp, start[5])
+    found['stable'] = False
+    return _result(loop.T, z0, loop.n, mode0, orbit=None, residual=start[3], converged=False,
+                   message=message, **found)
 
 
 #: Newton iterations from a starting point where the loop is unstable.
@@ -476,23 +545,25 @@ _UNSTABLE_NEWTON = 5
 
 
 def _flow_map(lp, loop, z0, mode0, opts):
-    """Period map, final mode and Jacobian of the continuous loop from ``z0``."""
+    """Period map, final mode, Jacobian and flow of the continuous loop from ``z0``."""
     flow = Flow(lp, 0.0, loop.T, z0, mode0, lambda t: np.zeros(loop.p), loop.params,
                 variational=True, **opts)
-    return flow.x_final, flow.mode_final, flow.phi
+    return flow.x_final, flow.mode_final, flow.phi, flow
 
 
 def _at_start(period_map, z0):
-    """``(z_T, mode_T, Jacobian, residual, failure)`` of the period map at the start.
+    """``(z_T, mode_T, Jacobian, residual, failure, flow)`` of the period map at the start.
 
     A loop that cannot be integrated over one period gets an infinite
-    Jacobian and the integrator's message.
+    Jacobian and the integrator's message; `flow` is None unless the
+    period map gives it (continuous loops).
     """
     try:
-        zT, modeT, J = period_map()
+        zT, modeT, J, *flow = period_map()
     except IntegrationError as err:
-        return None, None, np.full((len(z0), len(z0)), np.inf), np.inf, str(err)
-    return zT, modeT, J, float(np.max(np.abs(zT - z0)) / (1 + np.max(np.abs(z0)))), ''
+        return None, None, np.full((len(z0), len(z0)), np.inf), np.inf, str(err), None
+    return (zT, modeT, J, float(np.max(np.abs(zT - z0)) / (1 + np.max(np.abs(z0)))), '',
+            flow[0] if flow else None)
 
 
 def _sampled_orbit(sampled, z, mode, tol, max_iter, max_periods, first=None):
@@ -508,7 +579,7 @@ def _sampled_orbit(sampled, z, mode, tol, max_iter, max_periods, first=None):
     while True:
         for _ in range(max_iter + 1):
             if first is not None:
-                (zT, modeT, J, _, why), first = first, None
+                (zT, modeT, J, _, why, _), first = first, None
                 if zT is None:
                     break
             else:

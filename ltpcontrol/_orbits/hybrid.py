@@ -20,9 +20,12 @@ from control.exception import ControlArgument, ControlDimension
 from scipy.integrate import solve_ivp
 
 from .._core.validation import check_positive_int, real_array
+from .settings import solver_settings
 
 __all__ = ['HybridMode', 'HybridPlant', 'simulate_hybrid', 'saltation_matrix']
 
+#: a transition factor restarts when its condition number exceeds c (or its norm leaves [1e-2, c])
+_RESTART = 1e5
 # relative step of central differences: eps^(1/3) balances truncation and roundoff
 _FD_STEP = np.finfo(float).eps ** (1 / 3)
 
@@ -551,28 +554,38 @@ class Flow:
 
     With ``variational=True`` the state transition matrix is propagated
     alongside: ``dΦ/dt = ∂f/∂x Φ`` in each mode and ``Φ⁺ = S Φ⁻`` at events,
-    so that `phi` is the Jacobian of the flow map ``x(t0) -> x(tf)``.
+    so that `phi` is the Jacobian of the flow map ``x(t0) -> x(tf)``.  It is
+    also kept in product form, `factors` (first to last): one transition
+    matrix per mode interval and the saltation matrices.  With
+    ``factored=True`` ``Φ`` also restarts from the identity whenever its
+    condition number exceeds ``c = _RESTART`` or its norm leaves ``[1e-2,
+    c]``, so that every factor is computed to about ``c rtol`` relative to
+    each of its singular values (multipliers of stiff orbits).
     """
 
     def __init__(self, plant, t0, tf, x0, mode, ufun, params, rtol, atol, method,
-                 max_events, variational=False):
+                 max_events, variational=False, factored=False):
         n = plant.nstates
         self.segments, self.events, self.saltations = [], [], []
+        self.factors, self.trace_integral = [], 0.0
         t, x, i = t0, np.array(x0, float), mode
         phi = np.eye(n)
         while True:
             if not (np.all(np.isfinite(x)) and np.all(np.isfinite(phi))):
                 raise IntegrationError(f"the state is no longer finite at t={t:.6g} "
                                        f"(mode {plant.mode_names[i]!r}): the trajectory diverges")
-            rhs, z0 = self._system(plant, i, ufun, params, x, phi, variational)
-            events = None
+            rhs, z0 = self._system(plant, i, ufun, params, x, variational, factored)
+            events = []
             if plant.modes[i].guard is not None:
                 def event(s, z, i=i):
                     return plant.guard(s, z[:n], ufun(s), params, mode=i)
                 event.terminal, event.direction = True, -1
-                events = [event]
-            sol = solve_ivp(rhs, (t, tf), z0, method=method, rtol=rtol, atol=atol,
-                            events=events, dense_output=True)
+                events.append(event)
+            if variational and factored:
+                events.append(_restart_event(n))
+            sol = solve_ivp(rhs, (t, tf), z0, method=method, rtol=rtol,
+                            atol=_variational_atol(atol, n, len(z0)) if variational else atol,
+                            events=events or None, dense_output=True)
             if sol.status == -1:
                 raise IntegrationError(f"integration failed in mode {plant.mode_names[i]!r} "
                                        f"at t={sol.t[-1]:.6g}: {sol.message}")
@@ -580,15 +593,25 @@ class Flow:
             self.segments.append((t, t_end, i, sol.sol))
             x = z_end[:n]
             if variational:
-                phi = z_end[n:].reshape(n, n)
+                # one more factor: the transition matrix over [t, t_end]
+                self.factors.append(z_end[n:n + n * n].reshape(n, n))
+                phi = self.factors[-1] @ phi
+                if factored:
+                    self.trace_integral += z_end[-1]
             if sol.status != 1 or t_end >= tf:
                 break
+            guard_hit = plant.modes[i].guard is not None and sol.t_events[0].size > 0
+            if not guard_hit:
+                # restart of the transition matrix: same mode, same state
+                t = t_end
+                continue
             # transition: x⁺ = r(t, x⁻), Φ⁺ = S Φ⁻
             u = ufun(t_end)
             j = plant.mode_targets[i]
             if variational:
                 S = _saltation(plant, i, t_end, x, u, params, ufun)
                 self.saltations.append(S)
+                self.factors.append(S)
                 phi = S @ phi
             x_plus = plant.reset(t_end, x, u, params, mode=i)
             self.events.append((t_end, i, j, x.copy(), x_plus.copy()))
@@ -597,10 +620,10 @@ class Flow:
                 raise IntegrationError(f"more than max_events={max_events} events before "
                                        f"t={t:.6g} (Zeno or chattering behaviour?)")
         self.x_final, self.mode_final, self.phi = x, i, phi
-        self.nstates = n
+        self.nstates, self.rtol, self.factored = n, rtol, bool(variational and factored)
 
     @staticmethod
-    def _system(plant, i, ufun, params, x, phi, variational):
+    def _system(plant, i, ufun, params, x, variational, factored):
         n = plant.nstates
         if not variational:
             return (lambda s, z: plant.dynamics(s, z, ufun(s), params, mode=i)), x
@@ -608,9 +631,11 @@ class Flow:
         def rhs(s, z):
             u = ufun(s)
             A = plant.state_jacobian(s, z[:n], u, params, mode=i)
-            return np.concatenate([plant.dynamics(s, z[:n], u, params, mode=i),
-                                   (A @ z[n:].reshape(n, n)).ravel()])
-        return rhs, np.concatenate([x, phi.ravel()])
+            parts = [plant.dynamics(s, z[:n], u, params, mode=i),
+                     (A @ z[n:n + n * n].reshape(n, n)).ravel()]
+            # factored flows also integrate tr A (Liouville: d log det Φ/dt = tr A)
+            return np.concatenate(parts + [[np.trace(A)]] if factored else parts)
+        return rhs, np.concatenate([x, np.eye(n).ravel()] + ([[0.0]] if factored else []))
 
     def evaluate(self, t):
         """States and modes at sorted times ``t`` (right-continuous at events)."""
@@ -627,27 +652,40 @@ class Flow:
         return states, modes
 
 
-def solver_settings(where, rtol=1e-10, atol=1e-12, method='DOP853', max_events=10000):
-    """Checked `solve_ivp` settings of the hybrid integrator (`Flow`).
+#: absolute tolerance floor of the transition factors (entries of order 1)
+_PHI_ATOL = 1e-12
 
-    Examples
-    --------
-    >>> from ltpcontrol._orbits.hybrid import solver_settings
-    >>> solver_settings('simulate_hybrid')
-    {'rtol': 1e-10, 'atol': 1e-12, 'method': 'DOP853', 'max_events': 10000}
-    >>> solver_settings('simulate_hybrid', rtol=0)
-    Traceback (most recent call last):
-    ...
-    ValueError: simulate_hybrid: rtol must be a positive number, got 0
+
+def _variational_atol(atol, n, size):
+    """Absolute tolerances: `atol` for the state, at least `_PHI_ATOL` for the rest.
+
+    The transition factors are driven by ``∂f/∂x``, which central
+    differences give to about 1e-10 only; asking more of them makes the
+    step-size control chase that noise.  Restarted factors have entries of
+    order 1, so this is a relative accuracy of about 1e-10 per factor.
     """
-    for value, label in [(rtol, 'rtol'), (atol, 'atol')]:
-        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) \
-                or not value > 0:
-            raise ValueError(f"{where}: {label} must be a positive number, got {value!r}")
-    if not isinstance(method, str):
-        raise ControlArgument(f"{where}: method must be a solve_ivp method name, got {method!r}")
-    return dict(rtol=float(rtol), atol=float(atol), method=method,
-                max_events=check_positive_int(max_events, 'max_events'))
+    out = np.full(size, max(atol, _PHI_ATOL))
+    out[:n] = atol
+    return out
+
+
+def _restart_event(n):
+    """Terminal event: the transition factor becomes ill-conditioned or leaves scale.
+
+    Fires when ``σ_1/σ_n`` exceeds ``c = _RESTART`` or ``σ_1`` leaves
+    ``[1e-2, c]`` (the absolute tolerance then stays small relative to the
+    factor).  Rotations and oscillations of moderate stiffness do not fire it.
+    """
+    limit = np.log(_RESTART)
+
+    def restart(s, z):
+        sv = np.linalg.svd(z[n:n + n * n].reshape(n, n), compute_uv=False)
+        if not np.all(np.isfinite(sv)) or sv[-1] <= 0:
+            return -limit
+        top = np.log(sv[0])
+        return min(limit - (top - np.log(sv[-1])), top - np.log(1e-2), limit - top)
+    restart.terminal, restart.direction = True, -1
+    return restart
 
 
 def simulate_hybrid(plant, timepts, initial_state, mode0=0, inputs=0.0, params=None, *,

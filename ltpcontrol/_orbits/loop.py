@@ -13,6 +13,8 @@ input appended to the state (``u̇ = 0``) between them; its period map is the
 composition of both, with the Jacobian composed alike.
 """
 
+import bisect
+
 import numpy as np
 import control as ct
 from control.exception import ControlArgument, ControlDimension
@@ -20,6 +22,7 @@ from control.exception import ControlArgument, ControlDimension
 from .hybrid import Flow, HybridMode, HybridPlant, central_jacobian
 from .._core.ltpsys import LTPStateSpace
 from .orbits import as_hybrid, check_orbit_of
+from .tabulate import tabulate
 from .._core.validation import steps_per_period
 
 __all__ = []
@@ -46,7 +49,8 @@ class FeedbackLoop:
         if self.linear:
             mats = (self.ctrl.A, self.ctrl.B, self.ctrl.C, self.ctrl.D)
             self._fixed = [M(0.0) if M.is_constant else None for M in mats]
-            self._varying = [M for M in mats]
+            self._varying = _FastMatrices(mats) if not self.ctrl.dt \
+                and any(F is None for F in self._fixed) else None
             self._last = (None, None)
         self._ybar = _output_interpolant(plant, orbit)
         self._check_algebraic_loop()
@@ -70,8 +74,12 @@ class FeedbackLoop:
         are costly to evaluate.
         """
         if t != self._last[0]:
-            self._last = (t, [F if F is not None else M._eval(np.array([t]))[0]
-                              for F, M in zip(self._fixed, self._varying)])
+            if self._varying is not None:
+                self._last = (t, self._varying(t))
+            else:
+                mats = (self.ctrl.A, self.ctrl.B, self.ctrl.C, self.ctrl.D)
+                self._last = (t, [F if F is not None else M._eval(np.array([t]))[0]
+                                  for F, M in zip(self._fixed, mats)])
         return self._last[1]
 
     def ctrl_rhs(self, t, xc, e):
@@ -145,6 +153,43 @@ class FeedbackLoop:
                            inputs=[f'v[{k}]' for k in range(loop.p)],
                            outputs=plant.output_labels + plant.input_labels,
                            params=params, name=f'{plant.name}+{ctrl.name}')
+
+
+class _FastMatrices:
+    """``[A_c(t), B_c(t), C_c(t), D_c(t)]`` of a continuous LTP controller, tabulated.
+
+    Closed-loop integrations evaluate the controller's matrices at every
+    right-hand side evaluation, one time at a time; a designed gain (a
+    Riccati solution times B(t)) costs far more than the integration
+    itself.  Between consecutive breakpoints of the matrices (switching
+    instants, interpolant knots) they are smooth, and `tabulate` samples
+    them once (vectorised) into verified Chebyshev interpolants (1e-9
+    relative accuracy; exact values where that cannot be verified).  The
+    matrices are right-continuous at the breakpoints, as `PeriodicMatrix`.
+    """
+
+    def __init__(self, mats):
+        self.period = mats[0].period
+        self.shapes = [M.shape for M in mats]
+        self.sizes = np.cumsum([0] + [int(np.prod(sh)) for sh in self.shapes])
+        breaks = np.unique(np.concatenate([[0.0]] + [M.breakpoints for M in mats]))
+        breaks = breaks[breaks < self.period * (1 - 1e-12)]
+        ends = np.append(breaks[1:], self.period)
+        total = (int(self.sizes[-1]),)
+
+        def stacked(t):
+            return np.concatenate([M._eval(np.atleast_1d(t)).reshape(len(np.atleast_1d(t)), -1)
+                                   for M in mats], axis=1)
+        self.starts = list(breaks)
+        self.pieces = [tabulate(stacked, a, b, total) for a, b in zip(breaks, ends)]
+
+    def __call__(self, t):
+        # right-continuous at the breakpoints, within rounding of t mod T
+        tau = t % self.period
+        k = max(bisect.bisect_right(self.starts, tau + 1e-12 * self.period) - 1, 0)
+        flat = self.pieces[k](np.array([tau])).reshape(-1)
+        return [flat[a:b].reshape(shape) for a, b, shape in
+                zip(self.sizes[:-1], self.sizes[1:], self.shapes)]
 
 
 def _output_interpolant(plant, orbit, tol=1e-11):

@@ -19,7 +19,10 @@ from control import NonlinearIOSystem
 from control.exception import ControlArgument, ControlDimension
 
 from .hybrid import (HybridMode, HybridPlant, central_jacobian, constant_input,
-                      Flow, IntegrationError, plant_params, solver_settings)
+                      Flow, IntegrationError, plant_params, solver_settings, _RESTART)
+from .settings import inexact_options, newton_solver_settings
+from .multipliers import product_multipliers
+from .tabulate import tabulate
 from .._core.ltpsys import ltpss
 from .._core.periodic_matrix import PeriodicMatrix
 from .._core.validation import check_period, check_positive_int, real_array
@@ -57,9 +60,29 @@ class PeriodicOrbit:
         Saltation matrix of each event.
     monodromy : ndarray, shape (n, n)
         Jacobian of the period map at ``x0``: the exact linearised return
-        map, including the saltation matrices of hybrid events.
+        map, including the saltation matrices of hybrid events, formed as
+        one matrix (its small eigenvalues are not accurate; see
+        `multipliers`).
     multipliers : ndarray
-        Eigenvalues of `monodromy` (Floquet multipliers).
+        Floquet multipliers (eigenvalues of the period map's Jacobian),
+        sorted by decreasing modulus.  They are computed from the product
+        form of the Jacobian — transition matrices of short intervals and
+        saltation matrices, combined by QR sweeps — so that each one is
+        accurate relative to its own size (a multiplier of 1e-38 of a stiff
+        orbit included); moduli below 1e-308 underflow to 0 (see
+        `log_multipliers`).
+    log_multipliers : ndarray
+        ``log|μ|`` of `multipliers`, finite far below the float range.
+    multiplier_error : float
+        Estimated relative error of every multiplier: the mismatch of
+        Liouville's formula ``Σ log|μ_i| = ∮ tr ∂f/∂x dt + Σ log|det S_j|``
+        (trace integrated with the variational equations), plus ``rtol``
+        times the trace integral, plus the error estimate of the QR sweeps;
+        for an autonomous orbit also the effect of the period's
+        uncertainty (residual over the speed ``|f(x0)|``) through
+        ``tr ∂f/∂x(x0)``.  Errors of central-difference Jacobians (about
+        1e-10 relative) and, for forced orbits, of the orbit's location
+        (the residual `tol`) are not included.
     is_stable : bool
         True when all `stability_multipliers` lie strictly inside the unit
         circle.
@@ -119,15 +142,15 @@ class PeriodicOrbit:
         self.mode_sequence = [mode0] + [e[2] for e in flow.events]
         self.saltation_matrices = list(flow.saltations)
         self.monodromy = flow.phi
-        self.multipliers = np.linalg.eigvals(self.monodromy)
+        mult = flow_multipliers(flow, phase_direction)
+        self.multipliers, self.log_multipliers = mult.values, mult.log_moduli
+        self.multiplier_error = mult.error
         self.autonomous = phase_direction is not None
-        self.phase_multiplier, self.stability_multipliers = None, self.multipliers
+        self.phase_multiplier, self.stability_multipliers = None, mult.stability
         self.section = self.poincare_jacobian = None
         if self.autonomous:
-            k = _phase_index(self.monodromy, self.multipliers, phase_direction)
-            self.phase_multiplier = float(self.multipliers[k].real)
-            self.stability_multipliers = np.delete(self.multipliers, k)
-        self.is_stable = bool(np.all(np.abs(self.stability_multipliers) < 1))
+            self.phase_multiplier = float(np.real(mult.values[mult.phase]))
+        self.is_stable = bool(np.all(mult.stability_log_moduli < 0))
         self.residual, self.iterations, self.periods_simulated = residual, iterations, periods
 
     def __call__(self, t):
@@ -142,20 +165,12 @@ class PeriodicOrbit:
                 f"|multipliers|=[{mags}], stable={self.is_stable}>")
 
 
-def _phase_index(monodromy, multipliers, direction):
-    """Index of the multiplier whose eigenvector is the flow direction.
-
-    ``Φ f(x̄(0)) = f(x̄(0))``: among the multipliers near 1 take the one whose
-    eigenvector is best aligned with the vector field (several multipliers
-    equal 1 when the plant conserves a quantity, e.g. energy).
-    """
-    near = np.flatnonzero(np.abs(multipliers - 1) < 1e-3)
-    if near.size <= 1:
-        return int(np.argmin(np.abs(multipliers - 1)))
-    _, vecs = np.linalg.eig(monodromy)
-    unit = direction / np.linalg.norm(direction)
-    align = np.abs(vecs[:, near].conj().T @ unit) / np.linalg.norm(vecs[:, near], axis=0)
-    return int(near[np.argmax(align)])
+def flow_multipliers(flow, phase_direction=None):
+    """`OrbitMultipliers` of a variational `Flow` over one period (product form)."""
+    return product_multipliers(
+        flow.factors or [flow.phi], rtol=flow.rtol, restart=_RESTART,
+        trace_integral=flow.trace_integral if flow.factored else None,
+        saltations=flow.saltations, phase_direction=phase_direction, monodromy=flow.phi)
 
 
 def as_hybrid(plant, jacobian):
@@ -302,7 +317,7 @@ def period_map(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=Fal
 
 def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian=None,
                    warmup=0, tol=1e-10, max_iter=20, max_periods=200, npoints=200,
-                   rtol=1e-10, atol=1e-12, method='DOP853', max_events=10000):
+                   rtol=None, atol=None, method='DOP853', max_events=10000):
     """T-periodic steady state (limit cycle) of a periodically forced plant.
 
     Solves ``P(x) = x`` for the period map ``P`` by Newton's method
@@ -347,7 +362,11 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
         (200).
     npoints : int, optional
         Number of grid points of the stored orbit (200).
-    rtol, atol, method, max_events : optional
+    rtol, atol : float, optional
+        `solve_ivp` tolerances; by default ``rtol = min(1e-10, tol/100)``
+        and ``atol = rtol/100``, so that the integration error of the
+        period map stays below the Newton tolerance.
+    method, max_events : optional
         Integration settings, as in `simulate_hybrid`.
 
     Returns
@@ -379,7 +398,7 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
     >>> bool(np.allclose(orbit.x0, [0.0, 1.0], atol=1e-9)), orbit.is_stable
     (True, True)
     """
-    opts = solver_settings('periodic_orbit', rtol, atol, method, max_events)
+    opts = newton_solver_settings('periodic_orbit', tol, rtol, atol, method, max_events)
     hp, period, x0, mode0, u0, params = _prepare(plant, period, x0, mode0, u0, params, jacobian)
     tol, max_iter, max_periods, warmup, npoints = _shooting_options(
         tol, max_iter, max_periods, warmup, npoints)
@@ -395,6 +414,9 @@ def periodic_orbit(plant, period, x0, mode0=0, *, u0=None, params=None, jacobian
         found = shooter.newton(x, mode, tol, max_iter, f"Newton from t={periods}T", tried)
         if found is not None:
             fl, x, res, iterations = found
+            # the multipliers from the product form of the period map
+            if not fl.factored:
+                fl = shooter.flow(x, mode, True, factored=True)
             return _finish(hp, period, fl, x, mode, npoints, params, u0, res, iterations,
                            periods)
         if periods >= warmup + max_periods:
@@ -438,10 +460,10 @@ class _PeriodShooter:
         # forward simulation only supplies starting guesses: moderate tolerances
         self.loose = dict(opts, rtol=max(opts['rtol'], 1e-8), atol=max(opts['atol'], 1e-10))
 
-    def flow(self, x, mode, variational, options=None):
+    def flow(self, x, mode, variational, options=None, factored=False):
         u0 = self.u0
         return Flow(self.hp, 0.0, self.period, x, mode, lambda t: u0, self.params,
-                     variational=variational, **(options or self.opts))
+                     variational=variational, factored=factored, **(options or self.opts))
 
     def simulate(self, x, mode, nper):
         """State, mode and last-period residual after `nper` simulated periods."""
@@ -455,10 +477,15 @@ class _PeriodShooter:
     def newton(self, x, mode, tol, max_iter, where, tried):
         """Newton on ``P(x) − x = 0``: (flow, x, residual, iterations) or None."""
         names, n = self.hp.mode_names, self.hp.nstates
-        last, stalled = np.inf, 0
+        last, stalled, tight, start = np.inf, 0, False, x
         for it in range(max_iter + 1):
+            # inexact Newton: loose integration while the residual is large,
+            # the requested accuracy once it is small or a loose step misled
+            options = self.opts if tight else inexact_options(self.opts, last)
+            exact = options['rtol'] == self.opts['rtol']
             try:
-                fl = self.flow(x, mode, True)
+                # at full accuracy in product form: the multipliers of the last one
+                fl = self.flow(x, mode, True, options, factored=exact)
             except IntegrationError as err:
                 tried.append(f"{where}: {err}")
                 return None
@@ -467,12 +494,17 @@ class _PeriodShooter:
                              f"not {names[mode]!r}")
                 return None
             res = _relres(x, fl.x_final)
-            if res <= tol:
+            if res <= tol and exact:
                 return fl, x, res, it
+            if not exact and res > 0.9 * last:
+                # no progress with loose integration: restart at full accuracy
+                tight, x, last, stalled = True, start, np.inf, 0
+                continue
             stalled = stalled + 1 if res > 0.9 * last else 0
             if res > 1e3 * last or stalled >= 3 or it == max_iter:
                 tried.append(f"{where}: residual {res:.3g} after {it} iterations"
-                             + (" (no progress)" if stalled >= 3 else ""))
+                             + (" (no progress)" if stalled >= 3 else "")
+                             + _floor_hint(res, self.opts['rtol']))
                 return None
             last = res
             # (∂P/∂x − I) δ = −(P(x) − x); least squares handles neutral
@@ -483,11 +515,22 @@ class _PeriodShooter:
                              "(all multipliers 1)")
                 return None
             if np.max(np.abs(step)) > 10 * (1 + np.max(np.abs(x))):
+                if not exact:
+                    tight, x, last, stalled = True, start, np.inf, 0
+                    continue
                 tried.append(f"{where}: step of size {np.max(np.abs(step)):.3g} rejected "
                              "(divergence)")
                 return None
             x = x + step
         return None  # pragma: no cover - the loop always returns
+
+
+def _floor_hint(res, rtol):
+    """Hint when a stalled residual is at the integration error's level."""
+    if res <= 1e4 * rtol:
+        return (f" (at the level of the integration tolerance rtol={rtol:g}: lower rtol or "
+                "raise tol)")
+    return ""
 
 
 def _finish(hp, period, fl, x, mode, npoints, params, u0, res, iterations, periods):
@@ -541,7 +584,12 @@ def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, na
 
     ``A(t) = ∂f/∂x``, ``B(t) = ∂f/∂u``, ``C(t) = ∂h/∂x``, ``D(t) = ∂h/∂u``
     evaluated on the orbit (thesis eqs. 3.2-3.4), analytic where the plant
-    provides Jacobians and by central differences otherwise.  For a hybrid
+    provides Jacobians and by central differences otherwise.  They are
+    sampled once along the orbit and evaluated from piecewise Chebyshev
+    interpolants verified to ``1e-9 (1 + max |M|)`` on every subinterval
+    (fast to evaluate in transition matrices, Riccati equations and closed
+    loops); where an interpolant cannot be verified, the exact values are
+    used.  For a hybrid
     orbit the mode switches are frozen at the orbit's switching times, giving
     the switching LTP model of eqs. (3.6)-(3.7); with
     ``piecewise_constant=True`` each mode's matrices are replaced by their
@@ -602,6 +650,8 @@ def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, na
     }
     times = np.concatenate([[0.0], orbit.switching_times])
     ends = np.append(times[1:], T)
+    shapes = {'A': (hp.nstates, hp.nstates), 'B': (hp.nstates, hp.ninputs),
+              'C': (hp.noutputs, hp.nstates), 'D': (hp.noutputs, hp.ninputs)}
     mats = {}
     for key, deriv in derivatives.items():
         func = _along_orbit(orbit, deriv)
@@ -612,10 +662,15 @@ def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, na
         elif piecewise_constant:
             mats[key] = PeriodicMatrix.switching(
                 [_segment_average(func, a, b) for a, b in zip(times, ends)], times, T)
-        elif len(times) == 1:
-            mats[key] = PeriodicMatrix.from_function(func, T)
         else:
-            mats[key] = PeriodicMatrix.switching([func] * len(times), times, T)
+            # sampled once along the orbit, evaluated from verified interpolants
+            tabs = [tabulate(func, a, b, shapes[key]) for a, b in zip(times, ends)]
+            if len(times) == 1:
+                tab = tabs[0]
+                mats[key] = PeriodicMatrix.from_function(
+                    lambda t, tab=tab: tab(np.mod(t, T)), T, shapes[key], check=False)
+            else:
+                mats[key] = PeriodicMatrix.switching(tabs, times, T)
     return ltpss(mats['A'], mats['B'], mats['C'], mats['D'], T,
                  name=name if name is not None else f'{hp.name}$lin',
                  inputs=hp.input_labels, outputs=hp.output_labels, states=hp.state_labels)
