@@ -45,6 +45,11 @@ from ._rotors.read_lin import read_lin
 from ._rotors.campbell import campbell, CampbellDiagram
 from ._analysis.zeros import zeros
 from ._frequency.harmonic_ss import harmonic_ss
+from ._frequency.nyquist import nyquist_htf, HarmonicNyquistResponse
+from ._frequency.margins import harmonic_margins, stability_margins, HarmonicMargins, MarginPoint
+from ._frequency.loop_functions import (sensitivity_htf, complementary_sensitivity_htf,
+                                        siso_equivalent, harmonic_admittance,
+                                        harmonic_impedance)
 from ._analysis.riccati import care, dare
 from ._analysis.design import lqr, dlqr, lqe, dlqe, lqg
 from ._analysis.place import place
@@ -71,6 +76,10 @@ __all__ = [
     'floquet_transform',
     # frequency domain
     'HTF', 'HTFModel', 'HTFData', 'htf', 'htf_response', 'bode_htf', 'htf_map_plot',
+    # harmonic stability of periodic loops
+    'nyquist_htf', 'HarmonicNyquistResponse', 'harmonic_margins', 'stability_margins',
+    'HarmonicMargins', 'MarginPoint', 'sensitivity_htf', 'complementary_sensitivity_htf',
+    'siso_equivalent', 'harmonic_admittance', 'harmonic_impedance',
     'sample_system', 'c2d', 'd2c', 'lift',
     # rhythmic plants and their orbits
     'HybridMode', 'HybridPlant', 'simulate_hybrid', 'saltation_matrix',
