@@ -13,6 +13,8 @@ from ._core.periodic_matrix import PeriodicMatrix
 from ._core.ltpsys import LTPStateSpace, ltpss, series, parallel, feedback, append, negate
 from ._core.interconnect import interconnect
 from ._core.timeresp import forced_response, step_response, initial_response, impulse_response
+from ._core.frames import (clarke_matrix, park_matrix, frame_transform, park, clarke,
+                           sequence_components)
 from ._core.floquet import (monodromy, floquet_multipliers, floquet_exponents, is_stable,
                        floquet_transform)
 from ._frequency.htf import HTF, HTFModel, HTFData, htf
@@ -76,6 +78,9 @@ __all__ = [
     'floquet_transform',
     # frequency domain
     'HTF', 'HTFModel', 'HTFData', 'htf', 'htf_response', 'bode_htf', 'htf_map_plot',
+    # three-phase frames
+    'clarke_matrix', 'park_matrix', 'frame_transform', 'park', 'clarke',
+    'sequence_components',
     # harmonic stability of periodic loops
     'nyquist_htf', 'HarmonicNyquistResponse', 'harmonic_margins', 'stability_margins',
     'HarmonicMargins', 'MarginPoint', 'sensitivity_htf', 'complementary_sensitivity_htf',
