@@ -55,6 +55,7 @@ from ._frequency.loop_functions import (sensitivity_htf, complementary_sensitivi
 from ._analysis.riccati import care, dare
 from ._analysis.design import lqr, dlqr, lqe, dlqe, lqg
 from ._analysis.place import place
+from ._analysis.hhc import hhc_tmatrix, hhc_controller
 from ._analysis.lmi import lmi_statefbk, LMIDesign
 from ._analysis.reduction import hsvd, balred, minreal
 from ._identification.refine import refine_ltp, RefineInfo
@@ -85,6 +86,7 @@ __all__ = [
     'nyquist_htf', 'HarmonicNyquistResponse', 'harmonic_margins', 'stability_margins',
     'HarmonicMargins', 'MarginPoint', 'sensitivity_htf', 'complementary_sensitivity_htf',
     'siso_equivalent', 'harmonic_admittance', 'harmonic_impedance',
+    'hhc_tmatrix', 'hhc_controller',
     'sample_system', 'c2d', 'd2c', 'lift',
     # rhythmic plants and their orbits
     'HybridMode', 'HybridPlant', 'simulate_hybrid', 'saltation_matrix',
