@@ -203,3 +203,46 @@ def test_plot_is_a_controlplot():
     assert isinstance(resp.plot('det'), ct.ControlPlot)
     with pytest.raises(ValueError, match="kind"):
         resp.plot('bode')
+
+
+def _pll_loop(f_bw):
+    """Single-phase PLL linearized about its periodic steady state: the phase
+    detector gain (V/2)(1 + cos 2ω_g t) ripples at twice the grid frequency;
+    second-order low-pass filter and PI (two integrators on the axis)."""
+    V, wg = 1.0, 2 * np.pi * 50
+    bw = 2 * np.pi * f_bw
+    kp, ki, a = bw / (V / 2), bw ** 2 / (2 * V), 3 * bw
+    A = np.array([[-a, 0, 0, 0], [a, -a, 0, 0], [0, 1, 0, 0], [0, kp, ki, 0]])
+    b = np.array([a, 0, 0, 0])
+
+    def g(t):
+        return V / 2 * (1 + np.cos(2 * wg * t))
+    Tp = np.pi / wg
+    # g has the exact Fourier series V/4, V/2, V/4 at harmonics -1, 0, 1 of ω_p = 2ω_g
+    C = ltp.PeriodicMatrix(np.array([[[0, 0, 0, V / 4]], [[0, 0, 0, V / 2]],
+                                     [[0, 0, 0, V / 4]]]), Tp)
+    L = ltp.ltpss(A, b[:, None], C, 0, period=Tp, name='pll')
+
+    def radius(k):
+        def rhs(t, x):
+            X = x.reshape(4, 4)
+            return ((A - k * np.outer(b, [0, 0, 0, g(t)])) @ X).ravel()
+        sol = solve_ivp(rhs, (0, Tp), np.eye(4).ravel(), rtol=1e-11, atol=1e-13,
+                        method='DOP853')
+        return np.abs(np.linalg.eigvals(sol.y[:, -1].reshape(4, 4))).max()
+    return L, radius
+
+
+@pytest.mark.parametrize("f_bw, edge", [(30, True), (45, False)])
+def test_pll_gain_margin_equals_floquet_bisection(f_bw, edge):
+    # 30 Hz: crossing at the multiplier -1 (strip edge); 45 Hz: at the multiplier
+    # +1, where the open loop's integrators sit on the axis
+    L, radius = _pll_loop(f_bw)
+    m = ltp.harmonic_margins(L, 8)
+    g = m.gain_upper.value
+    k = bisect(radius, 0.99 * g, 1.01 * g, tol=2e-5 * g)
+    assert abs(m.gain_upper.value - k) < 1e-4 * k
+    assert (abs(abs(m.gain_upper.omega) - L.omega_p / 2) < 1e-6 * L.omega_p) == edge
+    resp = ltp.nyquist_htf(L, 8)
+    assert resp.stable and radius(1.0) < 1
+    assert not ltp.nyquist_htf(ltp.series(L, 1.01 * k), 8).stable

@@ -38,6 +38,8 @@ from scipy.optimize import brentq, minimize_scalar
 
 from .loop import LoopHTF, as_loop, open_loop_exponents
 from .nyquist import track
+from .._core.floquet import is_stable
+from .._core.ltpsys import feedback, series
 from .._core.validation import check_positive_int
 
 __all__ = ['harmonic_margins', 'stability_margins', 'HarmonicMargins', 'MarginPoint']
@@ -131,7 +133,7 @@ class HarmonicMargins:
 
 
 def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
-                     internal_harmonics=None, edge_tol=0.05):
+                     internal_harmonics=None, edge_tol=0.05, check=True):
     """Gain, phase, stability and disk margins of a periodic loop.
 
     Parameters
@@ -155,6 +157,11 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     edge_tol : float
         Warn when the outermost harmonic blocks of ``L̂_N`` reach this
         magnitude: crossings beyond the truncation may be missed.
+    check : bool
+        When the closed loop is stable, verify the gain margins by the
+        Floquet multipliers of the closed loops with the gains 0.1 % inside
+        (stable) and outside (unstable) them, and warn otherwise (a
+        crossing between grid points missed: raise `omega_num`).
 
     Returns
     -------
@@ -171,7 +178,7 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     -----
     UserWarning
         When the truncation edge of ``L̂_N`` is not small (increase
-        `nharmonics`).
+        `nharmonics`), or when the Floquet check of the gain margins fails.
 
     Examples
     --------
@@ -196,17 +203,22 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     w = np.linspace(-5 * wp / 8, 5 * wp / 8, num)
     poles = np.concatenate([axis_w + k * wp for k in (-1, 0, 1)]) if axis_w.size else axis_w
     if poles.size:
+        # the grid steps over each pole of L̂ closely (asymmetrically, so that no
+        # bisection lands on it): other branches may cross right there
         w = w[np.min(np.abs(w[:, None] - poles[None, :]), axis=1) > 1e-6 * wp]
-    # grid intervals that hold an open-loop exponent (a pole of L̂) are not searched
-    open_gap = np.array([np.any((poles > a) & (poles < b)) for a, b in zip(w[:-1], w[1:])])
+        near = np.concatenate([poles - 1e-7 * wp, poles + 1.37e-7 * wp])
+        w = np.sort(np.concatenate([w, near[np.abs(near) < 5 * wp / 8]]))
     Lh = loop(1j * w)
-    _check_edge(loop, Lh, edge_tol)
+    # near a pole on the axis every harmonic row is large: not a truncation effect
+    far = (np.min(np.abs(w[:, None] - poles[None, :]), axis=1) > wp / 20 if poles.size
+           else np.ones(len(w), bool))
+    _check_edge(loop, Lh[far], edge_tol)
     eig = _tracked(Lh)
 
     gains, phases = [], []
     for b in range(eig.shape[1]):
         lam = eig[:, b]
-        for i in np.nonzero((np.diff(np.sign(lam.imag)) != 0) & ~open_gap)[0]:
+        for i in np.nonzero(np.diff(np.sign(lam.imag)) != 0)[0]:
             if min(lam[i].real, lam[i + 1].real) < 0:
                 hit = _refine(loop, w[i], w[i + 1], lam[i], lam[i + 1], np.imag)
                 if hit and hit[1].real < 0 and abs(hit[1].imag) <= _REAL_RTOL * abs(hit[1]):
@@ -215,7 +227,7 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
                         gains.append(_point(loop, gm, hit))
         with np.errstate(divide='ignore'):
             logmag = np.log(np.abs(lam))
-        for i in np.nonzero((np.diff(np.sign(logmag)) != 0) & ~open_gap)[0]:
+        for i in np.nonzero(np.diff(np.sign(logmag)) != 0)[0]:
             hit = _refine(loop, w[i], w[i + 1], lam[i], lam[i + 1],
                           lambda z: np.log(np.abs(z)))
             if hit:
@@ -242,6 +254,8 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     alpha = 1 / peak.value
     disk = peak._replace(value=alpha)
     dgain, dphase = _disk_gain_phase(alpha, skew)
+    if check:
+        _verify(L, upper.value, lower.value)
     return HarmonicMargins(gain_upper=upper, gain_lower=lower, phase=phase,
                            stability=stability, disk=disk, disk_gain=dgain,
                            disk_phase=dphase, gain_crossings=gains,
@@ -317,7 +331,10 @@ def _refine(loop, w0, w1, ref0, ref1, fun):
     def nearest(w):
         t = (w - w0) / (w1 - w0)
         ref = ref0 + t * (ref1 - ref0)
-        lam, V = np.linalg.eig(loop(1j * w)[0])
+        try:
+            lam, V = np.linalg.eig(loop(1j * w)[0])
+        except ValueError:                   # on a pole of L̂: step off it
+            lam, V = np.linalg.eig(loop(1j * (w + 1e-9 * (w1 - w0)))[0])
         i = np.argmin(np.abs(lam - ref))
         return lam[i], V[:, i]
 
@@ -347,8 +364,8 @@ def _unique(points, wp):
     """One point per (frequency, value): the strip extension and mirrors repeat them."""
     out = []
     for p in sorted(points, key=lambda p: p.frequency):
-        if not any(abs(p.frequency - q.frequency) <= 1e-7 * wp
-                   and abs(p.value - q.value) <= 1e-7 * max(1.0, abs(q.value)) for q in out):
+        if not any(abs(p.frequency - q.frequency) <= 1e-5 * wp
+                   and abs(p.value - q.value) <= 1e-5 * max(1.0, abs(q.value)) for q in out):
             out.append(p)
     return out
 
@@ -383,6 +400,28 @@ def _disk_gain_phase(alpha, skew):
     else:
         phase = float(np.degrees(np.arccos(c))) if abs(c) < 1 else float('inf')
     return (float(gmin), float(gmax)), phase
+
+
+def _verify(L, upper, lower, delta=1e-3):
+    """Floquet check of the gain margins of a loop whose closed loop is stable."""
+    eye = np.eye(L.ninputs)
+
+    def stable(k):
+        return is_stable(feedback(series(L, k * eye), eye))
+    if not stable(1.0):
+        return
+    bad = []
+    if np.isfinite(upper):
+        bad += [k for k, want in ((upper * (1 - delta), True), (upper * (1 + delta), False))
+                if stable(k) != want]
+    if lower > 0:
+        bad += [k for k, want in ((lower * (1 + delta), True), (lower * (1 - delta), False))
+                if stable(k) != want]
+    if bad:
+        warnings.warn(f"harmonic_margins: the Floquet multipliers of the closed loop with "
+                      f"the gains {bad} contradict the gain margins ({lower:.6g}, "
+                      f"{upper:.6g}): a crossing was missed between grid points; increase "
+                      "omega_num", UserWarning, stacklevel=3)
 
 
 def _check_edge(loop, Lh, tol):

@@ -291,7 +291,7 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
                       f"{gap:.2g} > closure_tol={closure_tol:g} with nharmonics={loop.N}; "
                       "the count may be wrong: increase nharmonics", UserWarning,
                       stacklevel=2)
-    if dist < 1e-8 * max(1.0, np.abs(eig).max()):
+    if dist < 1e-8:
         warnings.warn("nyquist_htf: the contour passes through a closed-loop exponent "
                       f"(min singular value of I + L̂ = {dist:.1e}): the loop is at a "
                       "stability boundary and the count is not reliable", UserWarning,
