@@ -36,7 +36,7 @@ import warnings
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from .loop import LoopHTF, as_loop, open_loop_exponents
+from .loop import LoopHTF, as_loop, fold, open_loop_exponents
 from .nyquist import track
 from .._core.floquet import is_stable
 from .._core.ltpsys import feedback, series
@@ -230,7 +230,7 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
         for i in np.nonzero(np.diff(np.sign(logmag)) != 0)[0]:
             hit = _refine(loop, w[i], w[i + 1], lam[i], lam[i + 1],
                           lambda z: np.log(np.abs(z)))
-            if hit:
+            if hit and abs(abs(hit[1]) - 1) <= _REAL_RTOL:
                 pm = float(np.remainder(np.angle(hit[1], deg=True), 360.0) - 180.0)
                 phases.append(_point(loop, pm, hit, odd=True))
     gains, phases = _unique(gains, wp), _unique(phases, wp)
@@ -333,8 +333,9 @@ def _refine(loop, w0, w1, ref0, ref1, fun):
         ref = ref0 + t * (ref1 - ref0)
         try:
             lam, V = np.linalg.eig(loop(1j * w)[0])
-        except ValueError:                   # on a pole of L̂: step off it
-            lam, V = np.linalg.eig(loop(1j * (w + 1e-9 * (w1 - w0)))[0])
+        except ValueError:                   # on a pole of L̂: step off it, inwards
+            step = 1e-3 * (w1 - w0) * (1 if w < 0.5 * (w0 + w1) else -1)
+            lam, V = np.linalg.eig(loop(1j * (w + step))[0])
         i = np.argmin(np.abs(lam - ref))
         return lam[i], V[:, i]
 
@@ -353,10 +354,18 @@ def _point(loop, value, hit, odd=False):
     """The margin at a crossing; `odd` for a phase, which the mirror negates."""
     w, _, v = hit
     n = loop.dominant_harmonic(v)
-    f = w + n * loop.omega_p
+    wp = loop.omega_p
+    # the strip (-ω_p/2, ω_p/2]: a crossing seen in its extension is shifted back
+    k = int(np.round((w - fold(w, wp)) / wp))
+    if abs(w - k * wp + wp / 2) <= 1e-9 * wp:
+        k -= 1
+    w, n = w - k * wp, n + k
+    f = w + n * wp
     if f < 0:                  # the mirrored crossing (-ω, -n) of a real loop
         w, n, f = -w, -n, -f
         value = -value if odd else value
+    if abs(w + wp / 2) <= 1e-9 * wp:        # -ω_p/2 is the strip's edge ω_p/2
+        w, n = w + wp, n - 1
     return MarginPoint(float(value), float(w), int(n), float(f))
 
 

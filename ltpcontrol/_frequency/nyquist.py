@@ -183,7 +183,7 @@ class HarmonicNyquistResponse:
         span = max(1.5, 1.1 * np.abs(allz).max())
         ax.set_xlim(-span, span)
         ax.set_ylim(-span, span)
-        ax.set_aspect('equal', adjustable='datalim')
+        ax.set_aspect('equal', adjustable='box')
         what = "eigenloci of L̂" if kind == 'eigenloci' else "det(I + L̂)"
         ax.set_title(title or f"Nyquist plot ({what}, N={self.nharmonics}) of "
                      f"{self.sysname}: {self.encirclements} encirclement(s), "
