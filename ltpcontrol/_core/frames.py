@@ -177,8 +177,10 @@ def frame_transform(sys, states=None, inputs=None, outputs=None, *, name=None):
 
 
 def park(sys, omega, theta0=0.0, *, states=True, inputs=True, outputs=True, name=None):
-    """dq0 (Park) frame of a three-phase system: `frame_transform` with
-    ``T_dq0`` on every group of three signals.
+    """dq0 (Park) frame of a three-phase system.
+
+    `frame_transform` with ``T_dq0`` (`park_matrix`) on every group of three
+    signals (abc triples).
 
     Parameters
     ----------

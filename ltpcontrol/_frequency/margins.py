@@ -64,6 +64,15 @@ class MarginPoint(NamedTuple):
         crossing).
     frequency : float
         Physical frequency ``|ω + nω_p|`` in rad/s (nan without crossing).
+
+    Examples
+    --------
+    The fields of `HarmonicMargins`; a named tuple:
+
+    >>> m = ltp.harmonic_margins(ltp.ltpss(ct.tf([4], [1, 3, 3, 1]), period=1.0), 5)
+    >>> value, omega, harmonic, frequency = m.gain_upper
+    >>> round(value, 6), round(frequency, 6)              # python-control: 2 at √3
+    (2.0, 1.732051)
     """
 
     value: float
