@@ -8,6 +8,7 @@ import numpy as np
 import control as ct
 import pytest
 from control.exception import ControlDimension
+from hypothesis import assume, given, settings, strategies as st
 from scipy.integrate import solve_ivp
 
 import ltpcontrol as ltp
@@ -246,3 +247,20 @@ def test_pll_gain_margin_equals_floquet_bisection(f_bw, edge):
     resp = ltp.nyquist_htf(L, 8)
     assert resp.stable and radius(1.0) < 1
     assert not ltp.nyquist_htf(ltp.series(L, 1.01 * k), 8).stable
+
+
+@settings(max_examples=10, deadline=None)
+@given(k=st.floats(0.2, 30), a=st.floats(0.3, 3), b=st.floats(0.3, 3),
+       c=st.floats(-2, 4))
+def test_lti_loops_match_python_control(k, a, b, c):
+    # k (s + c) / ((s + a)(s + b)(s + 1)) written as periodic: same count, same margins
+    G = ct.tf([k, k * c], np.polymul([1, a + b, a * b], [1, 1]))
+    cl = ct.poles(ct.feedback(G, 1))
+    assume(np.all(np.abs(cl.real) > 1e-3))        # not at a stability boundary
+    assume(abs(abs(k * c / (a * b)) - 1) > 1e-3)    # no tangency of |L| = 1 at ω = 0
+    L = ltp.ltpss(G, period=0.1)
+    resp = ltp.nyquist_htf(L, 6)
+    assert resp.count == ct.nyquist_response(G).count
+    assert resp.stable == bool(np.all(cl.real < 0))
+    ours, theirs = ltp.stability_margins(L, nharmonics=6), ct.stability_margins(G)
+    np.testing.assert_allclose(ours[:3], theirs[:3], rtol=1e-6, atol=1e-9)

@@ -227,18 +227,16 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     gains, phases = [], []
     for b in range(eig.shape[1]):
         lam = eig[:, b]
-        for i in np.nonzero(np.diff(np.sign(lam.imag)) != 0)[0]:
+        for i in _sign_changes(lam.imag):
             if min(lam[i].real, lam[i + 1].real) < 0:
                 hit = _refine(loop, w[i], w[i + 1], lam[i], lam[i + 1], np.imag)
                 if hit and hit[1].real < 0 and abs(hit[1].imag) <= _REAL_RTOL * abs(hit[1]):
                     gm = 1 / abs(hit[1])
                     if 1 / _GAIN_LIMIT < gm < _GAIN_LIMIT:
                         gains.append(_point(loop, gm, hit))
-        with np.errstate(divide='ignore'):
-            logmag = np.log(np.abs(lam))
-        for i in np.nonzero(np.diff(np.sign(logmag)) != 0)[0]:
-            hit = _refine(loop, w[i], w[i + 1], lam[i], lam[i + 1],
-                          lambda z: np.log(np.abs(z)))
+        logmag = _logabs(lam)
+        for i in _sign_changes(logmag):
+            hit = _refine(loop, w[i], w[i + 1], lam[i], lam[i + 1], _logabs)
             if hit and abs(abs(hit[1]) - 1) <= _REAL_RTOL:
                 pm = float(np.remainder(np.angle(hit[1], deg=True), 360.0) - 180.0)
                 phases.append(_point(loop, pm, hit, odd=True))
@@ -330,6 +328,30 @@ def stability_margins(L, returnall=False, *, nharmonics=10, period=None, omega_n
 #
 # Helpers
 #
+
+def _logabs(z):
+    """log|z|, with -inf for z = 0 and no warning."""
+    with np.errstate(divide='ignore'):
+        return np.log(np.abs(z))
+
+
+def _sign_changes(x):
+    """Intervals [i, i+1] over which x changes sign strictly; a zero at a grid
+    point counts once (as [i-1, i]) when its neighbours have opposite signs,
+    and not at all when they agree (a tangency).
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.margins import _sign_changes
+    >>> _sign_changes(np.array([1.0, -1.0, 0.0, 2.0, 0.0, 3.0]))
+    array([0, 1])
+    """
+    sg = np.sign(x)
+    strict = np.nonzero(sg[:-1] * sg[1:] < 0)[0]
+    zero = np.nonzero(sg[1:-1] == 0)[0] + 1
+    through = zero[sg[zero - 1] * sg[zero + 1] < 0] - 1
+    return np.union1d(strict, through)
+
 
 def _tracked(Lh):
     return track(np.linalg.eigvals(Lh))

@@ -212,7 +212,8 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     omega : array_like, optional
         Initial frequencies of the contour in ``[-ω_p/2, ω_p/2]`` (default
         401 uniform points); the contour is refined wherever the phase of
-        the determinant turns by more than π/4 between points.
+        the determinant turns by more than π/4, or its modulus changes by
+        more than a factor e^0.5, between points.
     period : float, optional
         Period of an LTI loop.
     indent_radius : float, optional
@@ -370,7 +371,9 @@ def _refined_contour(loop, w, axis_w, r):
     s = contour_points(w, axis_w, r, wp)
     logabs, phase, eig = _evaluate(loop, s)
     while True:
-        bad = np.abs(_wrap(np.diff(phase))) > _MAX_TURN
+        # a fast turn of the phase, or a fast change of the modulus (a lightly
+        # damped exponent nearby, where the phase may turn between samples)
+        bad = (np.abs(_wrap(np.diff(phase))) > _MAX_TURN) | (np.abs(np.diff(logabs)) > 0.5)
         bad &= np.diff(w) > 1e-13 * wp
         if not bad.any() or len(w) + bad.sum() > _MAX_POINTS:
             break
