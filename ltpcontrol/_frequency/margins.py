@@ -94,8 +94,7 @@ class HarmonicMargins:
         Smallest gain margin above 1 (the loop gain may grow by this factor).
     gain_lower : MarginPoint
         Largest gain margin below 1 (the loop gain may shrink to this
-        factor); 0-valued ``value`` is reported as ``inf``-free: without a
-        crossing below 1 the value is 0.
+        factor); its value is 0 when no crossing lies below 1.
     phase : MarginPoint
         Phase margin of smallest magnitude (degrees).
     stability : MarginPoint
@@ -304,6 +303,13 @@ def stability_margins(L, returnall=False, *, nharmonics=10, period=None, omega_n
         Stability margin ``min σ_min(I + L̂(jω))``.
     wpc, wgc, wms : float
         Frequencies (rad/s) of gm, pm and sm.
+
+    Notes
+    -----
+    python-control's ``sm`` is the smallest *interior* local minimum of
+    ``|1 + L(jω)|`` over ω > 0; ours is the minimum over all frequencies,
+    so for an LTI loop whose minimum distance is reached at ω = 0 ours is
+    the smaller (and correct) one.
 
     Examples
     --------
