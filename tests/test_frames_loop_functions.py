@@ -123,3 +123,21 @@ def test_impedance_inverts_the_admittance():
     with pytest.raises(ControlDimension, match="as many voltages"):
         ltp.harmonic_admittance(ltp.ltpss(ct.ss(-np.eye(2), np.eye(2), [[1, 1]], 0),
                                           period=1.0), 2)
+
+
+def test_sequence_components_of_a_periodic_matrix():
+    # unbalanced currents: amplitudes (1, 0.8, 0.6) at 120°; their harmonic +1
+    # phasors, computed directly, give the same sequences
+    amp = np.array([1.0, 0.8, 0.6])
+    phi = np.array([0, 2 * np.pi / 3, -2 * np.pi / 3])
+    i_abc = ltp.PeriodicMatrix.from_function(
+        lambda t: np.array([[amp[i] * np.cos(t - phi[i])] for i in range(3)]), 2 * np.pi)
+    X = ltp.sequence_components(i_abc, nharmonics=1)
+    direct = ltp.sequence_components(amp * np.exp(-1j * phi) / 2)
+    np.testing.assert_allclose(X[2, :, 0], direct, atol=1e-12)
+    # harmonic -1 holds the conjugates, with the positive and negative sequences swapped
+    np.testing.assert_allclose(X[0, :, 0], np.conj(direct)[[0, 2, 1]], atol=1e-12)
+    with pytest.raises(ct.ControlArgument, match="nharmonics"):
+        ltp.sequence_components(i_abc)
+    with pytest.raises(ControlDimension, match="3 rows"):
+        ltp.sequence_components(i_abc[:2, :], nharmonics=1)

@@ -239,20 +239,26 @@ def clarke(sys, *, states=True, inputs=True, outputs=True, name=None, period=Non
     return _three_phase(sys, T, Ti, states, inputs, outputs, name)
 
 
-def sequence_components(phasors, axis=-1):
+def sequence_components(phasors, axis=-1, *, nharmonics=None):
     """Zero, positive and negative sequence components of three-phase phasors.
 
     Parameters
     ----------
-    phasors : array_like of complex
-        Phase phasors ``X_a, X_b, X_c`` along `axis` (length 3).
+    phasors : array_like of complex, or PeriodicMatrix
+        Phase phasors ``X_a, X_b, X_c`` along `axis` (length 3); or a
+        `PeriodicMatrix` with three rows (phases a, b, c), whose Fourier
+        coefficients ``X_k`` are the phasors of harmonic k.
     axis : int
-        The phase axis.
+        The phase axis of an array.
+    nharmonics : int, optional
+        Harmonics -K..K of a `PeriodicMatrix` (default: its exact Fourier
+        order, required otherwise).
 
     Returns
     -------
     ndarray of complex
-        ``[X_0, X_+, X_-]`` along `axis`.
+        ``[X_0, X_+, X_-]`` along `axis`; for a `PeriodicMatrix`, shape
+        ``(2K+1, 3, m)`` (harmonic, sequence, column).
 
     Examples
     --------
@@ -261,14 +267,31 @@ def sequence_components(phasors, axis=-1):
     >>> a = np.exp(2j * np.pi / 3)
     >>> np.round(ltp.sequence_components([1, a**2, a]), 12)
     array([0.+0.j, 1.+0.j, 0.+0.j])
+
+    Three phase currents ``cos(ωt - φ_b)`` as a periodic matrix: harmonic +1
+    is positive sequence, harmonic -1 its conjugate, negative sequence:
+
+    >>> i_abc = ltp.park_matrix(1.0, inverse=True)[:, :1]     # cos(t - φ_b)
+    >>> X = ltp.sequence_components(i_abc)
+    >>> np.round(X[2, :, 0], 12), np.round(X[0, :, 0], 12)
+    (array([0. +0.j, 0.5+0.j, 0. +0.j]), array([0. +0.j, 0. +0.j, 0.5+0.j]))
     """
+    a = np.exp(2j * np.pi / 3)
+    F = np.array([[1, 1, 1], [1, a, a * a], [1, a * a, a]]) / 3
+    if isinstance(phasors, PeriodicMatrix):
+        K = phasors.nharmonics if nharmonics is None else nharmonics
+        if K is None:
+            raise ControlArgument("sequence_components of a PeriodicMatrix without an exact "
+                                  "Fourier form needs nharmonics")
+        if phasors.shape[0] != 3:
+            raise ControlDimension(f"the PeriodicMatrix must have 3 rows (phases a, b, c), "
+                                   f"got {phasors.shape[0]}")
+        return F @ phasors.fourier(K)
     X = np.moveaxis(real_array(phasors, 'phasors', allow_complex=True).astype(complex),
                     axis, -1)
     if X.shape[-1] != 3:
         raise ControlDimension(f"phasors must have 3 phases along axis {axis}, "
                                f"got {X.shape[-1]}")
-    a = np.exp(2j * np.pi / 3)
-    F = np.array([[1, 1, 1], [1, a, a * a], [1, a * a, a]]) / 3
     return np.moveaxis(X @ F.T, -1, axis)
 
 
