@@ -80,6 +80,8 @@ class LoopHTF:
         with warnings.catch_warnings():
             # an unstable open loop is the point of the criterion, not a misuse
             warnings.filterwarnings('ignore', message='.* is unstable: its HTF')
+            # ... nor is the accuracy of the multipliers behind that remark
+            warnings.filterwarnings('ignore', message='product_eigenvalues')
             self.H = HTFModel(L, self.N, internal_harmonics=internal_harmonics)
 
     def __call__(self, s):
@@ -113,7 +115,12 @@ def open_loop_exponents(L, atol=None):
     """
     wp = L.omega_p
     atol = 1e-9 * wp if atol is None else atol
-    lam = np.atleast_1d(floquet_exponents(L)) if L.nstates else np.zeros(0, complex)
+    if not L.nstates:
+        lam = np.zeros(0, complex)
+    elif L.A.is_constant:
+        lam = np.linalg.eigvals(L.A(0.0))           # constant A: its eigenvalues
+    else:
+        lam = np.atleast_1d(floquet_exponents(L))
     on_axis = np.abs(lam.real) <= atol
     P = int(np.count_nonzero(lam.real > atol))
     w = fold(lam[on_axis].imag, wp)

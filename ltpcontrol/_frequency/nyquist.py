@@ -89,7 +89,7 @@ class HarmonicNyquistResponse:
 
     Examples
     --------
-    >>> L = ltp.ltpss(ct.tf([2], [1, 1]), period=1.0)
+    >>> L = ltp.ltpss(ct.tf([2], [1, 1]), period=0.2)
     >>> resp = ltp.nyquist_htf(L, 5)
     >>> resp.encirclements, resp.stable
     (0, True)
@@ -152,7 +152,7 @@ class HarmonicNyquistResponse:
 
         Examples
         --------
-        >>> L = ltp.ltpss(ct.tf([2], [1, 1]), period=1.0)
+        >>> L = ltp.ltpss(ct.tf([2], [1, 1]), period=0.1)
         >>> cplt = ltp.nyquist_htf(L, 2).plot()
         >>> type(cplt).__name__
         'ControlPlot'
