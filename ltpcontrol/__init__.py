@@ -13,6 +13,8 @@ from ._core.periodic_matrix import PeriodicMatrix
 from ._core.ltpsys import LTPStateSpace, ltpss, series, parallel, feedback, append, negate
 from ._core.interconnect import interconnect
 from ._core.timeresp import forced_response, step_response, initial_response, impulse_response
+from ._core.frames import (clarke_matrix, park_matrix, frame_transform, park, clarke,
+                           sequence_components)
 from ._core.floquet import (monodromy, floquet_multipliers, floquet_exponents, is_stable,
                        floquet_transform)
 from ._frequency.htf import HTF, HTFModel, HTFData, htf
@@ -45,9 +47,15 @@ from ._rotors.read_lin import read_lin
 from ._rotors.campbell import campbell, CampbellDiagram
 from ._analysis.zeros import zeros
 from ._frequency.harmonic_ss import harmonic_ss
+from ._frequency.nyquist import nyquist_htf, HarmonicNyquistResponse
+from ._frequency.margins import harmonic_margins, stability_margins, HarmonicMargins, MarginPoint
+from ._frequency.loop_functions import (sensitivity_htf, complementary_sensitivity_htf,
+                                        siso_equivalent, harmonic_admittance,
+                                        harmonic_impedance)
 from ._analysis.riccati import care, dare
 from ._analysis.design import lqr, dlqr, lqe, dlqe, lqg
 from ._analysis.place import place
+from ._analysis.hhc import hhc_tmatrix, hhc_controller
 from ._analysis.lmi import lmi_statefbk, LMIDesign
 from ._analysis.reduction import hsvd, balred, minreal
 from ._identification.refine import refine_ltp, RefineInfo
@@ -72,6 +80,14 @@ __all__ = [
     'floquet_transform',
     # frequency domain
     'HTF', 'HTFModel', 'HTFData', 'htf', 'htf_response', 'bode_htf', 'htf_map_plot',
+    # three-phase frames
+    'clarke_matrix', 'park_matrix', 'frame_transform', 'park', 'clarke',
+    'sequence_components',
+    # harmonic stability of periodic loops
+    'nyquist_htf', 'HarmonicNyquistResponse', 'harmonic_margins', 'stability_margins',
+    'HarmonicMargins', 'MarginPoint', 'sensitivity_htf', 'complementary_sensitivity_htf',
+    'siso_equivalent', 'harmonic_admittance', 'harmonic_impedance',
+    'hhc_tmatrix', 'hhc_controller',
     'sample_system', 'c2d', 'd2c', 'lift',
     # rhythmic plants and their orbits
     'HybridMode', 'HybridPlant', 'simulate_hybrid', 'saltation_matrix',

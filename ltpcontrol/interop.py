@@ -150,15 +150,21 @@ _STEADY = ("the periodic steady state (ltp.forced_response over enough periods, 
 REFUSED = {
     'frequency_response': _HTF,
     'bode_plot': "ltp.bode_htf(ltp.htf(sys, nharmonics))",
-    'nyquist_plot': "ltp.bode_htf or ltp.htf_map_plot of ltp.htf(sys, nharmonics)",
-    'nyquist_response': _HTF,
+    'nyquist_plot': ("ltp.nyquist_htf(L, nharmonics).plot() (generalized Nyquist criterion "
+                     "of a periodic loop)"),
+    'nyquist_response': ("ltp.nyquist_htf(L, nharmonics) (generalized Nyquist criterion of "
+                         "a periodic loop)"),
     'nichols_plot': "ltp.bode_htf(ltp.htf(sys, nharmonics))",
     'singular_values_response': _HTF,
     'singular_values_plot': "ltp.htf_map_plot(ltp.htf(sys, nharmonics), omega)",
     'evalfr': "ltp.htf(sys, nharmonics)(s)",
     'dcgain': "ltp.htf(sys, nharmonics)(0) (the harmonic DC gains)",
-    'margin': "ltp.floquet_multipliers or ltp.is_stable",
-    'stability_margins': "ltp.floquet_multipliers or ltp.is_stable",
+    'margin': ("ltp.stability_margins(L) (python-control's return values) or "
+               "ltp.harmonic_margins(L) (upper and lower gain, phase and disk margins with "
+               "their harmonics)"),
+    'stability_margins': ("ltp.stability_margins(L) (python-control's return values) or "
+                          "ltp.harmonic_margins(L)"),
+    'disk_margins': "ltp.harmonic_margins(L) (its disk, disk_gain and disk_phase)",
     'bandwidth': _HTF,
     'damp': "ltp.floquet_exponents(sys)",
     'pole_zero_map': "ltp.floquet_exponents(sys)",

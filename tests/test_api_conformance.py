@@ -130,6 +130,8 @@ KWARG_CALLS = {
         ltp.PeriodicMatrix.constant([[-1.0]], T), [[1.0]], [[1.0]], [[0.0]], T, **kw),
     'RotorStateSpace.average': lambda **kw: ltp.RotorStateSpace(
         ltp.PeriodicMatrix.constant([[-1.0]], T), [[1.0]], [[1.0]], [[0.0]], T).average(**kw),
+    'HarmonicNyquistResponse.plot': lambda **kw: ltp.nyquist_htf(
+        ltp.ltpss(ct.tf([2], [1, 1]), period=0.2), 2).plot(**kw),
     # feedback around orbits
     'closed_loop_response': lambda **kw: ltp.closed_loop_response(
         FORCED, ct.ss([], [], [], [[-1.0]]), ltp.periodic_orbit(FORCED, T, [0.0]), [0, 0.5],
@@ -154,7 +156,7 @@ KWARG_CALLS.update({
 })
 
 # plotting functions hand **kwargs to matplotlib, whose error is AttributeError
-_MATPLOTLIB_KWARGS = {'bode_htf', 'HTF.plot'}
+_MATPLOTLIB_KWARGS = {'bode_htf', 'HTF.plot', 'HarmonicNyquistResponse.plot'}
 
 
 def _accepts_var_keyword(func):
@@ -225,6 +227,7 @@ _RESULT_CLASSES |= {'LMIDesign'}
 _RESULT_CLASSES |= {'RefineInfo', 'MonteCarloResult'}
 _RESULT_CLASSES |= {'HTFEstimateInfo'}
 _RESULT_CLASSES |= {'FloquetModes', 'CampbellDiagram'}
+_RESULT_CLASSES |= {'HarmonicNyquistResponse', 'HarmonicMargins', 'MarginPoint'}
 
 DOC_DEFECTS = {}
 

@@ -19,6 +19,8 @@ def _slow(script, figure):
     ('plot_hopper_htf.py', 'hopper_htf.png'),
     ('plot_switching_mathieu.py', 'switching_mathieu.png'),
     ('plot_analysis.py', 'analysis.png'),
+    _slow('plot_pll_harmonic_stability.py', 'pll_harmonic_stability.png'),
+    _slow('plot_rotor_hhc.py', 'rotor_hhc.png'),
     _slow('plot_van_der_pol_orbit.py', 'van_der_pol_orbit.png'),
     _slow('plot_clockfree_hopper.py', 'clockfree_hopper_branch.png'),
     _slow('plot_slip_running.py', 'slip_running.png'),

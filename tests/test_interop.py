@@ -248,6 +248,7 @@ REFUSED_CALLS = {
     'dcgain': lambda: ct.dcgain(P),
     'margin': lambda: ct.margin(P[0, 0]),
     'stability_margins': lambda: ct.stability_margins(P[0, 0]),
+    'disk_margins': lambda: ct.disk_margins(P[0, 0], [1.0]),
     'bandwidth': lambda: ct.bandwidth(P[0, 0]),
     'damp': lambda: ct.damp(P),
     'pole_zero_map': lambda: ct.pole_zero_map(P),
@@ -273,6 +274,17 @@ def test_every_refused_entry_point_is_tested():
 def test_refused_entry_points_name_the_ltp_way(name):
     with pytest.raises(ControlArgument, match=rf"^{name} does not apply.*: use \S"):
         REFUSED_CALLS[name]()
+
+
+@pytest.mark.parametrize('name, target', [('nyquist_plot', 'nyquist_htf'),
+                                          ('nyquist_response', 'nyquist_htf'),
+                                          ('margin', 'stability_margins'),
+                                          ('stability_margins', 'harmonic_margins'),
+                                          ('disk_margins', 'harmonic_margins')])
+def test_loop_refusals_name_the_harmonic_stability_functions(name, target):
+    with pytest.raises(ControlArgument, match=rf"ltp\.{target}\(L"):
+        REFUSED_CALLS[name]()
+    assert callable(getattr(ltp, target))
 
 
 def test_aliases_are_refused_under_their_function_name():

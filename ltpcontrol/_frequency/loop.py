@@ -1,0 +1,140 @@
+"""A periodic feedback loop seen through its truncated HTF.
+
+Shared by the generalized Nyquist criterion, the margins and the
+closed-loop frequency functions.  The loop ``L`` is closed with negative
+feedback, ``u = r - y``; its HTF truncated to N harmonics is ``L̂_N(s)``
+(Conventions page) and the return difference ``I + L̂_N(s)``.
+
+The strip ``s = jω``, ``ω ∈ (-ω_p/2, ω_p/2]``, sees every frequency once:
+``L̂(s + jω_p)`` is ``L̂(s)`` with the harmonic blocks shifted by one.
+"""
+
+import warnings
+
+import numpy as np
+from control.exception import ControlArgument, ControlDimension
+
+from .htf import HTFModel
+from .._core.floquet import floquet_exponents
+from .._core.ltpsys import LTPStateSpace, series
+from .._core.validation import as_ltp, check_positive_int
+
+__all__ = []
+
+
+def as_loop(L, name='L', period=None):
+    """The loop as one square continuous-time `LTPStateSpace`.
+
+    `L` is a system, or a sequence of systems ``(L_1, ..., L_k)`` meaning
+    the product ``L_1 L_2 ... L_k`` (``L_k`` acts first), for example
+    ``(plant, controller)``.
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.loop import as_loop
+    >>> P = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> as_loop((P, ct.tf([2], [1, 3]))).nstates
+    2
+    >>> as_loop(ltp.ltpss([[-1.0]], [[1.0]], [[1.0], [2.0]], 0, period=1.0))
+    Traceback (most recent call last):
+    ...
+    control.exception.ControlDimension: L must be a square loop (as many outputs as inputs) to be closed by negative feedback; it has 2 outputs and 1 inputs
+    """
+    if isinstance(L, (list, tuple)):
+        if not L:
+            raise ControlArgument(f"{name} must be a system or a non-empty sequence of systems")
+        if len(L) > 1:
+            if period is not None:
+                L = [as_ltp(s, name, period=period) if not isinstance(s, LTPStateSpace)
+                     else s for s in L]
+            try:
+                # L_1 L_2 ... L_k: signals flow from L_k to L_1
+                L = series(*reversed(L), name='L')
+            except ValueError as err:
+                raise ValueError(f"{name}: the systems of the loop cannot be connected: "
+                                 f"{err}") from None
+        else:
+            L = L[0]
+    L = as_ltp(L, name, period=period if not isinstance(L, LTPStateSpace) else None)
+    if L.isdtime():
+        raise ValueError(f"{name} must be a continuous-time loop (for a discrete-time "
+                         "loop use ltp.lift(L) and python-control's LTI tools)")
+    if L.ninputs != L.noutputs:
+        raise ControlDimension(f"{name} must be a square loop (as many outputs as inputs) "
+                               "to be closed by negative feedback; it has "
+                               f"{L.noutputs} outputs and {L.ninputs} inputs")
+    return L
+
+
+class LoopHTF:
+    """``L̂_N(s)`` evaluated at many points, shape ``(points, M, M)``.
+
+    ``M = (2N+1) m`` with m loop channels, harmonic-major (Conventions).
+    """
+
+    def __init__(self, L, nharmonics, internal_harmonics=None):
+        self.L = L
+        self.N = check_positive_int(nharmonics, 'nharmonics', minimum=1)
+        self.m = L.ninputs
+        self.omega_p = L.omega_p
+        with warnings.catch_warnings():
+            # an unstable open loop is the point of the criterion, not a misuse
+            warnings.filterwarnings('ignore', message='.* is unstable: its HTF')
+            # ... nor is the accuracy of the multipliers behind that remark
+            warnings.filterwarnings('ignore', message='product_eigenvalues')
+            self.H = HTFModel(L, self.N, internal_harmonics=internal_harmonics)
+
+    def __call__(self, s):
+        s = np.atleast_1d(np.asarray(s, complex))
+        return np.moveaxis(self.H(s), -1, 0)
+
+    @property
+    def size(self):
+        return (2 * self.N + 1) * self.m
+
+    def dominant_harmonic(self, v):
+        """Harmonic n whose block carries most of the vector v."""
+        blocks = np.abs(v.reshape(2 * self.N + 1, self.m)) ** 2
+        return int(np.argmax(blocks.sum(axis=1))) - self.N
+
+
+def open_loop_exponents(L, atol=None):
+    """(P, axis) of the open loop: count of exponents with positive real part
+    and the strip frequencies of those on the imaginary axis.
+
+    An exponent with ``|Re λ| <= atol`` (default ``1e-9 ω_p``) counts as on
+    the axis; the Nyquist contour indents to its right, so it is not counted
+    in P, as python-control does.
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.loop import open_loop_exponents
+    >>> L = ltp.ltpss(ct.ss(ct.tf([1], [1, 0, -1])), period=1.0)   # poles ±1
+    >>> open_loop_exponents(L)
+    (1, array([], dtype=float64))
+    """
+    wp = L.omega_p
+    atol = 1e-9 * wp if atol is None else atol
+    if not L.nstates:
+        lam = np.zeros(0, complex)
+    elif L.A.is_constant:
+        lam = np.linalg.eigvals(L.A(0.0))           # constant A: its eigenvalues
+    else:
+        lam = np.atleast_1d(floquet_exponents(L))
+    on_axis = np.abs(lam.real) <= atol
+    P = int(np.count_nonzero(lam.real > atol))
+    w = fold(lam[on_axis].imag, wp)
+    return P, np.unique(np.round(w / wp, 12)) * wp if w.size else w
+
+
+def fold(omega, omega_p):
+    """Frequencies folded into the strip ``(-ω_p/2, ω_p/2]``.
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.loop import fold
+    >>> fold(np.array([0.5, -0.5, 1.2, 3.0]), 1.0)
+    array([0.5, 0.5, 0.2, 0. ])
+    """
+    w = np.asarray(omega, float)
+    return 0.0 - (np.remainder(-w + omega_p / 2, omega_p) - omega_p / 2)

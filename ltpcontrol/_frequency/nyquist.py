@@ -1,0 +1,412 @@
+"""Generalized Nyquist criterion for periodic feedback loops.
+
+The closed loop ``u = r - L y`` of a T-periodic loop ``L`` has the
+characteristic exponents where ``det(I + L̂(s)) = 0`` (Hall & Wereley,
+ACC 1990; Möllerstedt 2000).  Since ``L̂(s + jω_p)`` is ``L̂(s)`` with its
+harmonic blocks shifted, one strip ``-ω_p/2 < Im s <= ω_p/2`` of the right
+half plane holds every exponent once.  Its boundary, travelled clockwise —
+up the imaginary axis, then out along ``Im s = ω_p/2`` and back along
+``Im s = -ω_p/2`` (the two horizontal edges cancel by periodicity) —
+gives, by the argument principle,
+
+    encirclements (counter-clockwise, of 0 by det(I + L̂)) = P - Z,
+
+with P the open-loop exponents and Z the closed-loop exponents in the
+open right half plane.  With the HTF truncated to N harmonics the curve
+``det(I + L̂_N(jω))`` over the strip does not close exactly: its *closure
+gap* ``|f(-jω_p/2) / f(jω_p/2) - 1|`` vanishes as N grows and measures the
+truncation.  Exponents on the imaginary axis are passed on the right by
+semicircles of radius ``indent_radius`` (not counted in P), as in
+`control.nyquist_response`.
+
+For an LTI loop written as periodic, ``det(I + L̂_N(jω)) = Π_n (1 +
+L(jω + jnω_p))``, so the count is that of the ordinary Nyquist plot over
+``|ω| <= (N + 1/2) ω_p``; python-control counts *clockwise* encirclements
+(``count = -encirclements``).
+"""
+
+from dataclasses import dataclass
+
+import warnings
+
+import numpy as np
+import control as ct
+import matplotlib.pyplot as plt
+from scipy.optimize import linear_sum_assignment
+
+from .loop import LoopHTF, as_loop, open_loop_exponents
+from .._core.validation import check_positive, check_positive_int, real_array
+
+__all__ = ['nyquist_htf', 'HarmonicNyquistResponse']
+
+# refine an interval of the contour while the phase of det(I + L̂) turns more than this
+_MAX_TURN = np.pi / 4
+# bound on the number of contour points after refinement
+_MAX_POINTS = 50_000
+
+
+@dataclass(frozen=True, repr=False)
+class HarmonicNyquistResponse:
+    """Result of `nyquist_htf`: the generalized Nyquist criterion of a periodic loop.
+
+    Attributes
+    ----------
+    encirclements : int
+        Counter-clockwise encirclements of the origin by
+        ``det(I + L̂_N(s))`` along the contour (equivalently of -1 by the
+        eigenloci of ``L̂_N``).
+    count : int
+        python-control's convention: clockwise encirclements,
+        ``-encirclements``.
+    open_loop_unstable : int
+        P, the open-loop exponents with positive real part (one strip).
+    closed_loop_unstable : int
+        The verdict ``Z = P - encirclements``: closed-loop exponents with
+        positive real part.
+    stable : bool
+        True when Z is 0 (closed loop asymptotically stable).
+    closure_gap : float
+        ``|f(-jω_p/2) / f(jω_p/2) - 1|`` of ``f = det(I + L̂_N)``: zero for
+        the untruncated HTF; a truncation diagnostic.
+    min_distance : float
+        Smallest singular value of ``I + L̂_N`` on the contour (distance
+        to a closed-loop exponent on the axis).
+    omega : ndarray
+        Contour parameter: frequencies in the strip ``[-ω_p/2, ω_p/2]``.
+    contour : ndarray of complex
+        The points s of the contour (``jω``, or the indentation).
+    det : ndarray of complex
+        ``det(I + L̂_N(s))`` on the contour (may over- or underflow for
+        large N; the count uses its logarithm).
+    eigenloci : ndarray of complex, shape (points, (2N+1) m)
+        Eigenvalues of ``L̂_N(s)`` on the contour, tracked along it.
+    nharmonics : int
+        Truncation N.
+    omega_p : float
+        Fundamental frequency of the loop.
+    sysname : str
+        Name of the loop.
+
+    Examples
+    --------
+    >>> L = ltp.ltpss(ct.tf([2], [1, 1]), period=0.2)
+    >>> resp = ltp.nyquist_htf(L, 5)
+    >>> resp.encirclements, resp.stable
+    (0, True)
+    """
+
+    encirclements: int
+    open_loop_unstable: int
+    closure_gap: float
+    min_distance: float
+    omega: np.ndarray
+    contour: np.ndarray
+    det: np.ndarray
+    eigenloci: np.ndarray
+    nharmonics: int
+    omega_p: float
+    sysname: str
+
+    @property
+    def count(self):
+        """Clockwise encirclements (`control.nyquist_response` convention)."""
+        return -self.encirclements
+
+    @property
+    def closed_loop_unstable(self):
+        """Verdict Z = P - encirclements."""
+        return self.open_loop_unstable - self.encirclements
+
+    @property
+    def stable(self):
+        """True when the closed loop has no exponent in the right half plane."""
+        return self.closed_loop_unstable == 0
+
+    def __repr__(self):
+        return (f"<HarmonicNyquistResponse {self.sysname}: N={self.nharmonics}, "
+                f"encirclements={self.encirclements}, P={self.open_loop_unstable}, "
+                f"Z={self.closed_loop_unstable}, closure_gap={self.closure_gap:.2g}>")
+
+    def plot(self, kind='eigenloci', *, ax=None, title=None, max_curve_magnitude=20.0,
+             **kwargs):
+        """Nyquist plot of the eigenloci (critical point -1) or of the determinant.
+
+        Parameters
+        ----------
+        kind : {'eigenloci', 'det'}
+            The eigenvalues of ``L̂_N`` along the contour with the critical
+            point -1 (default), or ``det(I + L̂_N)`` with the critical
+            point 0.
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw into.
+        title : str, optional
+            Figure title.
+        max_curve_magnitude : float
+            View radius around the origin.
+        **kwargs
+            Matplotlib line properties.
+
+        Returns
+        -------
+        control.ControlPlot
+
+        Examples
+        --------
+        >>> L = ltp.ltpss(ct.tf([2], [1, 1]), period=0.1)
+        >>> cplt = ltp.nyquist_htf(L, 2).plot()
+        >>> type(cplt).__name__
+        'ControlPlot'
+        """
+        if kind not in ('eigenloci', 'det'):
+            raise ValueError(f"kind must be 'eigenloci' or 'det', got {kind!r}")
+        R = check_positive(max_curve_magnitude, 'max_curve_magnitude')
+        if ax is None:
+            fig, ax = plt.subplots()
+        fig = ax.figure
+        lines = []
+        if kind == 'eigenloci':
+            curves, critical = list(self.eigenloci.T), -1.0
+        else:
+            curves, critical = [self.det], 0.0
+        color = kwargs.pop('color', None)
+        for i, z in enumerate(curves):
+            if np.all(np.abs(z) < 1e-3 * R) and kind == 'eigenloci' and i:
+                continue        # branches of high harmonics that never leave the origin
+            line, = ax.plot(z.real, z.imag, color=color or 'C0', **kwargs)
+            _arrow(ax, z, line.get_color())
+            lines.append(line)
+        lines.append(ax.plot([critical], [0.0], 'r+', markersize=10)[0])
+        ax.set_xlabel("Real axis")
+        ax.set_ylabel("Imaginary axis")
+        ax.grid(True, alpha=0.3)
+        allz = np.concatenate([c[np.abs(c) <= R] for c in curves] + [np.array([critical])])
+        span = max(1.5, 1.1 * np.abs(allz).max())
+        ax.set_xlim(-span, span)
+        ax.set_ylim(-span, span)
+        ax.set_aspect('equal', adjustable='box')
+        what = "eigenloci of L̂" if kind == 'eigenloci' else "det(I + L̂)"
+        ax.set_title(title or f"Nyquist plot ({what}, N={self.nharmonics}) of "
+                     f"{self.sysname}: {self.encirclements} encirclement(s), "
+                     f"P={self.open_loop_unstable}")
+        return ct.ControlPlot(_line_array(lines), np.array([[ax]]), fig)
+
+
+def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
+                closure_tol=0.05, internal_harmonics=None):
+    """Generalized Nyquist criterion for a periodic loop with negative feedback.
+
+    Counts the encirclements of the origin by ``det(I + L̂_N(s))`` along the
+    strip ``s = jω``, ``ω ∈ [-ω_p/2, ω_p/2]`` (closed by periodicity), and
+    gives the verdict ``Z = P - encirclements`` on the closed loop
+    ``u = r - y`` (module notes; Conventions page for the HTF).
+
+    Parameters
+    ----------
+    L : LTPStateSpace, control.StateSpace or sequence of systems
+        The continuous-time loop, square (m inputs, m outputs).  A sequence
+        ``(L_1, ..., L_k)`` is the product ``L_1 ... L_k`` (``L_k`` acts
+        first), e.g. ``(plant, controller)``; their periods must be
+        commensurate.  An LTI loop needs `period`.
+    nharmonics : int
+        Truncation N >= 1 of the loop HTF.
+    omega : array_like, optional
+        Initial frequencies of the contour in ``[-ω_p/2, ω_p/2]`` (default
+        401 uniform points); the contour is refined wherever the phase of
+        the determinant turns by more than π/4, or its modulus changes by
+        more than a factor e^0.5, between points.
+    period : float, optional
+        Period of an LTI loop.
+    indent_radius : float, optional
+        Radius of the semicircles around open-loop exponents on the
+        imaginary axis (default ``1e-4 ω_p``).
+    closure_tol : float
+        A closure gap above this warns that N is too small.
+    internal_harmonics : int, optional
+        Truncation of the harmonic state space (see `htf`).
+
+    Returns
+    -------
+    HarmonicNyquistResponse
+        With ``encirclements`` (counter-clockwise positive),
+        ``open_loop_unstable`` (P), ``closed_loop_unstable`` (Z),
+        ``closure_gap`` and ``.plot()``.
+
+    Raises
+    ------
+    ControlDimension
+        If the loop is not square.
+    ValueError
+        For a discrete-time loop, incommensurate periods, or `omega`
+        outside the strip.
+
+    Warns
+    -----
+    UserWarning
+        When the closure gap exceeds `closure_tol` (increase `nharmonics`),
+        or when the contour passes within rounding of a closed-loop exponent
+        (the loop is at a stability boundary and the count is not
+        reliable).
+
+    Notes
+    -----
+    The determinant's phase is accumulated on the contour; the closing
+    step from ``jω_p/2`` back to ``-jω_p/2`` takes the principal value.
+    python-control's `control.nyquist_response` counts clockwise
+    encirclements of -1: for an LTI loop written as periodic,
+    ``ct.nyquist_response(L).count == -resp.encirclements`` when N covers
+    the loop's bandwidth (``(N + 1/2) ω_p`` beyond the last crossing).
+
+    Examples
+    --------
+    An unstable plant ``1/(s - 1)`` stabilized by the gain 2 (P = 1, one
+    counter-clockwise encirclement):
+
+    >>> L = ltp.ltpss(ct.tf([2], [1, -1]), period=0.2)
+    >>> resp = ltp.nyquist_htf(L, 10)
+    >>> resp.open_loop_unstable, resp.encirclements, resp.closed_loop_unstable
+    (1, 1, 0)
+    >>> ct.nyquist_response(ct.tf([2], [1, -1])).count == resp.count
+    True
+    """
+    L = as_loop(L, 'L', period)
+    loop = LoopHTF(L, nharmonics, internal_harmonics)
+    wp = L.omega_p
+    r = 1e-4 * wp if indent_radius is None else check_positive(
+        indent_radius, 'indent_radius', below=wp / 4)
+    closure_tol = check_positive(closure_tol, 'closure_tol')
+    P, axis_w = open_loop_exponents(L)
+    w = _initial_grid(omega, wp, axis_w, r)
+
+    w, s, logabs, phase, eig = _refined_contour(loop, w, axis_w, r)
+    dphi = _wrap(np.diff(phase))
+    closing = _wrap(phase[0] - phase[-1])
+    encirclements = int(np.round((dphi.sum() + closing) / (2 * np.pi)))
+    with np.errstate(over='ignore', under='ignore'):
+        gap = float(np.abs(np.exp(logabs[0] - logabs[-1] + 1j * closing) - 1))
+        det = np.exp(logabs + 1j * phase)
+    I = np.eye(loop.size)
+    sv = np.linalg.svd(I + loop(s[::max(1, len(s) // 2000)]), compute_uv=False)
+    dist = float(sv[:, -1].min())
+    if gap > closure_tol:
+        warnings.warn(f"nyquist_htf: the curve det(I + L̂_N) does not close: closure gap "
+                      f"{gap:.2g} > closure_tol={closure_tol:g} with nharmonics={loop.N}; "
+                      "the count may be wrong: increase nharmonics", UserWarning,
+                      stacklevel=2)
+    if dist < 1e-8:
+        warnings.warn("nyquist_htf: the contour passes through a closed-loop exponent "
+                      f"(min singular value of I + L̂ = {dist:.1e}): the loop is at a "
+                      "stability boundary and the count is not reliable", UserWarning,
+                      stacklevel=2)
+    return HarmonicNyquistResponse(
+        encirclements=encirclements, open_loop_unstable=P, closure_gap=gap,
+        min_distance=dist, omega=w, contour=s, det=det, eigenloci=track(eig),
+        nharmonics=loop.N, omega_p=wp, sysname=L.name)
+
+
+def contour_points(w, axis_w, r, wp):
+    """``s(ω) = jω``, pushed right onto semicircles of radius r around `axis_w`.
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.nyquist import contour_points
+    >>> contour_points(np.array([-0.5, 0.0, 0.05]), np.array([0.0]), 0.1, 1.0)
+    array([0.        -0.5j , 0.1       +0.j  , 0.08660254+0.05j])
+    """
+    s = 1j * w.astype(complex)
+    for wk in axis_w:
+        for c in (wk - wp, wk, wk + wp):
+            d = w - c
+            inside = np.abs(d) < r
+            s[inside] += np.sqrt(r ** 2 - d[inside] ** 2)
+    return s
+
+
+def track(eig):
+    """Eigenvalue branches: each row's order matched to the previous row's.
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.nyquist import track
+    >>> track(np.array([[1.0, 2.0], [2.1, 1.1]]))
+    array([[1. , 2. ],
+           [1.1, 2.1]])
+    """
+    out = np.array(eig, copy=True)
+    for i in range(1, len(out)):
+        cost = np.abs(out[i - 1][:, None] - out[i][None, :])
+        _, col = linear_sum_assignment(cost)
+        out[i] = out[i][col]
+    return out
+
+
+#
+# Helpers
+#
+
+def _initial_grid(omega, wp, axis_w, r):
+    if omega is None:
+        w = np.linspace(-wp / 2, wp / 2, 401)
+    else:
+        w = np.unique(real_array(omega, 'omega', ndim=1))
+        if w.size < 2 or w[0] < -wp / 2 * (1 + 1e-12) or w[-1] > wp / 2 * (1 + 1e-12):
+            raise ValueError("omega must hold at least two frequencies in the strip "
+                             f"[-ω_p/2, ω_p/2] = [{-wp / 2:g}, {wp / 2:g}]")
+        w = np.unique(np.concatenate([[-wp / 2], w, [wp / 2]]))
+    theta = np.sin(np.linspace(-np.pi / 2, np.pi / 2, 41))
+    extra = [c + r * theta for wk in axis_w for c in (wk - wp, wk, wk + wp)]
+    if extra:
+        w = np.concatenate([w] + extra)
+        w = np.unique(w[(w >= -wp / 2) & (w <= wp / 2)])
+    return w
+
+
+def _evaluate(loop, s):
+    Lh = loop(s)
+    sign, logabs = np.linalg.slogdet(np.eye(loop.size) + Lh)
+    return logabs, np.angle(sign), np.linalg.eigvals(Lh)
+
+
+def _refined_contour(loop, w, axis_w, r):
+    wp = loop.omega_p
+    s = contour_points(w, axis_w, r, wp)
+    logabs, phase, eig = _evaluate(loop, s)
+    while True:
+        # a fast turn of the phase, or a fast change of the modulus (a lightly
+        # damped exponent nearby, where the phase may turn between samples)
+        bad = (np.abs(_wrap(np.diff(phase))) > _MAX_TURN) | (np.abs(np.diff(logabs)) > 0.5)
+        bad &= np.diff(w) > 1e-13 * wp
+        if not bad.any() or len(w) + bad.sum() > _MAX_POINTS:
+            break
+        wn = 0.5 * (w[:-1][bad] + w[1:][bad])
+        sn = contour_points(wn, axis_w, r, wp)
+        la, ph, ev = _evaluate(loop, sn)
+        order = np.argsort(np.concatenate([w, wn]), kind='stable')
+        w = np.concatenate([w, wn])[order]
+        s = np.concatenate([s, sn])[order]
+        logabs = np.concatenate([logabs, la])[order]
+        phase = np.concatenate([phase, ph])[order]
+        eig = np.concatenate([eig, ev])[order]
+    if np.any(np.isinf(logabs)):
+        warnings.warn("nyquist_htf: det(I + L̂_N) vanishes on the contour: the loop is "
+                      "at a stability boundary", UserWarning, stacklevel=3)
+    return w, s, logabs, phase, eig
+
+
+def _wrap(x):
+    """Angles wrapped into [-π, π)."""
+    return np.remainder(x + np.pi, 2 * np.pi) - np.pi
+
+
+def _arrow(ax, z, color):
+    """Direction arrow at the middle of a curve."""
+    if len(z) < 3:
+        return
+    i = len(z) // 2
+    ax.annotate('', xy=(z[i + 1].real, z[i + 1].imag), xytext=(z[i].real, z[i].imag),
+                arrowprops=dict(arrowstyle='->', color=color))
+
+
+def _line_array(lines):
+    arr = np.empty((1, 1), dtype=object)
+    arr[0, 0] = lines
+    return arr
