@@ -224,7 +224,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         normalized RMS error ``info.holdout_nrmse`` decides ``success``
         (see Notes).  The returned model is then refitted on all lines
         from the validated one ('refit'; identified again from all lines
-        for 'log' and 'tustin').  None (or too few lines for the subspace
+        for 'log', 'tustin' and ``refit_a=False``, whose A is that of the
+        realization).  None (or too few lines for the subspace
         step without them, with a warning) skips the validation.
     validation_tol : float, optional
         Largest held-out NRMSE of a successful model (default 0.05).
@@ -415,7 +416,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
             if holdout_nrmse > before:
                 # the refinement must not predict worse than its start
                 fallback, holdout_nrmse = True, before
-        if conversion == 'refit':
+        if conversion == 'refit' and refit_a:
             # the validated model, refitted on all lines
             ctx_all = dict(ctx, refine=None if fallback else refine)
             start = val['start'] if fallback else val['sys']
@@ -424,7 +425,9 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
             res = dict(val, sys=fit[0], converged=fit[1], ml=fit[3], start=fit[6])
             nfev += fit[2]
         else:
-            res = _identify_lines(G, np.ones(M, bool), ctx, htf=data)
+            # A is that of the realization: identified again from all lines
+            res = _identify_lines(G, np.ones(M, bool), dict(
+                ctx, refine=None if fallback else refine), htf=data)
             nfev += res['nfev']
     else:
         res = _identify_lines(G, np.ones(M, bool), ctx, htf=data)
@@ -558,7 +561,12 @@ def _fit_and_refine(start, *, data, period, G, lines, htf, K, Kd, N, ny, convers
     before, ml = sysc, None
     if refine == 'ml':
         target = htf if isinstance(htf, HTF) else Gl
-        sysc, ml = refine_ltp(sysc, target, return_info=True, **(refine_options or {}))
+        options = dict(refine_options or {})
+        std = options.get('std')
+        if std is not None and not isinstance(htf, HTF) and np.ndim(std) >= 1 \
+                and np.shape(std)[-1] == lines.size:
+            options['std'] = np.asarray(std)[..., lines]        # std of the lines used
+        sysc, ml = refine_ltp(sysc, target, return_info=True, **options)
         nfev += ml.nfev
     return sysc, converged, nfev, ml, Gl, Gc, before
 
