@@ -253,10 +253,21 @@ _K_ALL = 8
 
 def _produced(sys):
     """Largest output harmonic |n| of the response to an input harmonic 0 (capped)."""
-    h = [M.nharmonics for M in (sys.A, sys.B, sys.C, sys.D)]
+    h = [_highest(M) for M in (sys.A, sys.B, sys.C, sys.D)]
     if any(x is None for x in h) or h[0] > 0:
         return _K_ALL
     return min(_K_ALL, max(h[1] + h[2], h[3]))
+
+
+def _highest(P):
+    """Highest non-zero harmonic of a periodic matrix (None if given as a function)."""
+    if P.nharmonics is None:
+        return None
+    c = np.abs(P.fourier(P.nharmonics))
+    size = c.reshape(c.shape[0], -1).max(axis=1)
+    K = P.nharmonics
+    nonzero = [abs(k) for k in range(-K, K + 1) if size[k + K] > 0]
+    return max(nonzero, default=0)
 
 
 def _signal(signal, true, omega, seed):
