@@ -385,7 +385,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         K if refit_harmonics == 'auto' else refit_harmonics)
     record_options = dict(frequencies=frequencies, transient=transient,
                           input_hold=input_hold, hold_step=hold_step, batch_size=batch_size)
-    G = _lifted_data(data, period, 2 * K + Hb, progress, record_options)
+    G = _lifted_data(data, period, 2 * K + Hb, progress, record_options, K)
     ny, N, Kd = _check_lifted_data(G, period, K, nstates, q)
     name = 'ltp_subspace' if name is None else name
     labels = dict(name=name, inputs=[lab.rsplit('_', 1)[0] for lab in G.input_labels],
@@ -579,16 +579,23 @@ def _fit_cost(fit, Kd, N, ny):
     return float(np.linalg.norm(_harmonic_response(sysc, G.omega, Kd) - Gc))
 
 
-def _lifted_data(data, period, Kd, progress, options):
+def _lifted_data(data, period, Kd, progress, options, K=0):
     """Step 1: the real lifted response, given or computed from time records (with
-    the harmonics -Kd..Kd, at most (N-1)/2)."""
+    the harmonics -Kd..Kd, at most (N-1)/2; from an HTF at least K)."""
     given = {key: val for key, val in options.items() if val is not None}
     if isinstance(data, (ct.FrequencyResponseData, HTF)):
         if given:
             raise TypeError(f"identify_ltp: {sorted(given)} only apply to time "
                             "records, not to frequency-response data")
         if isinstance(data, HTF):
-            return lifted_frequency_response(data, period, min(Kd, data.nharmonics))
+            # the most harmonics known together at some frequencies (band-limited
+            # chirps know few); the ML refinement fits all components of the HTF
+            for k in range(min(Kd, data.nharmonics), K, -1):
+                try:
+                    return lifted_frequency_response(data, period, k)
+                except ValueError:
+                    continue
+            return lifted_frequency_response(data, period, K)
         return data
     dt = _record_step(data)
     if dt is not None:
