@@ -49,7 +49,7 @@ def study(ninputs=1):
                     warnings.simplefilter('ignore')
                     model = ltp.identify_ltp(data, T, n, K, refit_harmonics=H)
                 elapsed = time.process_time() - start
-                cmp = ltp.compare_ltp(model, plant, UNSEEN)
+                cmp = ltp.compare_ltp(model, plant, UNSEEN, 1)
                 row.append((cmp.htf_error, cmp.exponent_error, model.B.nharmonics, elapsed))
             errors.append(row)
     return np.array(errors)

@@ -9,9 +9,15 @@ from ltpcontrol._core.lifting import _real_basis
 
 
 def random_ltp(seed, nstates=2, noutputs=1, harmonics=2, period=1.0, depth=0.3,
-               allow_negative=False, ninputs=1):
+               allow_negative=False, ninputs=1, periodic='ABC', actuator=None):
     """Random stable continuous LTP plant with harmonics up to `harmonics` in A, B, C
     (`ninputs` inputs, `noutputs` outputs).
+
+    Only the matrices named in `periodic` vary (e.g. ``'A'``: periodic A(t)
+    with constant B and C).  With ``actuator=r``, the last state is a
+    first-order actuator ``ẋ_n = -a (x_n - u)`` driving the others, with
+    ``a`` r times the largest modulus of the other exponents (a fast
+    actuator for r >= 10; one input, B constant).
 
     The mean A has exponents with real parts in [-3, -0.5] and imaginary
     parts below ω_p/4; every harmonic of A, B and C has a relative size of
@@ -45,9 +51,20 @@ def random_ltp(seed, nstates=2, noutputs=1, harmonics=2, period=1.0, depth=0.3,
                 c[harmonics + h], c[harmonics - h] = ch, ch.conj()
             return c
 
-        A = coeffs(A0, n, n, depth * scale / np.sqrt(n))
-        B = coeffs(rng.normal(size=(n, ninputs)), n, ninputs, depth)
-        C = coeffs(rng.normal(size=(noutputs, n)), noutputs, n, depth)
+        A = coeffs(A0, n, n, depth * scale / np.sqrt(n) * ('A' in periodic))
+        B = coeffs(rng.normal(size=(n, ninputs)), n, ninputs, depth * ('B' in periodic))
+        C = coeffs(rng.normal(size=(noutputs, n)), noutputs, n, depth * ('C' in periodic))
+        if actuator is not None:
+            # states 0..n-1 driven by the actuator state n through the old B_0
+            a = actuator * scale
+            Aa = np.zeros((2 * harmonics + 1, n + 1, n + 1), complex)
+            Aa[:, :n, :n] = A
+            Aa[:, :n, n] = B[:, :, 0]
+            Aa[harmonics, n, n] = -a
+            B = np.zeros((2 * harmonics + 1, n + 1, 1), complex)
+            B[harmonics, n, 0] = a
+            C = np.concatenate([C, np.zeros((2 * harmonics + 1, noutputs, 1))], axis=2)
+            A = Aa
         sys = ltp.ltpss(ltp.PeriodicMatrix(A, period), ltp.PeriodicMatrix(B, period),
                         ltp.PeriodicMatrix(C, period), 0, period=period,
                         name=f'plant{seed}')
@@ -63,9 +80,10 @@ def lifted_data(sys, nharmonics, omega, dt):
     the HTF columns of input harmonic 0, ``V^H H_{:,0}(jΩ)``."""
     K, ny, nu = nharmonics, sys.noutputs, sys.ninputs
     G = ltp.htf(sys, K)(1j * np.asarray(omega))[:, K * nu:(K + 1) * nu]   # (.., nu, M)
-    V, _ = _real_basis(np.arange(-K, K + 1), int(round(sys.period / dt)))
+    V, tags = _real_basis(np.arange(-K, K + 1), int(round(sys.period / dt)))
     Gr = np.einsum('ba,bjw->ajw', np.kron(V, np.eye(ny)).conj(), G)
-    return ct.frd(Gr, omega, dt)
+    outputs = [f'y[{i}]_{tag}' for tag in tags for i in range(ny)]
+    return ct.frd(Gr, omega, dt, outputs=outputs, inputs=[f'u[{j}]_c0' for j in range(nu)])
 
 
 def design_lines(period, nlines, wmax_factor=3.0, offset=0.37):

@@ -79,6 +79,8 @@ def test_vhop_noisy_draws_restart_to_a_stable_model(vhop, seed):
     with warnings.catch_warnings():
         warnings.simplefilter('error', UserWarning)
         warnings.filterwarnings('ignore', message='.*misses the data')       # the noise
+        # at SNR 12.5 the noise of the held-out lines alone exceeds validation_tol
+        warnings.filterwarnings('ignore', message='.*held-out lines')
         warnings.filterwarnings('ignore', message='.*Fisher information')
         model, _ = example['identify']((t, *example['with_noise'](u, y, seed)),
                                        out['records']['transient'], out['records']['lines'])

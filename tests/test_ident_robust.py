@@ -42,7 +42,7 @@ def test_thirty_random_plants():
         for K in (3, 4) if i < 6 else (3,):
             model, info = _identify(plant, K)
             assert info.success
-            cmp = ltp.compare_ltp(model, plant, UNSEEN)
+            cmp = ltp.compare_ltp(model, plant, UNSEEN, 1)
             worst[K] = np.maximum(worst[K], [cmp.htf_error, cmp.exponent_error])
     assert worst[3][0] <= 1e-3 and worst[3][1] <= 1e-3     # measured 2.3e-6, 1.0e-5
     assert worst[4][0] <= 1e-3 and worst[4][1] <= 1e-3
@@ -67,7 +67,7 @@ def test_periodic_a_plant_returns_model_and_error_decays_with_k():
         model, info = _identify(plant, K)
         assert model.nstates == 2 and model.is_floquet_form
         assert info.realization.transform is not None
-        errors.append(ltp.compare_ltp(model, plant, UNSEEN).htf_error)
+        errors.append(ltp.compare_ltp(model, plant, UNSEEN, 1).htf_error)
     assert errors[0] > 10 * errors[1] > 100 * errors[2] and errors[2] < 1e-3
 
 
@@ -82,7 +82,7 @@ def test_missing_ladder_realized_with_fewer_harmonics():
     assert direct.realized_harmonics < 4
     model, info = _identify(plant, 4)
     assert info.relative_residual < 1e-5
-    assert ltp.compare_ltp(model, plant, UNSEEN).exponent_error < 1e-4
+    assert ltp.compare_ltp(model, plant, UNSEEN, 1).exponent_error < 1e-4
 
 
 def test_compare_ltp_is_branch_and_basis_invariant():
@@ -175,10 +175,10 @@ def test_refit_harmonics_remove_exponent_bias(seed, n, ny):
     4.9e-3): the default refit gives B(t) K + 1 harmonics, which brings them
     within 2e-5 (measured <= 1.0e-5) and lowers the HTF error."""
     plant = random_ltp(seed, n, ny)
-    base = ltp.compare_ltp(_identify(plant, 3, refit_harmonics=3)[0], plant, UNSEEN)
+    base = ltp.compare_ltp(_identify(plant, 3, refit_harmonics=3)[0], plant, UNSEEN, 1)
     model, _ = _identify(plant, 3)
     assert model.B.nharmonics == 4 and model.C.nharmonics <= 6
-    wide = ltp.compare_ltp(model, plant, UNSEEN)
+    wide = ltp.compare_ltp(model, plant, UNSEEN, 1)
     assert base.exponent_error > 1e-3 and wide.exponent_error <= 2e-5
     assert wide.htf_error <= 1e-5 and wide.htf_error < base.htf_error
 
@@ -197,8 +197,8 @@ def test_refit_harmonic_kept_only_where_determined():
     unseen = [1.1, 2.9, 7.3, 13.3, 21.7]
     wide = ltp.identify_ltp(G, 0.5, 1, 1, q=10, refit_harmonics=2)
     model = ltp.identify_ltp(G, 0.5, 1, 1, q=10)
-    assert wide.B.nharmonics == 2 and ltp.compare_ltp(wide, sys, unseen).htf_error > 0.1
-    assert model.B.nharmonics == 1 and ltp.compare_ltp(model, sys, unseen).htf_error < 1e-5
+    assert wide.B.nharmonics == 2 and ltp.compare_ltp(wide, sys, unseen, 1).htf_error > 0.1
+    assert model.B.nharmonics == 1 and ltp.compare_ltp(model, sys, unseen, 1).htf_error < 1e-5
 
 
 def test_refit_harmonics_checked():

@@ -23,11 +23,13 @@ The errors of eq. (4.125) are normalised norms: ``‖A - Â‖_2 / ‖A‖_2``
 from typing import NamedTuple
 
 import numpy as np
+import scipy.signal
 from control.exception import ControlArgument, ControlDimension
 from scipy.optimize import linear_sum_assignment
 
 from .._core.ltpsys import ltpss
 from .._core.floquet import floquet_exponents
+from .._core.timeresp import forced_response
 from .._frequency.htf import htf
 from .._core.validation import as_ltp, check_kwargs, check_positive_int, real_array
 
@@ -225,6 +227,11 @@ class LTPComparison(NamedTuple):
         moved to the branch nearest to them.
     exponents_true : ndarray
         Floquet exponents of `true`.
+    time_nrmse : float
+        ``‖y_est - y_true‖ / ‖y_true‖`` of the simulated responses to the
+        `signal` of `compare_ltp` (NaN without a signal).
+    nharmonics : int
+        Harmonics K of the compared HTF blocks.
 
     Examples
     --------
@@ -236,9 +243,62 @@ class LTPComparison(NamedTuple):
     exponent_error: float
     exponents: np.ndarray
     exponents_true: np.ndarray
+    time_nrmse: float = np.nan
+    nharmonics: int = 0
 
 
-def compare_ltp(est, true, omega, nharmonics=1, **kwargs):
+#: harmonics compared by default when a system's are unbounded (periodic A) or unknown
+_K_ALL = 8
+
+
+def _produced(sys):
+    """Largest output harmonic |n| of the response to an input harmonic 0 (capped)."""
+    h = [_highest(M) for M in (sys.A, sys.B, sys.C, sys.D)]
+    if any(x is None for x in h) or h[0] > 0:
+        return _K_ALL
+    return min(_K_ALL, max(h[1] + h[2], h[3]))
+
+
+def _highest(P):
+    """Highest non-zero harmonic of a periodic matrix (None if given as a function)."""
+    if P.nharmonics is None:
+        return None
+    c = np.abs(P.fourier(P.nharmonics))
+    size = c.reshape(c.shape[0], -1).max(axis=1)
+    K = P.nharmonics
+    nonzero = [abs(k) for k in range(-K, K + 1) if size[k + K] > 0]
+    return max(nonzero, default=0)
+
+
+def _signal(signal, true, omega, seed):
+    """(timepts, inputs) of the time-domain comparison."""
+    if isinstance(signal, str):
+        if signal != 'noise':
+            raise ValueError(f"signal must be None, 'noise' or (timepts, inputs), got "
+                             f"{signal!r}")
+        # white noise low-passed to the compared band: 30 periods, 64 samples each
+        rng = np.random.default_rng(seed)
+        dt = true.dt if true.isdtime(strict=True) else true.period / 64
+        L = int(round(30 * true.period / dt))
+        cut = min(float(np.max(omega)) * dt / np.pi, 0.9)
+        b, a = scipy.signal.butter(4, cut)
+        u = scipy.signal.lfilter(b, a, rng.standard_normal((true.ninputs, L)), axis=1)
+        return np.arange(L) * dt, u
+    try:
+        t, u = signal
+    except (TypeError, ValueError):
+        raise ControlArgument("signal must be None, 'noise' or a tuple (timepts, inputs)"
+                              ) from None
+    t = real_array(t, 'signal timepts', ndim=1)
+    u = real_array(u, 'signal inputs', ndim=(1, 2))
+    u = u.reshape(true.ninputs, -1) if u.ndim == 1 or true.ninputs == 1 else u
+    if u.shape != (true.ninputs, t.size):
+        raise ControlDimension(f"signal inputs must have shape (ninputs, len(timepts)) = "
+                               f"{(true.ninputs, t.size)}, got {u.shape}")
+    return t, u
+
+
+def compare_ltp(est, true, omega, nharmonics='all', *, signal=None, seed=0, **kwargs):
     """Compare two LTP systems by their HTFs and Floquet exponents.
 
     Both quantities are invariant under any (periodic) change of state
@@ -257,13 +317,27 @@ def compare_ltp(est, true, omega, nharmonics=1, **kwargs):
     omega : array_like
         Frequencies (rad/s) at which the HTFs are compared, e.g. lines not
         used for identification.
-    nharmonics : int, optional
-        Harmonics -K..K of the compared HTF blocks (default 1).
+    nharmonics : int or 'all', optional
+        Harmonics -K..K of the compared HTF blocks.  'all' (default): every
+        output harmonic either system produces, ``K = max(K_B + K_C, K_D)``
+        for a system with constant A (a Floquet-form model), and 8 for a
+        periodic A (infinitely many) or matrices given as functions.  Small
+        K understates the prediction error of a model whose outer
+        harmonics are wrong.
+    signal : None, 'noise' or tuple, optional
+        Also compare in the time domain: the responses of both systems from
+        the zero state to ``(timepts, inputs)`` (inputs of shape
+        ``(ninputs, len(timepts))``), or to white noise low-passed to
+        ``max(omega)`` over 30 periods of 64 samples ('noise', drawn with
+        `seed`), simulated by `ltpcontrol.forced_response`.  Default None.
+    seed : int, optional
+        Seed of the 'noise' signal (default 0).
 
     Returns
     -------
     LTPComparison
-        ``(htf_error, exponent_error, exponents, exponents_true)``.
+        ``(htf_error, exponent_error, exponents, exponents_true,
+        time_nrmse, nharmonics)``.
 
     Raises
     ------
@@ -288,13 +362,28 @@ def compare_ltp(est, true, omega, nharmonics=1, **kwargs):
     >>> cmp = ltp.compare_ltp(est, true, [0.5, 1.5])
     >>> cmp.htf_error < 1e-12, cmp.exponent_error < 1e-12
     (True, True)
+    >>> cmp.nharmonics                              # B has 1 harmonic, C none
+    1
+    >>> cmp = ltp.compare_ltp(est, true, [0.5, 1.5], signal='noise')
+    >>> bool(cmp.time_nrmse < 1e-10)
+    True
     """
     check_kwargs(kwargs, 'compare_ltp')
     _check_pair(est, true)
     omega = real_array(omega, 'omega', ndim=(0, 1)).ravel()
     if omega.size == 0:
         raise ValueError("omega must hold at least one frequency")
-    K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
+    if isinstance(nharmonics, str) and nharmonics == 'all':
+        K = max(_produced(est), _produced(true))
+    else:
+        K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
+    time_nrmse = np.nan
+    if signal is not None:
+        t, u = _signal(signal, true, omega, seed)
+        yt = forced_response(true, t, u).outputs
+        ye = forced_response(est, t, u).outputs
+        time_nrmse = float(np.linalg.norm(ye - yt) / max(np.linalg.norm(yt),
+                                                         np.finfo(float).tiny))
     s = np.exp(1j * omega * true.dt) if true.isdtime(strict=True) else 1j * omega
     Ht, He = htf(true, K)(s), htf(est, K)(s)
     scale = max(np.linalg.norm(Ht, axis=(0, 1)).max(), np.finfo(float).tiny)
@@ -312,7 +401,7 @@ def compare_ltp(est, true, omega, nharmonics=1, **kwargs):
     dist = np.abs(moved - lt[:, None])
     rows, cols = linear_sum_assignment(dist)
     return LTPComparison(htf_error, float(dist[rows, cols].max()) if lt.size else 0.0,
-                         moved[rows, cols], lt)
+                         moved[rows, cols], lt, time_nrmse, K)
 
 
 def _check_pair(est, true):

@@ -26,6 +26,7 @@ M)``: entry ``[j, n + K, :, w]`` is ``G_n(jΩ_w)`` of input j.
 """
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from .._core.lifting import _real_basis
 from .._core.ltpsys import LTPStateSpace
@@ -98,10 +99,11 @@ def _conj_map(H, size):
 
 class _FloquetFit:
     """Real parameter vector θ = (B, C, D coefficients[, A]) of a model with H
-    harmonics in B fitted to K data harmonics."""
+    harmonics in B, 2K in C and K in D fitted to the data harmonics |n| <= Kd."""
 
-    def __init__(self, nx, ny, nu, K, H, period, estimate_d, fit_a):
+    def __init__(self, nx, ny, nu, K, H, period, estimate_d, fit_a, Kd=None):
         self.nx, self.ny, self.nu, self.K, self.H = nx, ny, nu, K, H
+        self.Kd = K if Kd is None else Kd
         self.wp, self.fit_a = 2 * np.pi / period, fit_a
         Tb, Tc, Td = _conj_map(H, nx * nu), _conj_map(2 * K, ny * nx), _conj_map(K, ny * nu)
         self.nb, self.nc, self.nd = Tb.shape[0], Tc.shape[0], Td.shape[0]
@@ -110,7 +112,9 @@ class _FloquetFit:
         T[:nb, :nb], T[nb:nb + nc, nb:nb + nc], T[nb + nc:, nb + nc:] = Tb, Tc, Td
         self.T = T if estimate_d else T[:, :nb + nc]
         self.ncoef = self.T.shape[1]
-        self.cpad = ((H - K, H - K), (0, 0), (0, 0))          # C_l = 0 for 2K < |l| <= K+H
+        Kd = self.Kd
+        self.cpad = ((Kd + H - 2 * K,) * 2, (0, 0), (0, 0))   # C_l = 0 for 2K < |l| <= Kd+H
+        self.dpad = ((Kd - K,) * 2, (0, 0), (0, 0))           # D_n = 0 for K < |n| <= Kd
 
     def pack(self, sys):
         K, H = self.K, self.H
@@ -126,28 +130,31 @@ class _FloquetFit:
             A = theta[self.ncoef:].reshape(nx, nx)
         return (A, c[:nb].reshape(2 * H + 1, nx, nu),
                 np.pad(c[nb:nb + nc].reshape(4 * K + 1, ny, nx), self.cpad),
-                c[nb + nc:].reshape(2 * K + 1, ny, nu))
+                np.pad(c[nb + nc:].reshape(2 * K + 1, ny, nu), self.dpad))
 
     def response_and_jacobian(self, theta, omega, A=None, jac=True):
-        """Harmonic response (nu, 2K+1, ny, M) and its Jacobian (nu (2K+1) ny M, len θ)."""
-        K, H, nx, ny, nu = self.K, self.H, self.nx, self.ny, self.nu
+        """Harmonic response (nu, 2Kd+1, ny, M) and its Jacobian (nu (2Kd+1) ny M, len θ)."""
+        K, H, nx, ny, nu, Kd = self.K, self.H, self.nx, self.ny, self.nu, self.Kd
         A, Bc, Cc, Dc = self.unpack(theta, A)
         R = _resolvents(A, omega, self.wp, H)
-        G = _model_response(R, Bc, Cc, Dc, K, H)
+        G = _model_response(R, Bc, Cc, Dc, Kd, H)
         if not jac:
             return G, None
         M, m = omega.size, np.arange(-H, H + 1)
-        CR = np.einsum('nmoi,wmij->nowmj', _cnm(Cc, K, H), R)     # C_{n-m} R_m
+        CR = np.einsum('nmoi,wmij->nowmj', _cnm(Cc, Kd, H), R)    # C_{n-m} R_m
         X = np.einsum('wmij,mjq->wmiq', R, Bc)                     # R_m B_m, (w, m, i, q)
         # rows (q, n, o, w) of G;  dG_n = Σ_m C_{n-m} R_m dB_m
         eu, ey = np.eye(nu), np.eye(ny)
         JB = np.einsum('nowmi,qr->qnowmir', CR, eu)
-        # dG_n = Σ_l dC_l X_{n-l}, |n-l| <= H
-        Xsel = np.zeros((2 * K + 1, 2 * (K + H) + 1, M, nx, nu), complex)
-        for a, n in enumerate(range(-K, K + 1)):
-            Xsel[a, n - m + K + H] = X.transpose(1, 0, 2, 3)
-        JC = np.einsum('oz,nlwiq->qnowlzi', ey, Xsel[:, H - K:H + 3 * K + 1])
-        JD = np.einsum('qr,na,oz,w->qnowazr', eu, np.eye(2 * K + 1), ey, np.ones(M))
+        # dG_n = Σ_l dC_l X_{n-l}, |n-l| <= H, |l| <= 2K
+        L = Kd + H
+        Xsel = np.zeros((2 * Kd + 1, 2 * L + 1, M, nx, nu), complex)
+        for a, n in enumerate(range(-Kd, Kd + 1)):
+            Xsel[a, n - m + L] = X.transpose(1, 0, 2, 3)
+        JC = np.einsum('oz,nlwiq->qnowlzi', ey, Xsel[:, L - 2 * K:L + 2 * K + 1])
+        # dG_n = dD_n, |n| <= K
+        JD = np.einsum('qr,na,oz,w->qnowazr', eu, np.eye(2 * Kd + 1, 2 * K + 1, Kd - K), ey,
+                       np.ones(M))
         J = np.hstack([Jx.reshape(G.size, -1) for Jx in (JB, JC, JD)]) @ self.T
         if self.fit_a:
             # dR_m = R_m dA R_m:  dG_n = Σ_m C_{n-m} R_m dA R_m B_m
@@ -157,11 +164,13 @@ class _FloquetFit:
 
 
 def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=True,
-                maxiter=50, rtol=1e-8, **labels):
-    """Least-squares Floquet-form model fitted to ``G_n(jΩ)``, n = -K..K, with
+                maxiter=50, rtol=1e-8, progress=False, **labels):
+    """Least-squares Floquet-form model fitted to ``G_n(jΩ)``, n = -Kd..Kd, with
     `harmonics` H >= K harmonics in B (default K), 2K in C, K in D.
 
-    `Gc` has the shape (nu, 2K+1, ny, M) of `_harmonic_response`.
+    `Gc` has the shape (nu, 2Kd+1, ny, M) of `_harmonic_response`, Kd >= K
+    the data harmonics.  The model produces the output harmonics ``|n| <=
+    2K + H``: with ``Kd >= 2K + H`` every one of them is fitted.
 
     Starts from the Floquet-form LTPStateSpace `sys` and minimises
     ``Σ |G_n(jΩ) - Ĝ_n|²`` over the lines Ω (rad/s) and n = -K..K (module
@@ -186,7 +195,10 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
     """
     nu, ny, nx = Gc.shape[0], Gc.shape[2], sys.nstates
     H = K if harmonics is None else harmonics
-    fit = _FloquetFit(nx, ny, nu, K, H, sys.period, estimate_d, fit_a)
+    Kd = (Gc.shape[1] - 1) // 2
+    if Kd < K:
+        raise ValueError(f"the data have {Kd} harmonics, fewer than the model's {K}")
+    fit = _FloquetFit(nx, ny, nu, K, H, sys.period, estimate_d, fit_a, Kd)
     A0 = sys.A(0.0)
     scale = max(np.linalg.norm(Gc), np.finfo(float).tiny)
 
@@ -204,7 +216,9 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
     r, J = cost(theta, True)
     f = r @ r
     mu, converged = 0.0, False
+    bar = tqdm(total=maxiter, desc="refit", disable=not progress, leave=False)
     for _ in range(maxiter):
+        bar.update(1)
         # column scaling, floored so that (nearly) uninfluential parameters stay put
         colnorm = np.linalg.norm(J, axis=0)
         colnorm = np.maximum(colnorm, 1e-8 * max(colnorm.max(), np.finfo(float).tiny))
@@ -233,9 +247,12 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
             converged = True
             break
         r, J = cost(theta, True)
+    bar.close()
     A, Bc, Cc, Dc = fit.unpack(theta, A0)
     period = sys.period
-    Cc = Cc[H - K:H + 3 * K + 1]                                  # harmonics -2K..2K
+    L = Kd + H
+    Cc = Cc[L - 2 * K:L + 2 * K + 1]                              # harmonics -2K..2K
+    Dc = Dc[Kd - K:Kd + K + 1]                                    # harmonics -K..K
     model = LTPStateSpace(A, PeriodicMatrix(Bc, period), PeriodicMatrix(Cc, period),
                           PeriodicMatrix(Dc, period), period, states=sys.state_labels,
                           **labels)

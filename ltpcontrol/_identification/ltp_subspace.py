@@ -37,7 +37,8 @@ from .._core.ltpsys import LTPStateSpace
 from .._core.periodic_matrix import PeriodicMatrix
 from .realization import FloquetRealization, floquet_realization
 from .refine import RefineInfo, _harmonics, refine_ltp
-from .._core.validation import check_kwargs, check_period, check_positive_int, steps_per_period
+from .._core.validation import (check_kwargs, check_period, check_positive, check_positive_int,
+                                steps_per_period)
 
 __all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
 
@@ -85,6 +86,17 @@ class LTPSubspaceInfo:
     refinement : RefineInfo or None
         With ``refine='ml'``: the `RefineInfo` of the refinement
         (parameters, covariance, ``realize``; e.g. for `sample_models`).
+    holdout_nrmse : float
+        Normalized RMS error of the model identified without the held-out
+        lines on those lines (time-domain steady-state output, all
+        harmonics of the data; see `identify_ltp`); NaN without validation.
+    holdout_lines : ndarray
+        The held-out lines (rad/s); empty without validation.
+    data_harmonics : int
+        Harmonics ``K_d`` of the data fitted by the refit and refinement.
+    refine_fallback : bool
+        True when the ML refinement predicted the held-out lines worse than
+        its start and the start was kept.
 
     Examples
     --------
@@ -103,14 +115,19 @@ class LTPSubspaceInfo:
     relative_residual: float
     realized_harmonics: int
     refinement: RefineInfo = None
+    holdout_nrmse: float = np.nan
+    holdout_lines: np.ndarray = None
+    data_harmonics: int = 0
+    refine_fallback: bool = False
 
 
 def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
                  realization='direct', realization_options=None, refit_a=True,
                  refit_harmonics='auto', refine=None, refine_options=None,
                  estimate_d=True, frequencies=None, transient=None, input_hold=None,
-                 hold_step=None, batch_size=None, seed=None, progress=False,
-                 return_info=False, name=None, **kwargs):
+                 hold_step=None, batch_size=None, seed=None, holdout=4,
+                 validation_tol=0.05, progress=False, return_info=False, name=None,
+                 **kwargs):
     r"""Identify a continuous-time LTP model from sine experiments (thesis §4.2).
 
     Runs the whole frequency-domain subspace pipeline: lifted frequency
@@ -200,8 +217,24 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         the hold's bias on the direct term.
     seed : int, optional
         Seed of the 'pso' realization search (reproducibility).
+    holdout : int or None, optional
+        Validation on held-out lines (default 4): every `holdout`-th line
+        (starting with the second) is kept out of the identification; the
+        model identified from the other lines predicts them, and its
+        normalized RMS error ``info.holdout_nrmse`` decides ``success``
+        (see Notes).  The returned model is then refitted on all lines
+        from the validated one ('refit'; identified again from all lines
+        for 'log', 'tustin' and ``refit_a=False``, whose A is that of the
+        realization).  None (or too few lines for the subspace
+        step without them, with a warning) skips the validation.
+    validation_tol : float, optional
+        Largest held-out NRMSE of a successful model (default 0.05).
+        Noise in the held-out data raises the NRMSE of a perfect model: at
+        an output SNR of 20 dB, with 20 periods of 40 samples per line, to
+        about 0.02.
     progress : bool, optional
-        Show progress bars (experiment batches, realization; default False).
+        Show progress bars (experiment batches, realization, refit; default
+        False).
     return_info : bool, optional
         Also return an `LTPSubspaceInfo` (``success``, ``message``,
         ``nfev`` and the intermediate results).
@@ -233,7 +266,9 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     Warns
     -----
     UserWarning
-        With 'refit': if the returned model misses the data by more than
+        If the model misses its held-out lines by more than
+        `validation_tol` (the warning names ``holdout_nrmse``).  With
+        'refit': if the returned model misses the data by more than
         the realization's ``fit_tol`` (default 0.05, relative residual) or
         the refit stops before converging.  With 'log' or 'tustin': if the
         realization does not find the Floquet structure or had to use
@@ -281,6 +316,31 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     the Mathieu example, above 6e5 for a constant-C plant identified from
     time records).
 
+    Every output harmonic the model produces is fitted.  A Floquet-form
+    model with H harmonics in B, 2K in C and K in D responds to a line Ω at
+    the output frequencies ``Ω + nω_p``, ``|n| <= 2K + H``.  From time
+    records, the lifted data are therefore analysed at the harmonics
+    ``|n| <= K_d = 2K + H`` (H = K + 1 for ``refit_harmonics='auto'``;
+    at most ``(N-1)/2`` for N samples per period): the subspace step and the
+    realization use the harmonics ``|n| <= K``, the refit and the ML
+    refinement all of them.  A harmonic the model produces but the data
+    do not hold is not determined by the data, yet it enters every
+    prediction (on a plant with periodic A(t) its error can exceed the
+    plant's own harmonic 100-fold).  Lifted data given as
+    `control.FrequencyResponseData` are used with the harmonics they hold
+    (their output labels ``'<y>_c0'``, ``'<y>_c1'``, ... tell how many);
+    when these are fewer than the model produces, ``info.message`` says so.
+
+    Validation.  ``holdout_nrmse = ‖Ĝ - G‖ / ‖G‖`` over the held-out
+    lines, all inputs, outputs and harmonics ``|n| <= K_d`` of the data.
+    By Parseval this is the normalized RMS error ``‖ŷ - y‖ / ‖y‖`` of the
+    model's steady-state output in the time domain, for the held-out
+    single-sine records of equal amplitude (or one multisine of the
+    held-out lines): the whole output the model predicts, since it has no
+    harmonics beyond ``K_d``.  With ``refine='ml'`` the refined model is
+    kept only if it predicts the held-out lines at least as well as its
+    start; otherwise the start is returned and ``info.message`` says so.
+
     The identified model and the true system are related by a periodic
     change of state: compare them with `ltpcontrol.compare_ltp` (HTFs and
     Floquet exponents modulo ``jω_p``).  `ltpcontrol.to_canonical` removes
@@ -317,47 +377,85 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     elif refine == 'ml' and (refine_options or {}).get('harmonics') is not None:
         # the refinement fixes the harmonics of B: the refit starts it with them
         refit_harmonics = max(K, _harmonics(refine_options['harmonics'], None, K)[0])
-    # 1. lifted frequency response
+    if holdout is not None:
+        holdout = check_positive_int(holdout, 'holdout', minimum=2)
+    validation_tol = check_positive(validation_tol, 'validation_tol')
+    # 1. lifted frequency response, with every output harmonic the model produces
+    Hb = K + 1 if refit_harmonics == 'auto' and K > 0 else (
+        K if refit_harmonics == 'auto' else refit_harmonics)
     record_options = dict(frequencies=frequencies, transient=transient,
                           input_hold=input_hold, hold_step=hold_step, batch_size=batch_size)
-    G = _lifted_data(data, period, K, progress, record_options)
-    ny, N = _check_lifted_data(G, period, K, nstates, q)
+    G = _lifted_data(data, period, 2 * K + Hb, progress, record_options, K)
+    ny, N, Kd = _check_lifted_data(G, period, K, nstates, q)
     name = 'ltp_subspace' if name is None else name
     labels = dict(name=name, inputs=[lab.rsplit('_', 1)[0] for lab in G.input_labels],
                   outputs=[lab.rsplit('_', 1)[0] for lab in G.output_labels[:ny]])
-    Gc = _harmonic_data(G.frdata, K, N, ny)
-    # 2-4. subspace model, Floquet realization (fewer harmonics if better), continuous time
-    candidates = _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, realization, seed,
-                          progress, realization_options, conversion, labels)
-    # 5-6. structured refit and optional maximum-likelihood refinement
-    fit = dict(data=data, period=period, G=G, Gc=Gc, K=K, N=N, ny=ny, conversion=conversion,
-               refit_harmonics=refit_harmonics, estimate_d=estimate_d, refit_a=refit_a,
-               labels=labels, input_hold=input_hold, record_options=record_options,
-               refine=refine, refine_options=refine_options)
-    chosen, (sysc, converged, nfev, ml, G, Gc) = 0, _fit_and_refine(candidates[0][-1], **fit)
-    if not sysc.is_stable() and len(candidates) > 1:
-        # steady-state data come from a stable plant: a local fit that left the
-        # stable models is restarted from the other realizations; keep the stable
-        # fit of lowest cost, if any
-        best = None
-        for i, cand in enumerate(candidates[1:], start=1):
-            trial = _fit_and_refine(cand[-1], **fit)
-            nfev += trial[2]
-            if trial[0].is_stable():
-                cost = _fit_cost(trial, K)
-                if best is None or cost < best[0]:
-                    best = (cost, i, trial)
-        if best is not None:
-            chosen, (sysc, converged, _, ml, G, Gc) = best[1], best[2]
-    lifted, sinfo, real, Kr, _ = candidates[chosen]
+    M = G.omega.size
+    held = np.zeros(M, bool)
+    if holdout is not None:
+        held[1::holdout] = True
+        if not _enough_lines(M - int(held.sum()), K, nstates, q):
+            warnings.warn(f"{M} lines are too few to hold every {holdout}-th out for "
+                          "validation: the model is not validated (holdout_nrmse is NaN)",
+                          UserWarning, stacklevel=2)
+            held[:] = False
+    ctx = dict(data=data, period=period, K=K, Kd=Kd, N=N, ny=ny, nstates=nstates, q=q,
+               conversion=conversion, refit_harmonics=refit_harmonics,
+               estimate_d=estimate_d, refit_a=refit_a, labels=labels,
+               input_hold=input_hold, record_options=record_options, refine=refine,
+               refine_options=refine_options, realization=realization, seed=seed,
+               progress=progress, realization_options=realization_options)
+    holdout_nrmse, fallback, nfev = np.nan, False, 0
+    if held.any():
+        # 2-6 without the held-out lines; their prediction validates the structure
+        val = _identify_lines(G, ~held, ctx, htf=None)
+        nfev += val['nfev']
+        holdout_nrmse = _nrmse(val['sys'], G, held, Kd, N, ny)
+        if val['ml'] is not None:
+            before = _nrmse(val['start'], G, held, Kd, N, ny)
+            if holdout_nrmse > before:
+                # the refinement must not predict worse than its start
+                fallback, holdout_nrmse = True, before
+        if conversion == 'refit' and refit_a:
+            # the validated model, refitted on all lines
+            ctx_all = dict(ctx, refine=None if fallback else refine)
+            start = val['start'] if fallback else val['sys']
+            fit = _fit_and_refine(start, G=G, lines=np.ones(M, bool), htf=data, **_fit_args(
+                ctx_all))
+            res = dict(val, sys=fit[0], converged=fit[1], ml=fit[3], start=fit[6])
+            nfev += fit[2]
+        else:
+            # A is that of the realization: identified again from all lines
+            res = _identify_lines(G, np.ones(M, bool), dict(
+                ctx, refine=None if fallback else refine), htf=data)
+            nfev += res['nfev']
+    else:
+        res = _identify_lines(G, np.ones(M, bool), ctx, htf=data)
+        nfev += res['nfev']
+    sysc, converged, ml, Kr = res['sys'], res['converged'], res['ml'], res['Kr']
+    real = res['realization']
     if conversion == 'refit' and not converged:
         warnings.warn("the least-squares refit did not converge", UserWarning, stacklevel=2)
-    Kc = K if conversion == 'refit' else min(K, Kr)
-    Gk = Gc if Kc == K else _harmonic_data(G.frdata, Kc, N, ny)
-    relres = float(np.linalg.norm(_harmonic_response(sysc, G.omega, Kc) - Gk)
-                   / np.linalg.norm(Gk))
+    Gc = _harmonic_data(G.frdata, Kd, N, ny)
+    relres = float(np.linalg.norm(_harmonic_response(sysc, G.omega, Kd) - Gc)
+                   / np.linalg.norm(Gc))
     success, message = _quality(real, Kr, K, conversion, relres, converged, ml,
                                 realization_options)
+    produced = 2 * K + max(K, sysc.B.nharmonics or 0)
+    if Kd < produced:
+        message += (f"; the data hold the output harmonics |n| <= {Kd}, the model produces "
+                    f"|n| <= {produced}: those above {Kd} are not fitted")
+    if fallback:
+        message += ("; the ML refinement predicted the held-out lines worse than its "
+                    "start, which is kept")
+    if held.any():
+        message += f"; held-out NRMSE {holdout_nrmse:.3g} (validation_tol {validation_tol:g})"
+        if not holdout_nrmse <= validation_tol:
+            success = False
+            warnings.warn(f"the identified model does not predict its held-out lines: "
+                          f"holdout_nrmse {holdout_nrmse:.3g} > validation_tol "
+                          f"{validation_tol:g}; try other nstates, nharmonics or more "
+                          "data", UserWarning, stacklevel=2)
     if not sysc.is_stable():
         # steady-state responses exist only for a stable plant: an unstable fit is doubtful
         growth = float(np.max(np.linalg.eigvals(sysc.A(0.0)).real))
@@ -369,78 +467,179 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     if not return_info:
         return sysc
     return sysc, LTPSubspaceInfo(
-        success=success, message=message, nfev=nfev, data=G, lifted=lifted, subspace=sinfo,
-        realization=real, conversion=conversion, relative_residual=relres,
-        realized_harmonics=Kr, refinement=ml)
+        success=success, message=message, nfev=nfev, data=G, lifted=res['lifted'],
+        subspace=res['subspace'], realization=real, conversion=conversion,
+        relative_residual=relres, realized_harmonics=Kr, refinement=ml,
+        holdout_nrmse=float(holdout_nrmse), holdout_lines=G.omega[held],
+        data_harmonics=Kd, refine_fallback=fallback)
 
 
-def _fit_and_refine(start, *, data, period, G, Gc, K, N, ny, conversion, refit_harmonics,
-                    estimate_d, refit_a, labels, input_hold, record_options, refine,
-                    refine_options):
-    """Steps 5-6 from the realization `start`: ``(model, converged, nfev, ml, G, Gc)``."""
+def _fit_args(ctx):
+    """The keywords of `_fit_and_refine` in the context `ctx`."""
+    keys = ('data', 'period', 'K', 'Kd', 'N', 'ny', 'conversion', 'refit_harmonics',
+            'estimate_d', 'refit_a', 'labels', 'input_hold', 'record_options', 'refine',
+            'refine_options', 'progress')
+    return {key: ctx[key] for key in keys}
+
+
+def _select_lines(G, lines, K, ny):
+    """The lifted data of harmonics -K..K on the lines `lines` (bool mask)."""
+    return ct.frd(G.frdata[:(2 * K + 1) * ny, :, lines], G.omega[lines], G.dt,
+                  inputs=G.input_labels, outputs=G.output_labels[:(2 * K + 1) * ny])
+
+
+def _nrmse(sys, G, lines, Kd, N, ny):
+    """``‖Ĝ - G‖ / ‖G‖`` on the lines `lines`, harmonics -Kd..Kd (the steady-state
+    time-domain NRMSE of the held-out records, by Parseval)."""
+    Gc = _harmonic_data(G.frdata, Kd, N, ny)[..., lines]
+    with np.errstate(all='ignore'):
+        err = np.linalg.norm(_harmonic_response(sys, G.omega[lines], Kd) - Gc)
+    err = err / max(np.linalg.norm(Gc), np.finfo(float).tiny)
+    return float(err) if np.isfinite(err) else np.inf
+
+
+def _enough_lines(M, K, nstates, q):
+    """The subspace step of order (2K+1) n_p with `q` block rows can use M lines."""
+    order = (2 * K + 1) * nstates
+    return 2 * M >= 2 * order + 1 and (q is None or 2 * M >= q + order)
+
+
+def _identify_lines(G, lines, ctx, htf):
+    """Steps 2-6 on the lines `lines` of the lifted data G (harmonics -Kd..Kd)."""
+    K, Kd, N, ny = ctx['K'], ctx['Kd'], ctx['N'], ctx['ny']
+    GK = _select_lines(G, lines, K, ny)
+    GcK = _harmonic_data(GK.frdata, K, N, ny)
+    # 2-4. subspace model, Floquet realization (fewer harmonics if better), continuous time
+    candidates = _realize(GK, GcK, ctx['period'], K, N, ctx['nstates'], ny, ctx['q'],
+                          ctx['estimate_d'], ctx['realization'], ctx['seed'], ctx['progress'],
+                          ctx['realization_options'], ctx['conversion'], ctx['labels'])
+    # 5-6. structured refit and optional maximum-likelihood refinement
+    fit = dict(_fit_args(ctx), G=G, lines=lines, htf=htf)
+    chosen, trial = 0, _fit_and_refine(candidates[0][-1], **fit)
+    nfev = trial[2]
+    if not trial[0].is_stable() and len(candidates) > 1:
+        # steady-state data come from a stable plant: a local fit that left the
+        # stable models is restarted from the other realizations; keep the stable
+        # fit of lowest cost, if any
+        best = None
+        for i, cand in enumerate(candidates[1:], start=1):
+            other = _fit_and_refine(cand[-1], **fit)
+            nfev += other[2]
+            if other[0].is_stable():
+                cost = _fit_cost(other, Kd, N, ny)
+                if best is None or cost < best[0]:
+                    best = (cost, i, other)
+        if best is not None:
+            chosen, trial = best[1], best[2]
+    lifted, sinfo, real, Kr, _ = candidates[chosen]
+    return dict(sys=trial[0], converged=trial[1], nfev=nfev, ml=trial[3], start=trial[6],
+                lifted=lifted, subspace=sinfo, realization=real, Kr=Kr)
+
+
+def _fit_and_refine(start, *, data, period, G, lines, htf, K, Kd, N, ny, conversion,
+                    refit_harmonics, estimate_d, refit_a, labels, input_hold,
+                    record_options, refine, refine_options, progress):
+    """Steps 5-6 from the realization `start` on the lines `lines` of G:
+    ``(model, converged, nfev, ml, G, Gc, model before refinement)``."""
     sysc, nfev, converged = start, 0, True
+    Gl = _select_lines(G, lines, Kd, ny)
+    Gc = _harmonic_data(Gl.frdata, Kd, N, ny)
     if conversion == 'refit':
-        sysc, converged, nfev = _refit(sysc, Gc, G.omega, K, refit_harmonics, estimate_d,
-                                       refit_a, labels)
+        sysc, converged, nfev = _refit(sysc, Gc, Gl.omega, K, refit_harmonics, estimate_d,
+                                       refit_a, labels, progress)
         if estimate_d and input_hold is not None and not isinstance(
-                data, ct.FrequencyResponseData):
+                data, (ct.FrequencyResponseData, HTF)):
             # the direct term sees the samples, not the held input: redo the
             # hold correction with the fitted D(t) and refit once more
             options = dict(record_options, feedthrough=sysc.D)
-            G = _lifted_data(data, period, K, False, options)
-            Gc = _harmonic_data(G.frdata, K, N, ny)
-            sysc, converged, more = _refit(sysc, Gc, G.omega, K, refit_harmonics, True,
-                                           refit_a, labels)
+            Gall = _lifted_data(data, period, Kd, False, options)
+            Gl = _select_lines(Gall, np.isin(Gall.omega, Gl.omega), Kd, ny)
+            Gc = _harmonic_data(Gl.frdata, Kd, N, ny)
+            sysc, converged, more = _refit(sysc, Gc, Gl.omega, K, refit_harmonics, True,
+                                           refit_a, labels, progress)
             nfev += more
-    ml = None
+    before, ml = sysc, None
     if refine == 'ml':
-        sysc, ml = refine_ltp(sysc, data if isinstance(data, HTF) else G, return_info=True,
-                              **(refine_options or {}))
+        target = htf if isinstance(htf, HTF) else Gl
+        options = dict(refine_options or {})
+        std = options.get('std')
+        if std is not None and not isinstance(htf, HTF) and np.ndim(std) >= 1 \
+                and np.shape(std)[-1] == lines.size:
+            options['std'] = np.asarray(std)[..., lines]        # std of the lines used
+        sysc, ml = refine_ltp(sysc, target, return_info=True, **options)
         nfev += ml.nfev
-    return sysc, converged, nfev, ml, G, Gc
+    return sysc, converged, nfev, ml, Gl, Gc, before
 
 
-def _fit_cost(fit, K):
+def _fit_cost(fit, Kd, N, ny):
     """The cost a fit minimised: the ML cost, else the harmonic residual norm."""
-    sysc, _, _, ml, G, Gc = fit
+    sysc, _, _, ml, G, Gc, _ = fit
     if ml is not None:
         return ml.cost
-    return float(np.linalg.norm(_harmonic_response(sysc, G.omega, K) - Gc))
+    return float(np.linalg.norm(_harmonic_response(sysc, G.omega, Kd) - Gc))
 
 
-def _lifted_data(data, period, K, progress, options):
-    """Step 1: the real lifted response, given or computed from time records."""
+def _lifted_data(data, period, Kd, progress, options, K=0):
+    """Step 1: the real lifted response, given or computed from time records (with
+    the harmonics -Kd..Kd, at most (N-1)/2; from an HTF at least K)."""
     given = {key: val for key, val in options.items() if val is not None}
     if isinstance(data, (ct.FrequencyResponseData, HTF)):
         if given:
             raise TypeError(f"identify_ltp: {sorted(given)} only apply to time "
                             "records, not to frequency-response data")
         if isinstance(data, HTF):
+            # the most harmonics known together at some frequencies (band-limited
+            # chirps know few); the ML refinement fits all components of the HTF
+            for k in range(min(Kd, data.nharmonics), K, -1):
+                try:
+                    return lifted_frequency_response(data, period, k)
+                except ValueError:
+                    continue
             return lifted_frequency_response(data, period, K)
         return data
-    return lifted_frequency_response(data, period, K, progress=progress,
+    dt = _record_step(data)
+    if dt is not None:
+        Kd = min(Kd, (int(round(period / dt)) - 1) // 2)
+    return lifted_frequency_response(data, period, Kd, progress=progress,
                                      unusable='skip', **given)
 
 
+def _record_step(data):
+    """Sampling time of time records (None if it cannot be read; the lifted
+    response then reports the error)."""
+    try:
+        t = data.time if isinstance(data, ct.TimeResponseData) else data[0]
+        t = np.asarray(t, dtype=float).ravel()
+        return float(t[1] - t[0]) if t.size > 1 and t[1] > t[0] else None
+    except (TypeError, IndexError, ValueError, AttributeError):
+        return None
+
+
 def _check_lifted_data(G, period, K, nstates, q):
-    """Validate the lifted data; return (outputs, steps per period)."""
+    """Validate the lifted data; return (outputs, steps per period, data harmonics)."""
     H = 2 * K + 1
     if not G.dt or G.dt is True:
         raise ControlArgument("data must be discrete-time frequency-response data "
                               "with a numeric sampling time (from "
                               "lifted_frequency_response)")
-    if G.noutputs % H:
-        raise ValueError(f"data must have (2K+1) = {H} lifted outputs per system output, "
-                         f"got shape {G.frdata.shape[:2]}")
+    # the labels '<y>_c0', '<y>_c1', ... of lifted_frequency_response tell the harmonics
+    ny = sum(1 for lab in G.output_labels if lab.endswith('_c0'))
+    if not (ny and G.noutputs % ny == 0 and (G.noutputs // ny) % 2 == 1
+            and G.noutputs // ny >= H):
+        if G.noutputs % H:
+            raise ValueError(f"data must have (2K+1) = {H} lifted outputs per system "
+                             f"output, got shape {G.frdata.shape[:2]}")
+        ny = G.noutputs // H
+    Kd = (G.noutputs // ny - 1) // 2
     N = steps_per_period(period, float(G.dt), 'the sampling time of data')
     order, M = H * nstates, G.omega.size
     # fdsubspace needs 2M >= q + order with q > order: at least order + 1 lines.
-    if 2 * M < 2 * order + 1 or (q is not None and 2 * M < q + order):
+    if not _enough_lines(M, K, nstates, q):
         raise ValueError(
             f"too few frequencies: {M} lines for the lifted order (2K+1)*nstates = "
             f"{order}{'' if q is None else f' and q={q}'}; need at least "
             f"{order + 1 if q is None else -(-(q + order) // 2)} distinct lines")
-    return G.noutputs // H, N
+    return ny, N, Kd
 
 
 def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, progress,
@@ -480,22 +679,39 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
     return [c[1:] for c in sorted(candidates, key=lambda c: c[0])]
 
 
-def _refit(sys, Gc, omega, K, harmonics, estimate_d, fit_a, labels):
+def _refit(sys, Gc, omega, K, harmonics, estimate_d, fit_a, labels, progress=False):
     """Step 5: the refit with ``H = harmonics`` harmonics in B; for 'auto' the refits
     with H = K and H = K + 1 (both from `sys`), K + 1 kept if it earns its place."""
-    fit = dict(estimate_d=estimate_d, fit_a=fit_a, **labels)
-    model, res, converged, nfev = fit_floquet(sys, Gc, omega, K, harmonics=(
-        K if harmonics == 'auto' else harmonics), **fit)
+    fit = dict(estimate_d=estimate_d, fit_a=fit_a, progress=progress, **labels)
+    model, res, converged, nfev = _staged_fit(sys, Gc, omega, K, (
+        K if harmonics == 'auto' else harmonics), fit)
     if harmonics == 'auto' and K > 0:            # K = 0: B_{±1} would meet no C harmonic
-        wide, res1, conv1, nfev1 = fit_floquet(sys, Gc, omega, K, harmonics=K + 1, **fit)
+        wide, res1, conv1, nfev1 = _staged_fit(sys, Gc, omega, K, K + 1, fit)
         nfev += nfev1
         # BIC = N log(SSE / N) + p log N: N real residuals, B_{±(K+1)} add 2 n_p m parameters
         nres, extra = 2 * Gc.size, 2 * sys.nstates * Gc.shape[0]
         tiny = np.finfo(float).tiny
-        bic = nres * np.log(max(res1, tiny) ** 2 / max(res, tiny) ** 2) + extra * np.log(nres)
-        if bic < 0 and _visibility(wide, omega, K) <= _MAX_VISIBILITY:
+        # in logs: the ratio of squares can overflow or divide by zero (exact fits)
+        bic = (2 * nres * (np.log(max(res1, tiny)) - np.log(max(res, tiny)))
+               + extra * np.log(nres))
+        # with the data harmonics K + 1 measured, B_{±(K+1)} is seen directly
+        seen = Gc.shape[1] > 2 * K + 1 or _visibility(wide, omega, K) <= _MAX_VISIBILITY
+        if bic < 0 and seen:
             model, converged = wide, conv1
     return model, converged, nfev
+
+
+def _staged_fit(sys, Gc, omega, K, H, fit):
+    """`fit_floquet` on the data harmonics -K..K, then on all of `Gc` (-Kd..Kd) from
+    there: the harmonics |n| <= K carry the structure, a start far from it
+    meets local minima when the small outer harmonics weigh in from the outset."""
+    Kd = (Gc.shape[1] - 1) // 2
+    nfev = 0
+    if Kd > K:
+        sys, _, _, nfev = fit_floquet(sys, Gc[:, Kd - K:Kd + K + 1], omega, K, harmonics=H,
+                                      **fit)
+    model, res, converged, more = fit_floquet(sys, Gc, omega, K, harmonics=H, **fit)
+    return model, res, converged, nfev + more
 
 
 #: largest ratio of the effect of B_{±(K+1)} on the unmeasured harmonics ±(K+1) to

@@ -629,7 +629,9 @@ def refine_ltp(sys, data, *, std=None, harmonics=None, weighted=True, stable=Fal
         success, message = bool(res.status > 0), str(res.message)
     f, J = residual(theta, True)
     dof = n - p
-    scale = float(f @ f) / dof
+    # floor: data fitted to rounding (noise-free) must not make J^T J / s² overflow
+    floor = (np.finfo(float).eps * max(np.linalg.norm(target * weight), 1.0)) ** 2 / n
+    scale = max(float(f @ f) / dof, floor)
     fisher = J.T @ J / (1.0 if known else scale)
     w_eig, U = np.linalg.eigh(fisher)
     if w_eig[0] <= w_eig[-1] / _COND_FISHER:

@@ -1,11 +1,13 @@
 """Choice of the harmonics K and the order n_p of an identified LTP model.
 
-Every candidate ``(n_p, K)`` is identified with `identify_ltp` from the
-lines of the training set (all lines but every `holdout`-th) and scored on
+Every candidate ``(n_p, K)`` is identified with `identify_ltp` (every
+`holdout`-th line held out) and scored on
 
-* the held-out lines: ``e_val = ‖Ĝ - G‖ / ‖G‖`` over the harmonics
-  ``|n| <= K_max`` of the data (a K-harmonic model predicts them all),
-* an information criterion on the training lines, ``AIC = M_r log(SSE/M_r)
+* the held-out lines: ``info.holdout_nrmse = ‖Ĝ - G‖ / ‖G‖`` of the model
+  identified without them, over all harmonics of the data: the
+  normalized RMS error of its steady-state output in the time domain
+  (Parseval), the prediction that matters,
+* an information criterion on all lines, ``AIC = M_r log(SSE/M_r)
   + 2 d`` with ``M_r`` real residuals and ``d = (2H+1) n_p m + (4K+1) p n_p +
   (2K+1) p m`` free parameters (B, C, D harmonics for m inputs and p
   outputs, H = K or K + 1 the harmonics of the refitted B; A is fixed by the
@@ -27,6 +29,7 @@ import control as ct
 from control.exception import ControlArgument
 from tqdm.auto import tqdm
 
+from .._core.lifting import _real_basis
 from .floquet_fit import _harmonic_data, _harmonic_response
 from .ltp_subspace import identify_ltp
 from .._core.validation import check_kwargs, check_period, check_positive_int, steps_per_period
@@ -45,10 +48,10 @@ class StructureSelection:
     nharmonics : ndarray of int
         Candidate harmonics K (columns of the tables).
     validation_error : ndarray, shape (len(nstates), len(nharmonics))
-        Relative error on the held-out lines (NaN where identification
-        failed).
+        Held-out time-domain NRMSE (``holdout_nrmse`` of `identify_ltp`;
+        NaN where identification failed).
     aic : ndarray, same shape
-        Information criterion on the training lines.
+        Information criterion on all lines.
     singular_values : ndarray
         Singular values of the subspace step for the largest candidate.
     best : tuple of int
@@ -128,14 +131,14 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
         Candidate orders n_p and harmonics K.
     holdout : int, optional
         Every `holdout`-th line (starting with the second) is held out for
-        validation (default 4).
+        validation (default 4; `identify_ltp` with this `holdout`).
     criterion : {'validation', 'aic'}, optional
         Score that picks `best` (default the held-out error; ties within
         10 % go to the smaller model).
     q : int, optional
         Block rows of the subspace step (`identify_ltp`).
     progress : bool, optional
-        Show a progress bar over the candidates.
+        Show a progress bar over the candidates (default False).
 
     Returns
     -------
@@ -195,6 +198,11 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
     held = np.zeros(M, bool)
     held[1::holdout] = True
     Gc = _harmonic_data(data.frdata, Kdata, N, ny)             # (m, 2K_d+1, ny, M)
+    # labels '<y>_c0', '<y>_c1', ...: identify_ltp fits all K_d harmonics
+    _, tags = _real_basis(np.arange(-Kdata, Kdata + 1), N)
+    full = ct.frd(data.frdata[:(2 * Kdata + 1) * ny], data.omega, data.dt,
+                  outputs=[f'y[{o}]_{tag}' for tag in tags for o in range(ny)],
+                  inputs=[f'u[{j}]_c0' for j in range(data.ninputs)])
     nu = data.ninputs
     val = np.full((ns.size, Ks.size), np.nan)
     aic = np.full((ns.size, Ks.size), np.nan)
@@ -202,23 +210,22 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
     sv = None
     for i, n in enumerate(ns):
         for j, K in enumerate(Ks):
-            train = ct.frd(data.frdata[:(2 * K + 1) * ny, :, ~held], data.omega[~held],
-                           data.dt)
+            bar.set_postfix(n_p=int(n), K=int(K))
             try:
                 with warnings.catch_warnings():
                     warnings.simplefilter('ignore')
-                    model, info = identify_ltp(train, period, int(n), int(K), q=q,
-                                               return_info=True)
+                    model, info = identify_ltp(full, period, int(n), int(K), q=q,
+                                               holdout=holdout, return_info=True)
             except ValueError:
                 bar.update(1)
                 continue
             if n == ns[-1] and K == Ks[-1]:
                 sv = info.subspace.singular_values
-            pred = _harmonic_response(model, data.omega, Kdata)
-            err = pred - Gc
-            val[i, j] = np.linalg.norm(err[..., held]) / np.linalg.norm(Gc[..., held])
-            sse = np.sum(np.abs(err[..., ~held]) ** 2)
-            mr = 2 * err[..., ~held].size
+            # time-domain NRMSE of the model identified without the held-out lines
+            val[i, j] = info.holdout_nrmse
+            err = _harmonic_response(model, data.omega, Kdata) - Gc
+            sse = np.sum(np.abs(err) ** 2)
+            mr = 2 * err.size
             Hb = max(K, model.B.nharmonics or 0)                  # K or K + 1 (refit)
             d = (2 * Hb + 1) * n * nu + (4 * K + 1) * ny * n + (2 * K + 1) * ny * nu + n
             aic[i, j] = mr * np.log(max(sse, np.finfo(float).tiny) / mr) + 2 * d

@@ -1,0 +1,152 @@
+"""Identified models predict: every produced harmonic fitted, held-out validation,
+time-domain comparison, refinement fallback (independent truth: simulation of the
+true plant by forced_response)."""
+
+import os
+import sys
+import warnings
+
+import numpy as np
+import pytest
+from control.exception import ControlArgument, ControlDimension
+
+import ltpcontrol as ltp
+import ltpcontrol._identification.ltp_subspace as subspace
+from ltpcontrol._identification.floquet_fit import _harmonic_data, _harmonic_response, fit_floquet
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "examples"))
+from random_ltp_plants import design_lines, lifted_data, random_ltp  # noqa: E402
+from ident_prediction_study import evaluate, plant_classes  # noqa: E402
+
+T, DT = 1.0, 1 / 64
+LINES = design_lines(T, 60)
+
+
+def _identify(plant, K, Kd, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        return ltp.identify_ltp(lifted_data(plant, Kd, LINES, DT), T, plant.nstates, K,
+                                return_info=True, **kw)
+
+
+def test_fit_uses_all_data_harmonics():
+    """Data with harmonics |n| <= 3K+1 of a Floquet-form plant: the exact model is a
+    zero-residual point of the fit, a perturbed start returns to it."""
+    plant = random_ltp(200, 2, 1, periodic='B')
+    Kd = 7
+    Gc = _harmonic_data(lifted_data(plant, Kd, LINES, DT).frdata, Kd, 64, 1)
+    assert np.abs(_harmonic_response(plant, LINES, Kd) - Gc).max() < 1e-12
+    start = ltp.ltpss(plant.A(0.0) * 1.05, plant.B, plant.C, 0, period=T)
+    model, res, converged, _ = fit_floquet(start, Gc, LINES, 2)
+    assert converged and res < 1e-10
+    with pytest.raises(ValueError, match='harmonics'):
+        fit_floquet(start, Gc[:, 6:9], LINES, 2)
+
+
+def test_periodic_a_model_predicts_in_time_domain():
+    """Periodic A(t), constant B, C: fitted with all the harmonics it produces the model
+    predicts filtered noise; fitted with |n| <= K only, its outer harmonics are free
+    and the prediction is worse."""
+    plant = random_ltp(101, 3, 1, periodic='A')
+    errors = {}
+    for K in (2, 3):
+        model, info = _identify(plant, K, 3 * K + 1)
+        assert info.success and info.data_harmonics == 3 * K + 1
+        assert info.holdout_nrmse < 1e-2 and info.holdout_lines.size == 15
+        cmp = ltp.compare_ltp(model, plant, LINES[:20], signal='noise')
+        errors[K] = cmp.time_nrmse
+    assert errors[2] <= 1e-2 and errors[3] <= 2 * errors[2]
+    partial, info = _identify(plant, 3, 3)
+    assert 'not fitted' in info.message
+    assert ltp.compare_ltp(partial, plant, LINES[:20], signal='noise').time_nrmse > errors[3]
+
+
+def test_poor_structure_flagged_by_holdout():
+    """Too few states: the held-out prediction fails, success is False and the warning
+    names the figure."""
+    plant = random_ltp(501, 3, 1)
+    with pytest.warns(UserWarning, match='holdout_nrmse'):
+        model, info = ltp.identify_ltp(lifted_data(plant, 7, LINES, DT), T, 1, 2,
+                                       return_info=True)
+    assert not info.success and info.holdout_nrmse > 0.05
+    t = np.arange(1280) * DT
+    u = np.sin(1.7 * t) + np.sin(5.1 * t)
+    y = ltp.forced_response(plant, t, u).outputs
+    assert np.linalg.norm(ltp.forced_response(model, t, u).outputs - y) > 0.05 * np.linalg.norm(y)
+
+
+def test_holdout_options():
+    plant = random_ltp(200, 2, 1, periodic='B')
+    model, info = _identify(plant, 1, 3, holdout=None)
+    assert np.isnan(info.holdout_nrmse) and info.holdout_lines.size == 0
+    with pytest.raises(ValueError, match='holdout'):
+        _identify(plant, 1, 3, holdout=1)
+    with pytest.raises(ValueError, match='validation_tol'):
+        _identify(plant, 1, 3, validation_tol=-1.0)
+    # too few lines to hold some out: a warning, no validation
+    few = lifted_data(plant, 3, LINES[:8], DT)
+    with pytest.warns(UserWarning, match='not validated'):
+        _, info = ltp.identify_ltp(few, T, 2, 1, q=None, return_info=True)
+    assert np.isnan(info.holdout_nrmse)
+
+
+def test_refinement_never_predicts_worse(monkeypatch):
+    """A refinement that spoils the model is rejected on the held-out lines."""
+    plant = random_ltp(101, 2, 1, periodic='A')
+    real = subspace.refine_ltp
+
+    def spoiling(sys, data, **kw):
+        model, info = real(sys, data, **kw)
+        bad = ltp.ltpss(model.A(0.0) * 1.3, model.B, model.C, model.D, period=T)
+        return bad, info
+    monkeypatch.setattr(subspace, 'refine_ltp', spoiling)
+    model, info = _identify(plant, 2, 7, refine='ml')
+    assert info.refine_fallback and 'worse than its start' in info.message
+    assert info.holdout_nrmse < 1e-2
+    assert ltp.compare_ltp(model, plant, LINES[:20], signal='noise').time_nrmse < 1e-2
+
+
+def test_compare_all_harmonics_and_time_domain():
+    """The default compares every produced harmonic: an error in an outer harmonic of C
+    is understated with nharmonics=1 and seen by default and in the time domain."""
+    plant = random_ltp(200, 2, 1, periodic='B')                  # B: 2 harmonics
+    C = np.zeros((7, 1, 2), complex)
+    C[3] = plant.C(0.0)
+    C[0], C[6] = 0.05, 0.05                                       # C_{±3}
+    est = ltp.ltpss(plant.A, plant.B, ltp.PeriodicMatrix(C, T), 0, period=T)
+    one = ltp.compare_ltp(est, plant, LINES[:10], 1)
+    full = ltp.compare_ltp(est, plant, LINES[:10])
+    assert full.nharmonics == 5 and 5 * one.htf_error < full.htf_error
+    t = np.arange(640) * DT
+    u = np.sin(2.3 * t)
+    cmp = ltp.compare_ltp(est, plant, LINES[:10], signal=(t, u))
+    # independent: the outputs differ by C_{±3}-terms only
+    x = ltp.forced_response(plant, t, u, return_states=True).states
+    dy = 0.1 * np.cos(6 * np.pi * t) * x.sum(axis=0)
+    y = ltp.forced_response(plant, t, u).outputs
+    assert np.isclose(cmp.time_nrmse, np.linalg.norm(dy) / np.linalg.norm(y), rtol=1e-6)
+    with pytest.raises(ValueError, match='signal'):
+        ltp.compare_ltp(est, plant, [1.0], signal='chirp')
+    with pytest.raises(ControlArgument, match='signal'):
+        ltp.compare_ltp(est, plant, [1.0], signal=3.0)
+    with pytest.raises(ControlDimension, match='signal'):
+        ltp.compare_ltp(est, plant, [1.0], signal=(t, np.ones((2, t.size))))
+
+
+def test_progress_bar_on_the_refit(capsys):
+    plant = random_ltp(200, 2, 1, periodic='B')
+    ltp.identify_ltp(lifted_data(plant, 3, LINES, DT), T, 2, 1, progress=True)
+    assert 'refit' in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_reduced_prediction_study():
+    """One plant of each class (A only, B, fast actuator, 2x2 MIMO, ABC), K = 2 and 3,
+    noise-free: filtered-noise NRMSE <= 1e-2; 20 dB draws: no silent failure."""
+    for cls, plant in plant_classes(1):
+        e2, ok2, _, _ = evaluate(plant, 2)
+        e3, ok3, _, _ = evaluate(plant, 3)
+        assert e2 <= 1e-2 and e3 <= 1e-2, cls
+        assert e3 <= 2 * e2 + 1e-9, cls
+        e, ok, _, _ = evaluate(plant, 2, snr_db=20.0, seed=7)
+        assert e <= 0.1 or not ok, cls
