@@ -15,8 +15,8 @@ import hopper  # noqa: E402
 import mathieu  # noqa: E402
 import vhop  # noqa: E402
 
-from ltpcontrol._orbits.hybrid import simulate_hybrid  # noqa: E402
-from ltpcontrol._orbits.orbits import linearize_orbit  # noqa: E402
+from ltpcontrol import simulate_hybrid  # noqa: E402
+from ltpcontrol import linearize_orbit  # noqa: E402
 from systems import fd_period_map_jacobian  # noqa: E402
 
 

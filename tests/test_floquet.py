@@ -16,11 +16,11 @@ import scipy.linalg as la
 from control.exception import ControlArgument
 from scipy.integrate import solve_ivp
 
-from ltpcontrol._core.floquet import (floquet_exponents, floquet_multipliers,
-                                 floquet_transform, is_stable, monodromy)
-from ltpcontrol._core.ltpsys import ltpss
-from ltpcontrol._core.periodic_matrix import PeriodicMatrix
-from ltpcontrol._core.timeresp import forced_response
+from ltpcontrol import (floquet_exponents, floquet_multipliers, floquet_transform, is_stable,
+                        monodromy)
+from ltpcontrol import ltpss
+from ltpcontrol import PeriodicMatrix
+from ltpcontrol import forced_response
 
 
 def _vectorised(entries):

@@ -6,7 +6,7 @@ import control as ct
 from control.exception import ControlArgument
 
 import ltpcontrol as ltp
-from ltpcontrol._core.lifting import lift
+from ltpcontrol import lift
 
 
 def _random_dt(N, n=2, m=2, p=1, seed=0, dt=0.1):

@@ -8,11 +8,10 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
-from ltpcontrol._identification.canonical import matrix_errors, to_canonical
-from ltpcontrol._core.lifting import _real_basis, lift
-from ltpcontrol._identification.ltp_subspace import (identify_ltp, lifted_frequency_response,
-                                      _harmonic_response)
-from systems import mathieu
+from ltpcontrol import matrix_errors, to_canonical
+from ltpcontrol import lift
+from ltpcontrol import identify_ltp, lifted_frequency_response
+from systems import mathieu, real_fourier_basis
 
 T, TS = 0.5, 0.01               # thesis §4.2.9: period 0.5 s, 100 Hz sampling
 OVERSAMPLE = 4                  # simulation step TS/4, records kept at 100 Hz
@@ -74,9 +73,9 @@ def _errors(model, truth):
 
 def test_lifted_response_matches_continuous_htf(truth, frd):
     """G_n(Ω) = H_{n,0}(jΩ) of the continuous HSS (U_0 = 1/2 convention)."""
-    V, _ = _real_basis(np.arange(-1, 2), int(T / TS))
+    V = real_fourier_basis(1)
     G = (V @ frd.frdata[:, 0, :]).reshape(3, 1, -1)
-    H = _harmonic_response(truth, frd.omega, 1)
+    H = ltp.htf(truth, 1)(1j * frd.omega)[:, 1, :].reshape(3, 1, -1)     # H_{n,0}(jΩ)
     assert frd.frdata.shape == (3, 1, 400) and frd.dt == TS
     assert np.linalg.norm(G - H) / np.linalg.norm(H) < 1e-5
     Hc = ltp.htf(truth, 1)(1j * frd.omega[:5])[:, 1]

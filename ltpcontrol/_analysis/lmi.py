@@ -31,7 +31,7 @@ from control.exception import ControlArgument
 
 from .._core.floquet import _log_multipliers
 from .._core.periodic_matrix import PeriodicMatrix
-from .._core.validation import as_ltp
+from .._core.coerce import as_ltp
 
 __all__ = ['lmi_statefbk', 'LMIDesign']
 

@@ -33,7 +33,8 @@ from control.exception import ControlArgument
 from .._core.ltpsys import LTPStateSpace
 from .lyapunov import dlyap
 from .periodic_balancing import gramians, hankel_svd, truncate
-from .._core.validation import as_ltp, check_positive_int, real_array
+from .._core.coerce import as_ltp
+from .._core.validation import check_positive_int, real_array
 
 __all__ = ['hsvd', 'balred', 'minreal']
 

@@ -29,7 +29,8 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
-from .validation import as_ltp, check_kwargs, check_positive_int
+from .coerce import as_ltp
+from .validation import check_kwargs, check_positive_int
 
 __all__ = ['lift']
 

@@ -31,7 +31,8 @@ from .._core.ltpsys import ltpss
 from .._core.floquet import floquet_exponents
 from .._core.timeresp import forced_response
 from .._frequency.htf import htf
-from .._core.validation import as_ltp, check_kwargs, check_positive_int, real_array
+from .._core.coerce import as_ltp
+from .._core.validation import check_kwargs, check_positive_int, real_array
 
 __all__ = ['to_canonical', 'matrix_errors', 'MatrixErrors', 'compare_ltp', 'LTPComparison']
 

@@ -50,7 +50,8 @@ from .floquet_fit import _harmonic_data
 from .._frequency.htf import HTF, HTFData
 from .._core.ltpsys import LTPStateSpace
 from .._core.periodic_matrix import PeriodicMatrix
-from .._core.validation import as_ltp, check_kwargs, check_positive_int, real_array, steps_per_period
+from .._core.coerce import as_ltp
+from .._core.validation import check_kwargs, check_positive_int, real_array, steps_per_period
 
 __all__ = ['refine_ltp', 'RefineInfo']
 
