@@ -18,6 +18,7 @@ from hypothesis import given, settings, strategies as st
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
+from systems import real_fourier_basis
 
 
 def random_floquet(seed, nx=3, ny=1, nu=1, KB=1, KC=1, d=0.0, T=1.0, complex_pair=True):

@@ -32,6 +32,7 @@ from .._core.discretize import d2c
 from .fdsubspace import fdsubspace, FDSubspaceInfo
 from .floquet_fit import _harmonic_data, _harmonic_response, fit_floquet
 from .._frequency.htf import HTF
+from .records import as_records, refuse_ambiguous
 from .lifted_response import lifted_frequency_response
 from .._core.ltpsys import LTPStateSpace
 from .._core.periodic_matrix import PeriodicMatrix
@@ -597,22 +598,12 @@ def _lifted_data(data, period, Kd, progress, options, K=0):
                     continue
             return lifted_frequency_response(data, period, K)
         return data
-    dt = _record_step(data)
-    if dt is not None:
-        Kd = min(Kd, (int(round(period / dt)) - 1) // 2)
+    # time records: parsed once here, so that errors name this function's argument
+    refuse_ambiguous(data, 'data', 'identify_ltp')
+    dt = as_records(data, 'data')[0].dt
+    Kd = min(Kd, (int(round(period / dt)) - 1) // 2)
     return lifted_frequency_response(data, period, Kd, progress=progress,
                                      unusable='skip', **given)
-
-
-def _record_step(data):
-    """Sampling time of time records (None if it cannot be read; the lifted
-    response then reports the error)."""
-    try:
-        t = data.time if isinstance(data, ct.TimeResponseData) else data[0]
-        t = np.asarray(t, dtype=float).ravel()
-        return float(t[1] - t[0]) if t.size > 1 and t[1] > t[0] else None
-    except (TypeError, IndexError, ValueError, AttributeError):
-        return None
 
 
 def _check_lifted_data(G, period, K, nstates, q):
