@@ -356,7 +356,7 @@ def test_transform_discrete(nper, negative):
 
 def test_validation():
     sys = _zhou_hagiwara(np.pi)
-    with pytest.raises(TypeError, match="unrecognized keyword"):
+    with pytest.raises(TypeError, match="unexpected keyword argument 'method'"):
         floquet_transform(sys, method='x')
     with pytest.raises(ControlArgument, match="real"):
         floquet_transform(sys, real='yes')

@@ -268,7 +268,7 @@ def test_other_bad_arguments(truth, frd):
         lifted_frequency_response((t, np.stack([u, u]), y), T, 1, transient=2.0)
     with pytest.raises(ControlArgument, match="TimeResponseData or a tuple"):
         lifted_frequency_response([t, u, y], T, 1)
-    with pytest.raises(TypeError, match="unrecognized"):
+    with pytest.raises(TypeError, match="unexpected keyword argument 'hold'"):
         lifted_frequency_response((t, u, y), T, 1, hold=None)
     with pytest.raises(ValueError, match="conversion"):
         identify_ltp(frd, T, 2, 1, conversion='zoh')

@@ -81,7 +81,7 @@ class LMIDesign:
     multipliers: np.ndarray
 
 
-def lmi_statefbk(sysd, Q=None, R=None, objective='h2', G=None, rate=None, solver=None):
+def lmi_statefbk(sysd, Q=None, R=None, *, objective='h2', G=None, rate=None, solver=None):
     """Periodic state feedback by convex optimization (LMIs, cvxpy).
 
     Parameters

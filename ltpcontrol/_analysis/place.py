@@ -35,7 +35,7 @@ from .._core.validation import real_array
 __all__ = ['place']
 
 
-def place(sys, p, step=None, dt=None):
+def place(sys, p, *, step=None, dt=None):
     """Periodic state feedback with prescribed closed-loop poles, as `control.place`.
 
     Parameters

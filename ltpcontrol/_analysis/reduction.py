@@ -92,7 +92,7 @@ def hsvd(sys, t=None, *, nsteps=None):
     return hankel_svd(P(t), Q(t))[3]
 
 
-def balred(sys, orders, method='truncate', return_bound=False, *, nsteps=None):
+def balred(sys, orders, method='truncate', *, return_bound=False, nsteps=None):
     """Periodic balanced truncation, as `control.balred`.
 
     Discrete time: per-step balancing projections of the periodic gramians.

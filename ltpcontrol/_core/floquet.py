@@ -34,7 +34,7 @@ from .pm_ops import register_func
 from .steps import step_grid
 from .transition import expm_batch, step_transitions
 from .coerce import as_ltp
-from .validation import check_kwargs, check_positive_int, steps_per_period
+from .validation import check_positive_int, steps_per_period
 from .registry import method_alias
 
 __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
@@ -260,7 +260,7 @@ def _without_phase_multiplier(logmod, arg):
     return np.delete(logmod, np.argmin(np.hypot(logmod, arg)))
 
 
-def floquet_transform(sys, real=True, nsteps=None, **kwargs):
+def floquet_transform(sys, real=True, nsteps=None):
     """Floquet (Lyapunov) transform to a system with constant A.
 
     With ``x = P(t) z`` (thesis eqs. 4.30-4.35), ``Φ(t, 0) = P(t) e^{Ft}``,
@@ -341,7 +341,6 @@ def floquet_transform(sys, real=True, nsteps=None, **kwargs):
     >>> np.allclose(P(0.0), np.eye(2)), np.allclose(P(1.0), np.eye(2))
     (True, True)
     """
-    check_kwargs(kwargs, 'floquet_transform')
     if not isinstance(real, (bool, np.bool_)):
         raise ControlArgument(f"real must be True or False, got {real!r}")
     grid, factors = _factors(sys, nsteps)

@@ -23,7 +23,7 @@ from control.exception import ControlArgument, ControlDimension
 
 from .._core.ltpsys import LTPStateSpace
 from .records import as_records, common_grid, refuse_ambiguous
-from .._core.validation import (check_kwargs, check_period, check_positive_int, real_array,
+from .._core.validation import (check_period, check_positive_int, real_array,
                           steps_per_period)
 
 __all__ = ['identify_arx']
@@ -39,7 +39,7 @@ def _records(data):
     return t, U[0], Y[0]
 
 
-def identify_arx(data, period, na, nb, *, ridge=0.0, name=None, **kwargs):
+def identify_arx(data, period, na, nb, *, ridge=0.0, name=None):
     """Identify a periodic ARX model of a SISO LTP system from sampled records.
 
     Parameters
@@ -89,7 +89,6 @@ def identify_arx(data, period, na, nb, *, ridge=0.0, name=None, **kwargs):
     >>> bool(np.allclose(model.C.sample(N)[:, 0, 0], a))
     True
     """
-    check_kwargs(kwargs, 'identify_arx')
     t, U, Y = _records(data)
     period = check_period(period)
     na = check_positive_int(na, 'na')

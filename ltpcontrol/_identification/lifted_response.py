@@ -29,8 +29,8 @@ from .._frequency.htf import HTF, HTFData
 from .._core.lifting import _harmonic_labels, _real_basis
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .records import as_records, common_grid, refuse_ambiguous
-from .._core.validation import (check_kwargs, check_period, check_positive, check_positive_int,
-                          real_array, steps_per_period, time_record)
+from .._core.validation import (check_period, check_positive, check_positive_int,
+                          real_array, steps_per_period)
 
 __all__ = ['lifted_frequency_response']
 
@@ -49,7 +49,7 @@ _HOLDS = (None, 'foh', 'zoh')
 def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
                               transient=0.0, input_hold=None, hold_step=None,
                               feedthrough=None, real=True, unusable='raise', batch_size=64,
-                              progress=False, name=None, **kwargs):
+                              progress=False, name=None):
     r"""Lifted frequency response of an LTP system from sine experiments.
 
     Each experiment applies real sinusoids (single sines) or sums of
@@ -219,7 +219,6 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
            [1. , 2. ],
            [0.5, 0. ]])
     """
-    check_kwargs(kwargs, 'lifted_frequency_response')
     period = check_period(period)
     if isinstance(response, HTF):
         K = check_positive_int(nharmonics, 'nharmonics', minimum=0)

@@ -38,7 +38,7 @@ from .._core.ltpsys import LTPStateSpace
 from .._core.periodic_matrix import PeriodicMatrix
 from .realization import FloquetRealization, floquet_realization
 from .refine import RefineInfo, _harmonics, refine_ltp
-from .._core.validation import (check_kwargs, check_period, check_positive, check_positive_int,
+from .._core.validation import (check_period, check_positive, check_positive_int,
                                 steps_per_period)
 
 __all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
@@ -127,8 +127,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
                  refit_harmonics='auto', refine=None, refine_options=None,
                  estimate_d=True, frequencies=None, transient=None, input_hold=None,
                  hold_step=None, batch_size=None, seed=None, holdout=4,
-                 validation_tol=0.05, progress=False, return_info=False, name=None,
-                 **kwargs):
+                 validation_tol=0.05, progress=False, return_info=False, name=None):
     r"""Identify a continuous-time LTP model from sine experiments (thesis §4.2).
 
     Runs the whole frequency-domain subspace pipeline: lifted frequency
@@ -365,7 +364,6 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     >>> round(float((B[2] / B[1]).real), 4)
     0.25
     """
-    check_kwargs(kwargs, 'identify_ltp')
     period = check_period(period)
     nstates = check_positive_int(nstates, 'nstates')
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
