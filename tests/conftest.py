@@ -1,15 +1,10 @@
 """Shared test set-up."""
 import os
-import pathlib
-import sys
 import zlib
 
 import numpy as np
 import pytest
 from hypothesis import settings
-
-# the gallery's example plants (examples/*.py) are importable from every test
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / 'examples'))
 
 # Hypothesis: derandomized in continuous integration (CI=true), so a CI run
 # is reproducible; random exploration everywhere else

@@ -1,8 +1,6 @@
 """Identification of generic LTP plants (periodic A, B, C), model comparison,
 structure selection and excitation design."""
 
-import os
-import sys
 import warnings
 
 import numpy as np
@@ -10,8 +8,7 @@ import pytest
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "examples"))
-from random_ltp_plants import design_lines, lifted_data, random_ltp  # noqa: E402
+from examples.random_ltp_plants import design_lines, lifted_data, random_ltp
 
 T, DT = 1.0, 1 / 64
 LINES = design_lines(T, 120)                           # training lines in (0, 3 ω_p)

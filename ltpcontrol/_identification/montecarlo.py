@@ -101,7 +101,7 @@ def monte_carlo(func, ndraws, *, seed=None, n_jobs=None, timeout=None, progress=
         Number of joblib workers (default: that of the active
         ``joblib.parallel_config``, i.e. 1 unless set; -1 uses all cores).
         With a local backend (processes or threads) it is capped to the
-        cores this process may run on (`os.sched_getaffinity`), so that
+        cores this process may run on (``os.sched_getaffinity``), so that
         workers never outnumber the cores of a shared machine.
     timeout : float, optional
         Seconds after which a draw that has not finished raises
