@@ -1,8 +1,10 @@
 """Gallery scripts in tests: imported or run as sphinx-gallery runs them, from ``examples/``.
 
 The shared models are a package (``from examples.hopper import ...``); the
-gallery scripts import them by module name, so they are imported or run with
-``examples/`` first on the path for that call only.
+gallery scripts import them by module name, so they run with ``examples/``
+first on the path for that call only.  A script imported as a module keeps
+``examples/`` on the path: joblib's worker processes import it by name to
+run its functions.
 """
 
 import contextlib
@@ -26,8 +28,9 @@ def in_examples():
 
 def import_script(name):
     """Import the gallery script `name` (without ``.py``) as a module."""
-    with in_examples():
-        return importlib.import_module(name)
+    if str(EXAMPLES) not in sys.path:
+        sys.path.insert(0, str(EXAMPLES))
+    return importlib.import_module(name)
 
 
 def run_script(filename, **kwargs):
