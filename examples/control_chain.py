@@ -53,7 +53,8 @@ def record(plant, orbit, exc, *, snr=None, seed=0, solver=None, n_jobs=2):
         rng = np.random.default_rng(seed)
         u = u + rng.standard_normal(u.shape) * np.sqrt(np.mean(u ** 2) / snr)
         y = y + rng.standard_normal(y.shape) * np.sqrt(np.mean(y ** 2) / snr)
-    return exc.time, u, y
+    # one channel, one experiment per segment: shape (1, nexp, L)
+    return exc.time, np.reshape(u, (1, -1, u.shape[-1])), np.reshape(y, (1, -1, y.shape[-1]))
 
 
 def output_lqg(model, r, rn, qn=1.0):

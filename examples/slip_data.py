@@ -25,7 +25,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.signal import butter, sosfiltfilt
 
-from slip_model import Event, SLIPParams, boom_gravity, neutral_touchdown_angle
+try:                    # imported as the package ``examples`` (tests)
+    from .slip_model import Event, SLIPParams, boom_gravity, neutral_touchdown_angle
+except ImportError:     # run from this folder (gallery scripts)
+    from slip_model import Event, SLIPParams, boom_gravity, neutral_touchdown_angle
 
 __all__ = ["MONOPOD", "SPRINGS", "Perturbations", "spring_params",
            "simulate_stride", "record_stride", "process_record",

@@ -19,7 +19,10 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import least_squares
 
-from slip_model import METHODS, neutral_touchdown_angle, predict_stride
+try:                    # imported as the package ``examples`` (tests)
+    from .slip_model import METHODS, neutral_touchdown_angle, predict_stride
+except ImportError:     # run from this folder (gallery scripts)
+    from slip_model import METHODS, neutral_touchdown_angle, predict_stride
 
 __all__ = ["identify_vertical", "identify_flight_damping", "prediction_errors",
            "fit_leg", "CVResult", "cross_validate", "format_table",

@@ -27,7 +27,10 @@ The apex is the section ``vz = 0`` crossed downwards in flight.
 import numpy as np
 
 import ltpcontrol as ltp
-from slip_model import SLIPParams
+try:                    # imported as the package ``examples`` (tests)
+    from .slip_model import SLIPParams
+except ImportError:     # run from this folder (gallery scripts)
+    from slip_model import SLIPParams
 
 
 def _flight(t, x, u, p):

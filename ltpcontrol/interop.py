@@ -29,8 +29,11 @@ from control.config import _process_kwargs
 from control.exception import ControlArgument
 from control.timeresp import _timeresp_aliases
 
+from ._analysis import design, lyapunov, norms, place, reduction, zeros
+from ._core import interconnect, ltpsys, timeresp
 from ._core.ltpsys import LTPStateSpace
 from ._core.periodic_matrix import PeriodicMatrix
+from ._core.refusals import REFUSED, refusal, refusal_error as _refusal  # noqa: F401
 
 __all__ = []
 
@@ -44,9 +47,15 @@ def _involves_ltp(args, kwargs):
     return any(_is_ltp(a) for a in args) or any(_is_ltp(v) for v in kwargs.values())
 
 
+#: ltpcontrol's functions that python-control's entry points reach, by name
+_PUBLIC = {name: getattr(module, name)
+           for module in (timeresp, ltpsys, interconnect, zeros, norms, lyapunov, design,
+                          place, reduction)
+           for name in module.__all__}
+
+
 def _ltp_function(name):
-    import ltpcontrol
-    return getattr(ltpcontrol, name, None)
+    return _PUBLIC.get(name)
 
 
 #
@@ -137,51 +146,6 @@ HOOKS = {name: name for name in ('zeros', 'norm', 'lyap', 'dlyap', 'gram', 'lqr'
                                  'lqe', 'dlqe', 'place', 'h2syn', 'hinfsyn', 'minreal')}
 HOOKS.update(hankel_singular_values='hsvd', balanced_reduction='balred')
 
-_HTF = ("ltp.htf(sys, nharmonics) (or ltp.harmonic_ss) for the harmonic transfer function; "
-        "HTF.component(k, omega) or ltp.htf_response give its components")
-_LTI = ("sys.to_ss() for constant matrices, sys.average(), sys.linearize(t=...) or "
-        "ltp.lift(sys) for an LTI view")
-
-_STEADY = ("the periodic steady state (ltp.forced_response over enough periods, or "
-           "ltp.limit_cycle for an orbit of a nonlinear system): a forced periodic "
-           "system has periodic orbits, not equilibria")
-
-#: python-control names that have no LTP meaning as called -> what to use instead
-REFUSED = {
-    'frequency_response': _HTF,
-    'bode_plot': "ltp.bode_htf(ltp.htf(sys, nharmonics))",
-    'nyquist_plot': ("ltp.nyquist_htf(L, nharmonics).plot() (generalized Nyquist criterion "
-                     "of a periodic loop)"),
-    'nyquist_response': ("ltp.nyquist_htf(L, nharmonics) (generalized Nyquist criterion of "
-                         "a periodic loop)"),
-    'nichols_plot': "ltp.bode_htf(ltp.htf(sys, nharmonics))",
-    'singular_values_response': _HTF,
-    'singular_values_plot': "ltp.htf_map_plot(ltp.htf(sys, nharmonics), omega)",
-    'evalfr': "ltp.htf(sys, nharmonics)(s)",
-    'dcgain': "ltp.htf(sys, nharmonics)(0) (the harmonic DC gains)",
-    'margin': ("ltp.stability_margins(L) (python-control's return values) or "
-               "ltp.harmonic_margins(L) (upper and lower gain, phase and disk margins with "
-               "their harmonics)"),
-    'stability_margins': ("ltp.stability_margins(L) (python-control's return values) or "
-                          "ltp.harmonic_margins(L)"),
-    'disk_margins': "ltp.harmonic_margins(L) (its disk, disk_gain and disk_phase)",
-    'bandwidth': _HTF,
-    'damp': "ltp.floquet_exponents(sys)",
-    'pole_zero_map': "ltp.floquet_exponents(sys)",
-    'pole_zero_plot': "ltp.floquet_exponents(sys)",
-    'root_locus_map': "ltp.floquet_exponents of the closed loops",
-    'root_locus_plot': "ltp.floquet_exponents of the closed loops",
-    'step_info': "ct.step_info(ltp.step_response(sys, T).outputs, T)",
-    'similarity_transform': "ltp.floquet_transform or ltp.to_canonical",
-    'canonical_form': "ltp.to_canonical",
-    'ss': _LTI,
-    'tf': _LTI,
-    'ss2tf': _LTI,
-    'mixsyn': "ltpcontrol's synthesis functions",
-    'find_operating_point': _STEADY,
-}
-
-
 #: python-control functions of matrices -> the ltpcontrol way when a matrix is
 #: a `PeriodicMatrix` (or, for those not hooked above, the system an LTPStateSpace)
 MATRIX_REFUSED = {
@@ -198,27 +162,6 @@ MATRIX_REFUSED = {
     'ctrb': "ltp.lift(sys) (the lifted LTI system's controllability)",
     'obsv': "ltp.lift(sys) (the lifted LTI system's observability)",
 }
-
-
-def refusal(name):
-    """The error for python-control's `name` (function or method) on an LTP system.
-
-    Examples
-    --------
-    >>> from ltpcontrol.interop import refusal
-    >>> err = refusal('dcgain')
-    >>> isinstance(err, ct.ControlArgument)
-    True
-    >>> print(err)  # doctest: +NORMALIZE_WHITESPACE
-    dcgain does not apply to a linear time-periodic system (LTPStateSpace): use
-    ltp.htf(sys, nharmonics)(0) (the harmonic DC gains)
-    """
-    return _refusal(name, REFUSED[name])
-
-
-def _refusal(what, hint):
-    return ControlArgument(f"{what} does not apply to a linear time-periodic system "
-                           f"(LTPStateSpace): use {hint}")
 
 
 #: python-control's return convention where it differs from the ltpcontrol

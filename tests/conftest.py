@@ -1,13 +1,16 @@
 """Shared test set-up."""
-import pathlib
-import sys
+import os
 import zlib
 
 import numpy as np
 import pytest
+from hypothesis import settings
 
-# the gallery's example plants (examples/*.py) are importable from every test
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / 'examples'))
+# Hypothesis: derandomized in continuous integration (CI=true), so a CI run
+# is reproducible; random exploration everywhere else
+settings.register_profile('ci', derandomize=True, print_blob=True)
+if os.environ.get('CI', '').lower() in ('true', '1'):
+    settings.load_profile('ci')
 
 
 @pytest.fixture(autouse=True)

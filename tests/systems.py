@@ -58,3 +58,19 @@ def random_periodic_plant(n, ninputs=1, seed=0, period=1.0, name=None):
     w = 2 * np.pi / period
     return ltp.ltpss(lambda t: A0 + A1 * np.cos(w * t), rng.standard_normal((n, ninputs)),
                      rng.standard_normal((1, n)), 0, period=period, name=name)
+
+
+def real_fourier_basis(nharmonics):
+    """Unitary V mapping harmonics -K..K to the real basis c_0, c_1, s_1, ..., c_K, s_K.
+
+    Stated from the definitions (independent of the library):
+    ``c_0 = e_0``, ``c_n = (e_n + e_{-n})/√2``, ``s_n = j(e_n - e_{-n})/√2``,
+    with e_n the unit vector of harmonic n.
+    """
+    K = nharmonics
+    V = np.zeros((2 * K + 1, 2 * K + 1), complex)
+    V[K, 0] = 1.0
+    for n in range(1, K + 1):
+        V[[K + n, K - n], 2 * n - 1] = 1 / np.sqrt(2)
+        V[[K + n, K - n], 2 * n] = 1j / np.sqrt(2), -1j / np.sqrt(2)
+    return V

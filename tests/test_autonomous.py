@@ -5,9 +5,6 @@ runs with event location, finite differences of independently coded
 return maps, Liouville's formula, and closed-form bifurcation points.
 """
 
-import sys
-from pathlib import Path
-
 import control as ct
 import numpy as np
 import pytest
@@ -16,10 +13,9 @@ from scipy.integrate import solve_ivp
 
 import ltpcontrol as ltp
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'examples'))
-from clockfree_hopper import apex_map, clockfree_hopper, hopping_gait  # noqa: E402
-from slip_model import SLIPParams, neutral_touchdown_angle, predict_stride  # noqa: E402
-from slip_running import apex_return_map, slip_plant  # noqa: E402
+from examples.clockfree_hopper import apex_map, clockfree_hopper, hopping_gait
+from examples.slip_model import SLIPParams, neutral_touchdown_angle, predict_stride
+from examples.slip_running import apex_return_map, slip_plant
 
 
 # ----------------------------------------------------------------- van der Pol

@@ -559,7 +559,7 @@ CATALOGUE = [
     ('estimate-nharmonics-too-large', _call(ltp.estimate_htf, DATA, T, 24,
                                             segments=EXC.segments), VE, 'nharmonics'),
     ('estimate-length-mismatch', _call(ltp.estimate_htf, (EXC.time, EXC.inputs,
-                                                          Y_EXC[:-1]), T, 1), CD, r'data\[0\]'),
+                                                          Y_EXC[:-1]), T, 1), CD, r'data: inputs'),
     ('estimate-nonuniform-time', _call(ltp.estimate_htf, (EXC.time ** 1.01, EXC.inputs,
                                                           Y_EXC), T, 1), VE, 'time'),
     ('estimate-shorter-than-period', _call(ltp.estimate_htf, (EXC.time[:20], EXC.inputs[:20],

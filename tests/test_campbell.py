@@ -6,7 +6,7 @@ from scipy.optimize import brentq
 from control.exception import ControlArgument
 
 import ltpcontrol as ltp
-from rotor_models import hammond_A, hammond_groups
+from examples.rotor_models import hammond_A, hammond_groups
 from test_rotors import mbc_by_hand
 
 

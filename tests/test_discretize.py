@@ -6,7 +6,7 @@ import control as ct
 from control.exception import ControlArgument
 
 import ltpcontrol as ltp
-from ltpcontrol._core.discretize import d2c, sample_system
+from ltpcontrol import d2c, sample_system
 
 WP = 2 * np.pi          # period 1
 
@@ -187,7 +187,7 @@ def test_bad_inputs():
 
 def test_floquet_then_tustin_round_trip():
     # thesis pipeline: Floquet form (constant A), Tustin, inverse Tustin
-    from ltpcontrol._core.floquet import floquet_transform
+    from ltpcontrol import floquet_transform
     A = lambda t: np.array([[0.0, 1.0], [-(1 + 0.3 * np.cos(WP * t)) * 4.0, -0.8]])
     B = lambda t: np.array([[0.0], [1 + 0.4 * np.cos(WP * t)]])
     sysF, _ = floquet_transform(ltp.ltpss(A, B, [[1.0, 0.0]], 0, period=1.0))

@@ -4,20 +4,16 @@ Each test runs the core functions of a gallery script on a reduced
 experiment and checks the numbers the script is meant to show.
 """
 
-import os
-import sys
-
 import numpy as np
 import pytest
 
 import ltpcontrol as ltp
 
-EXAMPLES = os.path.join(os.path.dirname(__file__), os.pardir, 'examples')
-sys.path.insert(0, os.path.abspath(EXAMPLES))
+from example_scripts import import_script
 
-import plot_delay_identification as delays  # noqa: E402
-import plot_hopper_htf_identification as hop  # noqa: E402
-import plot_vhop_prediction as vh  # noqa: E402
+delays = import_script('plot_delay_identification')
+hop = import_script('plot_hopper_htf_identification')
+vh = import_script('plot_vhop_prediction')
 
 #: A shorter chirp experiment than the thesis's (8 s chirps instead of 30 s).
 SMALL_DESIGN = {**hop.DESIGN, 'duration': 8.0, 'gap': 4.0}
@@ -121,7 +117,7 @@ def _vhop_like_plant(stance=0.2):
     touchdown reset it is not the VHOP's linearisation, but it has the same
     impulsive harmonic content (Floquet multipliers 0.61).
     """
-    from vhop import (PERIOD, VHOP_PARAMS, _flight_input, _flight_jacobian,
+    from examples.vhop import (PERIOD, VHOP_PARAMS, _flight_input, _flight_jacobian,
                       _stance_input, _stance_jacobian)
 
     def switching(stance_matrix, flight_matrix):

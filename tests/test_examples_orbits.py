@@ -1,22 +1,14 @@
 """Tests of the hopper, VHOP and Mathieu example models and their gallery scripts."""
 
-import os
-import runpy
-import sys
-
 import numpy as np
 import pytest
 from scipy.linalg import expm
 
-EXAMPLES = os.path.join(os.path.dirname(__file__), os.pardir, 'examples')
-sys.path.insert(0, os.path.abspath(EXAMPLES))
+from examples import hopper, mathieu, vhop
+from example_scripts import run_script
 
-import hopper  # noqa: E402
-import mathieu  # noqa: E402
-import vhop  # noqa: E402
-
-from ltpcontrol._orbits.hybrid import simulate_hybrid  # noqa: E402
-from ltpcontrol._orbits.orbits import linearize_orbit  # noqa: E402
+from ltpcontrol import simulate_hybrid  # noqa: E402
+from ltpcontrol import linearize_orbit  # noqa: E402
 from systems import fd_period_map_jacobian  # noqa: E402
 
 
@@ -155,7 +147,7 @@ class TestMathieu:
                                          ('plot_vhop_limit_cycle.py', 'vhop_limit_cycle.png')])
 def test_gallery_script(script, png, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
-    runpy.run_path(os.path.join(EXAMPLES, script), run_name='__main__')
+    run_script(script, run_name='__main__')
     assert (tmp_path / png).stat().st_size > 1000
     out = capsys.readouterr().out
     if script.startswith('plot_hopper'):

@@ -1,18 +1,14 @@
 """Tests of the SLIP example plants (examples/slip_*.py), thesis Chapter 2."""
 
 import doctest
-import os
-import sys
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "examples"))
-
-import slip_data  # noqa: E402
-import slip_identification as sid  # noqa: E402
-import slip_model as sm  # noqa: E402
+from examples import slip_data
+from examples import slip_identification as sid
+from examples import slip_model as sm
 
 LOSSLESS = sm.SLIPParams(m_l=0.0, d=0.0, d_h=0.0, d_v=0.0)
 

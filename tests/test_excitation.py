@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from control.exception import ControlArgument
 
-from ltpcontrol._identification.excitation import chirp_replicas, multisine, sine_experiments
-from ltpcontrol._identification.htf_estimate import estimate_htf
+from ltpcontrol import chirp_replicas, multisine, sine_experiments
+from ltpcontrol import estimate_htf
 from test_htf_estimate import ScalarLTP
 
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from control.exception import ControlArgument, ControlDimension
 
-from ltpcontrol._identification.fdsubspace import FDSubspaceInfo, fdsubspace
+from ltpcontrol import FDSubspaceInfo, fdsubspace
 
 SHAPES = [(1, 1), (2, 2), (3, 2), (2, 3)]
 

@@ -16,11 +16,11 @@ import scipy.linalg as la
 from control.exception import ControlArgument
 from scipy.integrate import solve_ivp
 
-from ltpcontrol._core.floquet import (floquet_exponents, floquet_multipliers,
-                                 floquet_transform, is_stable, monodromy)
-from ltpcontrol._core.ltpsys import ltpss
-from ltpcontrol._core.periodic_matrix import PeriodicMatrix
-from ltpcontrol._core.timeresp import forced_response
+from ltpcontrol import (floquet_exponents, floquet_multipliers, floquet_transform, is_stable,
+                        monodromy)
+from ltpcontrol import ltpss
+from ltpcontrol import PeriodicMatrix
+from ltpcontrol import forced_response
 
 
 def _vectorised(entries):
@@ -356,7 +356,7 @@ def test_transform_discrete(nper, negative):
 
 def test_validation():
     sys = _zhou_hagiwara(np.pi)
-    with pytest.raises(TypeError, match="unrecognized keyword"):
+    with pytest.raises(TypeError, match="unexpected keyword argument 'method'"):
         floquet_transform(sys, method='x')
     with pytest.raises(ControlArgument, match="real"):
         floquet_transform(sys, real='yes')

@@ -5,9 +5,8 @@ import pytest
 import control as ct
 
 import ltpcontrol as ltp
-from ltpcontrol._core.lifting import _real_basis
 from analysis_systems import stable_rss
-from systems import mathieu, switching_mathieu
+from systems import mathieu, real_fourier_basis, switching_mathieu
 
 
 @pytest.mark.parametrize('make', [mathieu, switching_mathieu])
@@ -16,7 +15,7 @@ def test_harmonic_ss_response_is_the_htf(make):
     K = 2
     H = ltp.htf(sys, K, internal_harmonics=30)
     Hs = ltp.harmonic_ss(sys, K, internal_harmonics=30)
-    V, _ = _real_basis(np.arange(-K, K + 1), 2 * K + 2)
+    V = real_fourier_basis(K)
     Vu, Vy = np.kron(V, np.eye(sys.ninputs)), np.kron(V, np.eye(sys.noutputs))
     for s in (0.3j, 1.7j, 0.2 + 5j):
         assert np.allclose(Hs(s), Vy.conj().T @ H(s) @ Vu, rtol=1e-10, atol=1e-12)

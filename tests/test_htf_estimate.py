@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 from control.exception import ControlArgument, ControlDimension
 
-from ltpcontrol._identification.excitation import chirp_replicas
-from ltpcontrol._frequency.htf import HTFData
-from ltpcontrol._identification.htf_estimate import HTFEstimateInfo, estimate_htf
-from ltpcontrol._core.metrics import e_rms, nrmse
+from ltpcontrol import chirp_replicas
+from ltpcontrol import HTFData
+from ltpcontrol import HTFEstimateInfo, estimate_htf
+from ltpcontrol import e_rms, nrmse
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 
@@ -353,7 +353,7 @@ def test_nan_in_data(replica_data):
     _, exc, y = replica_data
     bad = y.copy()
     bad[10] = np.nan
-    with pytest.raises(ValueError, match="outputs contains NaN"):
+    with pytest.raises(ValueError, match="outputs must be finite"):
         estimate_arrays((exc.time, exc.inputs, bad), 1.0, 1, segments=exc.segments)
 
 
@@ -422,7 +422,7 @@ def test_data_type_errors():
         estimate_arrays("abc", 1.0, 1)
     with pytest.raises(ControlArgument, match=r"data\[0\]"):
         estimate_arrays([np.ones(3)], 1.0, 1)
-    with pytest.raises(ControlDimension, match="time axis"):
+    with pytest.raises(ControlDimension, match="must have the same experiments"):
         estimate_arrays((t, np.ones(199), np.ones(200)), 1.0, 1)
     with pytest.raises(ValueError, match="uniformly"):
         estimate_arrays((t ** 2, np.ones(200), np.ones(200)), 1.0, 1)
@@ -535,26 +535,3 @@ def test_enough_replicas_keep_errors_small_or_warn():
         assert rel.max() <= 0.05 or warned
         assert warned                            # harmonics beyond K are reported
 
-
-@pytest.mark.parametrize("nrec, nfreq, nunk, alpha", [(7, 40, 3, 0.3), (1, 129, 3, 1e4),
-                                                      (3, 61, 5, 10.0), (2, 5, 1, 1.0)])
-def test_gcv_trace_by_block_sweeps_equals_column_solves(nrec, nfreq, nunk, alpha):
-    # tr H of the GCV search (two Schur-complement sweeps) against the
-    # column-by-column solves, and the blocks against a dense inverse
-    import scipy.sparse as sp
-    from ltpcontrol._identification.htf_estimate import _inverse_diagonal_blocks, _penalty, _solve_joint
-    rng = np.random.default_rng(nfreq)
-    phi = rng.normal(size=(nrec, nfreq, nunk)) + 1j * rng.normal(size=(nrec, nfreq, nunk))
-    Yb = rng.normal(size=(nrec, nfreq, 2)) + 1j * rng.normal(size=(nrec, nfreq, 2))
-    pen = _penalty(nfreq, nunk)
-    g1, tr1, _ = _solve_joint(phi, Yb, alpha, pen, 2.0, True)
-    g2, tr2, _ = _solve_joint(phi, Yb, alpha, pen, 2.0, False)
-    np.testing.assert_allclose(g2, g1, rtol=1e-13, atol=0)
-    assert abs(tr2 - tr1) <= 1e-10 * abs(tr1)
-    puu = np.einsum('rfa,rfb->fab', phi.conj(), phi)
-    A = sp.block_diag(list(puu)) + alpha * 2.0 * pen
-    Z = np.linalg.inv(A.toarray())
-    blocks = _inverse_diagonal_blocks(sp.csr_matrix(A), nfreq, nunk)
-    for f in range(nfreq):
-        sl = slice(f * nunk, (f + 1) * nunk)
-        np.testing.assert_allclose(blocks[f], Z[sl, sl], rtol=0, atol=1e-10 * np.abs(Z).max())

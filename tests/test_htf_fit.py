@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from control.exception import ControlArgument, ControlDimension
 
-from ltpcontrol._identification.excitation import chirp_replicas
-from ltpcontrol._frequency.htf import HTFData, htf
-from ltpcontrol._identification.htf_estimate import estimate_htf
-from ltpcontrol._core.ltpsys import ltpss
-from ltpcontrol._identification.htf_fit import estimate_delays, fit_htf
+from ltpcontrol import chirp_replicas
+from ltpcontrol import HTFData, htf
+from ltpcontrol import estimate_htf
+from ltpcontrol import ltpss
+from ltpcontrol import estimate_delays, fit_htf
 from test_htf_estimate import ScalarLTP
 
 TRUE = np.array([-2.0, 0.8])                 # (a0, a1)

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from control.exception import ControlArgument, ControlDimension
 
-from ltpcontrol._orbits.hybrid import HybridMode, HybridPlant, saltation_matrix, simulate_hybrid
-from ltpcontrol._orbits.orbits import period_map
+from ltpcontrol import HybridMode, HybridPlant, saltation_matrix, simulate_hybrid
+from ltpcontrol import period_map
 
 G = 9.81
 

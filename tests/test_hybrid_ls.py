@@ -12,7 +12,7 @@ import pytest
 from control.exception import ControlArgument, ControlDimension
 from scipy.integrate import solve_ivp
 
-from ltpcontrol._identification.hybrid_ls import HybridLSResult, hybrid_ls
+from ltpcontrol import HybridLSResult, hybrid_ls
 
 
 #
@@ -292,8 +292,8 @@ def test_single_record_arrays_and_scalar_state():
 
 
 def test_model_reproduces_record(mathieu1k):
-    from ltpcontrol._core.ltpsys import LTPStateSpace
-    from ltpcontrol._core.timeresp import forced_response
+    from ltpcontrol import LTPStateSpace
+    from ltpcontrol import forced_response
 
     t, x, u = mathieu1k
     sys = hybrid_ls(t, x, u, T_M, [0, T_M / 2], 1)

@@ -3,8 +3,6 @@ per-line least-squares separation of the inputs, and the whole chain
 (subspace, Floquet realization, refit, ML refinement, structure selection) on
 random 2-input, 2-output plants with periodic A, B, C."""
 
-import os
-import sys
 import warnings
 
 import control as ct
@@ -12,8 +10,7 @@ import numpy as np
 import pytest
 
 import ltpcontrol as ltp
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "examples"))
-from random_ltp_plants import design_lines, lifted_data, random_ltp  # noqa: E402
+from examples.random_ltp_plants import design_lines, lifted_data, random_ltp
 
 T, DT = 1.0, 1 / 64
 LINES = design_lines(T, 120)

@@ -1,8 +1,6 @@
 """Identification of generic LTP plants (periodic A, B, C), model comparison,
 structure selection and excitation design."""
 
-import os
-import sys
 import warnings
 
 import numpy as np
@@ -10,9 +8,7 @@ import pytest
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
-from ltpcontrol._identification.excitation import _replicas
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "examples"))
-from random_ltp_plants import design_lines, lifted_data, random_ltp  # noqa: E402
+from examples.random_ltp_plants import design_lines, lifted_data, random_ltp
 
 T, DT = 1.0, 1 / 64
 LINES = design_lines(T, 120)                           # training lines in (0, 3 ω_p)
@@ -128,22 +124,6 @@ def test_select_structure_finds_order_and_harmonics():
         ltp.select_structure(G, T, [2], [1], criterion='bic')
     with pytest.raises(ValueError, match='harmonics'):
         ltp.select_structure(G, T, [2], [5])
-
-
-def test_replicas_default_and_alias_warning():
-    assert _replicas(None, 2, None, 'nreplicas') == 7          # K + 2K + 1
-    assert _replicas(None, 2, 3, 'nreplicas') == 6
-    with pytest.warns(UserWarning, match=r'components \[-2, 2\] aliased'):
-        _replicas(5, 2, 3, 'nreplicas')
-    with warnings.catch_warnings():
-        warnings.simplefilter('error')
-        assert _replicas(5, 2, None, 'nreplicas') == 5        # 2K+1 for K_p = K
-    exc = ltp.chirp_replicas(1.0, None, 2.0, 0.0, 5.0, dt=0.01, nharmonics=1)
-    assert exc.segments.shape == (4, 2)
-    assert ltp.multisine([4.0, 8.0], 1.0, dt=0.01, nperiods=4, nharmonics=1,
-                         plant_harmonics=1).inputs.shape[0] == 3
-    with pytest.raises(ValueError, match='nharmonics'):
-        ltp.chirp_replicas(1.0, None, 2.0, 0.0, 5.0, dt=0.01)
 
 
 def test_unusable_lines_dropped_and_skipped():

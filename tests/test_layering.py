@@ -1,235 +1,120 @@
-"""The package is layered: a module may import only from its own layer or below.
+"""The package is layered, and its import graph has no cycle.
 
-The layer map below is the one place the layers are defined; the Developer
-notes page of the documentation shows it.  Every import counts, including
-imports inside functions, so a lazy import cannot hide a dependency on a
-higher layer.  A new module must be given a layer here before the suite
-passes.
+The layer map and the graph are defined once, in ``tools/import_graph.py``
+(the script anyone can rerun: ``python tools/import_graph.py``); the
+Developer notes page shows that map.  Every import counts, including imports
+inside functions, so a lazy import can neither hide a dependency on a higher
+layer nor close a cycle.  A new module must sit in a layer folder before the
+suite passes.
 """
 
 import ast
-import functools
 import pathlib
 import re
+import subprocess
+import sys
 
 import pytest
 
-PACKAGE = pathlib.Path(__file__).resolve().parents[1] / 'ltpcontrol'
+from tools.import_graph import (LAYERS, PACKAGE, TOP, cycles, layer_index, package_graph,
+                                package_imports, package_paths, violations)
 
-# layer map
-#: Layers from the bottom up, one folder of ``ltpcontrol/`` each (top-level
-#: modules named explicitly); a module may import from its own layer and the
-#: layers listed before it.
-LAYERS = {
-    # configuration
-    'config': ['config'],
-    # systems, periodic matrices, simulation, Floquet theory, discretization, lifting
-    'core': ['_core'],
-    # harmonic transfer functions, their plots, the harmonic state space
-    'frequency': ['_frequency'],
-    # analysis and synthesis on LTP models
-    'analysis': ['_analysis'],
-    # rhythmic (hybrid) plants, their periodic orbits and closed loops
-    'orbits': ['_orbits'],
-    # experiments and identification from data
-    'identification': ['_identification'],
-    # rotors and wind turbines: multi-blade coordinates, OpenFAST files, Campbell diagrams
-    'rotors': ['_rotors'],
-    # python-control's entry points
-    'interop': ['interop'],
-    # portable files of systems, periodic matrices and HTFs
-    'storage': ['storage'],
-}
-
-#: Method aliases: methods of a class that call a public function of a higher
-#: layer (python-control's ``lti.py`` does the same), e.g. ``sys.zeros()``
-#: for ``ltp.zeros(sys)``, so that python-control's own function dispatches.
-METHOD_ALIASES = {'_core.ltpsys': {'_frequency.htf', '_analysis.zeros', 'interop'},
-                  '_core.interconnect': {'interop'}}
-# end of layer map
-
-#: Modules exempt from the layering: the public namespace imports everything.
-TOP = {'__init__'}
-
-
-def module_key(path):
-    """Dotted name of a package module relative to the package: ``_core.ltpsys``."""
-    parts = path.relative_to(PACKAGE).with_suffix('').parts
-    if parts[-1] == '__init__' and len(parts) > 1:
-        parts = parts[:-1]
-    return '.'.join(parts)
-
-
-def layer_of(module, layers):
-    """The layer whose folder (or top-level module) holds `module`."""
-    head = module.split('.')[0]
-    for name, members in layers.items():
-        if head in members:
-            return name
-    return None
-
-
-def layer_index(layers):
-    """Map each folder or top-level module to the rank of its layer (0 = bottom)."""
-    rank = {}
-    for i, members in enumerate(layers.values()):
-        for mod in members:
-            assert mod not in rank, f"{mod} is assigned to two layers"
-            rank[mod] = i
-    return rank
-
-
-def package_imports(source, here='', package='ltpcontrol'):
-    """Package modules (dotted, relative to the package) imported anywhere in `source`.
-
-    `here` is the dotted folder of the importing module ('' at the top).
-    ``from .x import y`` names module ``x`` (or ``x.y`` when `y` is a module
-    of the package); ``from . import x`` names ``x``.
-    """
-    found = set()
-    base = here.split('.') if here else []
-
-    def resolve(level, module):
-        parts = base[:len(base) - (level - 1)] if level > 1 else list(base)
-        return '.'.join(parts + (module.split('.') if module else []))
-
-    for node in ast.walk(ast.parse(source)):
-        if isinstance(node, ast.ImportFrom):
-            if node.level >= 1:
-                target = resolve(node.level, node.module)
-            elif node.module and node.module.startswith(package + '.'):
-                target = node.module[len(package) + 1:]
-            else:
-                continue
-            for alias in node.names:
-                candidate = f"{target}.{alias.name}" if target else alias.name
-                found.add(candidate if _is_module(candidate) or not target else target)
-        elif isinstance(node, ast.Import):
-            for alias in node.names:
-                if alias.name.startswith(package + '.'):
-                    found.add(alias.name[len(package) + 1:])
-    return {mod for mod in found if mod}
-
-
-def _is_module(dotted):
-    path = PACKAGE.joinpath(*dotted.split('.'))
-    return path.with_suffix('.py').is_file() or (path / '__init__.py').is_file()
-
-
-def violations(graph, layers, top=frozenset(), aliases=None):
-    """Layering errors of a module graph ``{module: set of imported modules}``."""
-    aliases = aliases or {}
-    members = layer_index(layers)
-    rank = {mod: members[mod.split('.')[0]] for mod in set(graph).union(*graph.values())
-            if mod.split('.')[0] in members}
-    names = list(layers)
-    errors = []
-    for mod in sorted(graph):
-        if mod in top:
-            continue
-        if mod not in rank:
-            errors.append(f"{mod} has no layer: add it to LAYERS in tests/test_layering.py "
-                          f"(one of {names}); the Developer notes page shows that map")
-            continue
-        for dep in sorted(graph[mod]):
-            if dep in top:
-                errors.append(f"{mod} imports the package namespace; import the module")
-            elif dep in rank and rank[dep] > rank[mod] and dep not in aliases.get(mod, ()):
-                errors.append(f"{mod} ({names[rank[mod]]}) imports {dep} "
-                              f"({names[rank[dep]]}), a higher layer")
-    return errors
-
-
-def package_paths():
-    """Every module of the package, by its dotted key."""
-    return {module_key(path): path for path in sorted(PACKAGE.rglob('*.py'))}
-
-
-def package_source_imports(key, source):
-    here = key if PACKAGE.joinpath(*key.split('.'), '__init__.py').is_file() else \
-        key.rpartition('.')[0]
-    return package_imports(source, here)
-
-
-def package_graph():
-    return {key: package_source_imports(key, path.read_text())
-            for key, path in package_paths().items()}
-
-
-def _module_level(source):
-    """The module-level statements of `source` (imports inside functions excluded)."""
-    body = ast.parse(source).body
-    return '\n'.join(ast.unparse(node) for node in body
-                     if not isinstance(node, (ast.FunctionDef, ast.ClassDef)))
-
-
-def lazy_imports(source, here=''):
-    """Package modules imported inside functions and methods of `source`."""
-    return package_imports(source, here) - package_imports(_module_level(source), here)
-
-
-def reaches(graph, start, goal):
-    """True when `start` imports `goal`, directly or through other modules."""
-    seen, todo = set(), [start]
-    while todo:
-        mod = todo.pop()
-        if mod == goal:
-            return True
-        if mod not in seen:
-            seen.add(mod)
-            todo.extend(graph.get(mod, ()))
-    return False
-
-
-def unforced_lazy_imports(sources, aliases=None):
-    """Lazy imports ``(module, imported)`` that a module-level import could replace.
-
-    A lazy import is forced when the imported module already imports the
-    importer at module level (a top-level import would close a cycle), or
-    when it serves a method alias.
-    """
-    aliases = aliases or {}
-    def here(mod):
-        return mod.rpartition('.')[0]
-    top = {mod: package_imports(_module_level(src), here(mod)) for mod, src in sources.items()}
-    return sorted((mod, dep) for mod, src in sources.items()
-                  for dep in lazy_imports(src, here(mod)) - TOP
-                  if dep not in aliases.get(mod, ()) and not reaches(top, dep, mod))
-
-
-@functools.cache
-def package_unforced():
-    sources = {key: path.read_text() for key, path in package_paths().items()}
-    return unforced_lazy_imports(sources, METHOD_ALIASES)
+ROOT = PACKAGE.parent
 
 
 def test_package_respects_layers():
-    errors = violations(package_graph(), LAYERS, TOP, METHOD_ALIASES)
+    errors = violations(package_graph())
     assert not errors, "\n".join(errors)
 
 
-def modules(pending, reason):
-    """The package's modules; those in `pending` must fail (strict xfail) until mended."""
-    return [pytest.param(key, marks=pytest.mark.xfail(strict=True, reason=reason))
-            if key in pending else key for key in package_paths()]
+def test_import_graph_has_no_cycle():
+    found = cycles(package_graph())
+    assert not found, "import cycles: " + "; ".join(" <-> ".join(c) for c in found)
 
 
-# modules whose lazy imports are not yet at module level
-PENDING_LAZY = set()
+def test_every_module_sits_in_a_layer_folder():
+    top_level = {name for members in LAYERS.values() for name in members
+                 if not name.startswith('_')}
+    for key, path in package_paths().items():
+        head = key.split('.')[0]
+        if key == TOP:
+            continue
+        if '.' in key or path.name == '__init__.py':
+            assert head.startswith('_') and head in layer_index(LAYERS), key
+        else:
+            assert key in top_level, (f"{key} is a top-level module; put it in the folder "
+                                      "of its layer")
 
 
-@pytest.mark.parametrize('module', modules(PENDING_LAZY, "lazy imports without a cycle"))
-def test_lazy_imports_only_where_a_cycle_forces_them(module):
-    found = [dep for mod, dep in package_unforced() if mod == module]
-    assert not found, f"{module} imports {found} inside functions; import at module top"
+def test_import_graph_script_reports_layers_and_no_cycle():
+    run = subprocess.run([sys.executable, str(ROOT / 'tools' / 'import_graph.py')],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "Import cycles (every import, inside functions too): none" in run.stdout
+    assert "Modules without a layer: none" in run.stdout
+    for key in package_paths():
+        if key != TOP:
+            assert re.search(rf"^    {re.escape(key)} +imports", run.stdout, re.M), key
 
 
-def test_unforced_lazy_import_is_found():
-    sources = {'_a': "from ._b import g\n", '_b': "def f():\n    from ._a import h\n",
-               '_c': "def f():\n    from ._b import g\n"}
-    # _b -> _a is forced (_a imports _b at module level); _c -> _b is not
-    assert unforced_lazy_imports(sources) == [('_c', '_b')]
-    assert unforced_lazy_imports(sources, {'_c': {'_b'}}) == []
+def private_names(source, package='ltpcontrol'):
+    """Private names of the package that `source` imports or reaches by attribute.
+
+    A name is private when it, or a module on its dotted path, starts with one
+    underscore (``ltpcontrol._core.ltpsys``, ``from ltpcontrol.interop import
+    _wrap``, ``ltp._x``).
+    """
+    def private(parts):
+        return [p for p in parts if p.startswith('_') and not p.startswith('__')]
+
+    found, aliases = set(), set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                parts = alias.name.split('.')
+                if parts[0] == package:
+                    if private(parts):
+                        found.add(alias.name)
+                    elif len(parts) == 1:
+                        aliases.add(alias.asname or package)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module and \
+                node.module.split('.')[0] == package:
+            parts = node.module.split('.')
+            for alias in node.names:
+                if private(parts + [alias.name]):
+                    found.add(f"{node.module}.{alias.name}")
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Attribute):
+            chain, value = [node.attr], node.value
+            while isinstance(value, ast.Attribute):
+                chain.insert(0, value.attr)
+                value = value.value
+            if isinstance(value, ast.Name) and value.id in aliases and private(chain):
+                found.add('.'.join([value.id] + chain))
+    return sorted(found)
+
+
+TESTS = ROOT / 'tests'
+
+
+@pytest.mark.parametrize('path', sorted(p.relative_to(TESTS).as_posix()
+                                        for p in TESTS.rglob('*.py')
+                                        if 'internals' not in p.parts))
+def test_tests_use_public_names(path):
+    """Tests outside ``tests/internals/`` import only the public names of ltpcontrol."""
+    found = private_names((TESTS / path).read_text())
+    assert not found, (f"{path} uses private names {found}: use the public namespace, or "
+                       "move the test of internals to tests/internals/")
+
+
+def test_private_names_are_found():
+    source = ("import ltpcontrol as ltp\nimport ltpcontrol._core.ltpsys\n"
+              "from ltpcontrol import htf, _x\nfrom ltpcontrol.interop import refusal, _wrap\n"
+              "from ltpcontrol._core import floquet\nltp.htf\nltp._y\nltp.interop._z\n"
+              "other._w\n")
+    assert private_names(source) == ['ltp._y', 'ltp.interop._z', 'ltpcontrol._core.floquet',
+                                     'ltpcontrol._core.ltpsys', 'ltpcontrol._x',
+                                     'ltpcontrol.interop._wrap']
 
 
 #: python-control's system keywords, documented where they are passed on to the result
@@ -270,12 +155,7 @@ def hidden_options(source):
     return found
 
 
-# modules that still take documented options out of **kwargs
-PENDING_OPTIONS = set()
-
-
-@pytest.mark.parametrize('module', modules(PENDING_OPTIONS,
-                                              "documented option in **kwargs"))
+@pytest.mark.parametrize('module', sorted(package_paths()))
 def test_documented_options_are_parameters(module):
     found = hidden_options(package_paths()[module].read_text())
     assert not found, f"{module}: make these keyword-only parameters: {found}"
@@ -336,21 +216,31 @@ def test_upward_import_fails():
     assert violations(graph, SYNTHETIC) == ["_c (mid) imports _d (high), a higher layer"]
 
 
-def test_method_alias_is_the_only_upward_exception():
-    graph = {'_a': {'_d'}, '_b': {'_d'}, '_c': set(), '_d': set()}
-    assert violations(graph, SYNTHETIC, aliases={'_a': {'_d'}}) == [
-        "_b (low) imports _d (high), a higher layer"]
+def test_importing_the_namespace_fails():
+    graph = {'_a': {TOP}, TOP: {'_a'}}
+    assert violations(graph, SYNTHETIC) == ["_a imports the package namespace; import the module"]
+    assert cycles(graph) == [sorted(['_a', TOP])]
 
 
 def test_unknown_module_fails_with_instructions():
     errors = violations({'_new': {'_a'}, '_a': set()}, SYNTHETIC)
     assert len(errors) == 1
-    assert errors[0].startswith("_new has no layer: add it to LAYERS")
+    assert errors[0].startswith("_new has no layer: put it in a layer folder")
 
 
 def test_module_in_two_layers_is_rejected():
-    with pytest.raises(AssertionError, match="two layers"):
+    with pytest.raises(ValueError, match="two layers"):
         layer_index({'low': ['_a'], 'high': ['_a']})
+
+
+def test_cycle_through_a_lazy_import_is_found():
+    # _a imports _b at the top; _b imports _a inside a function: still a cycle
+    graph = {'_a': package_imports("from ._b import g\n"),
+             '_b': package_imports("def f():\n    from ._a import h\n"),
+             '_c': package_imports("from ._a import h\n")}
+    assert cycles(graph) == [['_a', '_b']]
+    assert cycles({'_a': {'_a'}}) == [['_a']]
+    assert cycles({'_a': {'_b'}, '_b': {'_c'}, '_c': set()}) == []
 
 
 @pytest.mark.parametrize('source, expected', [
@@ -362,6 +252,9 @@ def test_module_in_two_layers_is_rejected():
     ("from ltpcontrol._core.floquet import monodromy", {'_core.floquet'}),
     ("def f():\n    from .._identification.realization import floquet_realization\n",
      {'_identification.realization'}),
+    ("def f():\n    import ltpcontrol\n", {TOP}),
+    ("from ltpcontrol import htf", {TOP}),
+    ("from .. import htf", {TOP}),
     ("import numpy as np\nfrom scipy import linalg", set()),
 ])
 def test_imports_are_found_everywhere(source, expected):

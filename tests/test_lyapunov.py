@@ -119,7 +119,7 @@ def test_lyap_manufactured_switching(adjoint):
         if adjoint:
             return -_dX(t) - np.swapaxes(a, -1, -2) @ _X(t) - _X(t) @ a
         return _dX(t) - a @ _X(t) - _X(t) @ np.swapaxes(a, -1, -2)
-    Qp = ltp.PeriodicMatrix._new(T, (2, 2), func=Q, breakpoints=[0.0, 0.4 * T])
+    Qp = ltp.PeriodicMatrix.from_function(Q, T, (2, 2), breakpoints=[0.0, 0.4 * T])
     X = ltp.lyap(S, Qp, adjoint=adjoint)
     ts = np.concatenate([RNG.uniform(0, T, 6), [0.4 * T, 0.4 * T + 1e-9]])
     assert np.abs(X(ts) - _X(ts)).max() <= 1e-9

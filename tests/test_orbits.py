@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 from control.exception import ControlArgument, ControlDimension
 
-from ltpcontrol._orbits.hybrid import HybridMode, HybridPlant
-from ltpcontrol._core.ltpsys import LTPStateSpace
-from ltpcontrol._orbits.orbits import PeriodicOrbit, linearize_orbit, period_map, periodic_orbit
+from ltpcontrol import HybridMode, HybridPlant
+from ltpcontrol import LTPStateSpace
+from ltpcontrol import PeriodicOrbit, linearize_orbit, period_map, periodic_orbit
 from systems import fd_period_map_jacobian
 
 T = 2 * np.pi

@@ -8,9 +8,9 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
-from ltpcontrol._core.lifting import lift
-from ltpcontrol._identification.realization import floquet_realization, FloquetRealization
-from ltpcontrol._identification.canonical import to_canonical, matrix_errors, MatrixErrors
+from ltpcontrol import lift
+from ltpcontrol import floquet_realization, FloquetRealization
+from ltpcontrol import to_canonical, matrix_errors, MatrixErrors
 
 from systems import mathieu
 
@@ -173,13 +173,6 @@ class TestDirect:
         # (errata item 5): only the corrected distance vanishes there
         assert res.success and res.corrected_distance < 1e-18
         assert res.terms['A'] > 1e-3 and res.terms['C'] < 1e-18
-        # the literal distance is not scale invariant: d_C shrinks with T
-        from ltpcontrol._identification.realization import _Problem
-        prob = _Problem.from_system(ident, 1, 50, None, 'all')
-        T = np.random.default_rng(0).standard_normal((6, 6))
-        lit = [prob.distance(c * T[None], literal=True)[1]['C'][0] for c in (1.0, 0.1)]
-        cor = [prob.distance(c * T[None])[0][0] for c in (1.0, 0.1)]
-        assert np.isclose(lit[1], 0.01 * lit[0]) and np.isclose(cor[0], cor[1])
 
     def test_no_ladders_is_flagged(self):
         rng = np.random.default_rng(3)
@@ -262,7 +255,7 @@ class TestInputs:
         return lift(sysd, nharmonics=1)
 
     def test_unknown_keyword(self, ident):
-        with pytest.raises(TypeError, match='unrecognized'):
+        with pytest.raises(TypeError, match="unexpected keyword argument 'bogus'"):
             floquet_realization(ident, 1, 4, bogus=1)
 
     def test_wrong_sizes(self, ident):
@@ -333,7 +326,7 @@ class TestCanonical:
             to_canonical(unctrb, input=1)
         with pytest.raises(ControlArgument, match='sys'):
             to_canonical(ct.ss(-1, 1, 1, 0))
-        with pytest.raises(TypeError, match='unrecognized'):
+        with pytest.raises(TypeError, match="unexpected keyword argument 'foo'"):
             to_canonical(unctrb, foo=1)
 
     def test_matrix_errors(self):

@@ -18,8 +18,7 @@ from hypothesis import given, settings, strategies as st
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
-from ltpcontrol._identification.refine import (_Parametrisation, _data_points, _modal, _normalise,
-                                _response)
+from systems import real_fourier_basis
 
 
 def random_floquet(seed, nx=3, ny=1, nu=1, KB=1, KC=1, d=0.0, T=1.0, complex_pair=True):
@@ -68,27 +67,6 @@ def data_htf(sys, K, omega, std=None):
 OMEGA = np.linspace(0.2, 15.0, 40)
 
 
-@pytest.mark.parametrize("seed, shape, pair", [(0, (1, 1), True), (1, (2, 2), True),
-                                               (2, (2, 1), False)])
-def test_model_response_and_jacobian(seed, shape, pair):
-    sys = random_floquet(seed, ny=shape[0], nu=shape[1], KC=2, d=0.3, complex_pair=pair)
-    H, G = data_htf(sys, 2, OMEGA)
-    k, Om, vals, _, _ = _data_points(H, sys.period, *shape)
-    lam, V, kinds = _modal(sys.A(0.0))
-    Bt, Ct = np.linalg.inv(V) @ sys.B.fourier(1), sys.C.fourier(2) @ V
-    _normalise(Bt, Ct, kinds)
-    par = _Parametrisation(lam, Bt, Ct, sys.D.fourier(0), kinds, True, True)
-    Gm, J = _response(*par.unpack(par.theta0), k, Om, 2 * np.pi, jac=True)
-    assert np.max(np.abs(Gm - vals)) < 1e-12 * np.max(np.abs(vals))
-    Jz, th, eps = J @ par.M, par.theta0, 1e-6
-    for i in range(th.size):
-        step = np.zeros_like(th)
-        step[i] = eps
-        num = (_response(*par.unpack(th + step), k, Om, 2 * np.pi)
-               - _response(*par.unpack(th - step), k, Om, 2 * np.pi)).ravel() / (2 * eps)
-        assert np.max(np.abs(num - Jz[:, i])) < 1e-6 * max(1.0, np.abs(Jz[:, i]).max())
-
-
 @pytest.mark.parametrize("seed, shape, pair", [(3, (1, 1), True), (4, (2, 2), True),
                                                (5, (1, 2), False)])
 def test_noise_free_refinement_recovers_truth(seed, shape, pair):
@@ -128,8 +106,7 @@ def test_lifted_response_with_std_and_identify_ltp_start():
     # lifted response: G_n(jΩ) at the input lines Ω (component n at Ω + nω_p)
     Gn = np.stack([ltp.htf(true, K).components(w + n * 2 * np.pi / T)[1][n + K]
                    for n in range(-K, K + 1)])                         # (H, 1, 1, M)
-    from ltpcontrol._core.lifting import _real_basis
-    V, _ = _real_basis(np.arange(-K, K + 1), 20)
+    V = real_fourier_basis(K)
     frd = ct.frd((V.conj().T @ Gn[:, 0, 0])[:, None, :], w, dt=T / 20)
     start = perturbed(true, 6, 0.05)
     model, info = ltp.refine_ltp(start, frd, std=0.01, return_info=True)
@@ -240,8 +217,7 @@ def test_identify_ltp_refine_hook():
     w = 2 * np.pi / T * (np.arange(1, 40) / 8 + 1 / 16)
     H = ltp.htf(true, K)
     Gn = np.stack([H.components(w + n * 2 * np.pi / T)[1][n + K] for n in range(-K, K + 1)])
-    from ltpcontrol._core.lifting import _real_basis
-    V, _ = _real_basis(np.arange(-K, K + 1), N)
+    V = real_fourier_basis(K)
     rng = np.random.default_rng(0)
     noise = 1e-3 * (rng.standard_normal(Gn.shape) + 1j * rng.standard_normal(Gn.shape))
     frd = ct.frd((V.conj().T @ (Gn + noise)[:, 0, 0])[:, None, :], w, dt=T / N)

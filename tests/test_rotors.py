@@ -14,7 +14,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
 import ltpcontrol as ltp
-from rotor_models import HAMMOND, flap_A, hammond_A, hammond_groups, hammond_matrices
+from examples.rotor_models import HAMMOND, flap_A, hammond_A, hammond_groups, hammond_matrices
 
 FAILED = np.array([0.0, 1.0, 1.0, 1.0]) * HAMMOND['c_lag']
 

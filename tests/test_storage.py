@@ -136,7 +136,7 @@ def test_identified_model(how, tmp_path):
                        rng.standard_normal((N, 1, 2)), 0, period=N * dt, dt=dt)
     t = np.arange(200) * dt
     y = np.asarray(ltp.forced_response(model0, t, u[None]).outputs)[0]
-    model = ltp.identify_arx((t, u, y), N * dt, 2, 2)
+    model = ltp.identify_arx((t, u[None], y[None]), N * dt, 2, 2)        # 2 experiments
     back = how(model, tmp_path)
     assert_same_system(model, back)
     r0, r1 = ltp.forced_response(model, t, u[0]), ltp.forced_response(back, t, u[0])

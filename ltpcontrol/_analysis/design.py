@@ -23,7 +23,8 @@ from .._core.floquet import lti_representatives
 from .._core.ltpsys import LTPStateSpace, series
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .riccati import _check_weights, care, dare
-from .._core.validation import as_ltp, check_method, real_array
+from .._core.coerce import as_ltp
+from .._core.validation import check_method, real_array
 
 __all__ = ['lqr', 'dlqr', 'lqe', 'dlqe', 'lqg']
 

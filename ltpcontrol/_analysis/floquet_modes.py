@@ -37,7 +37,8 @@ from .._core.periodic_matrix import PeriodicMatrix
 from .._core.periodic_schur import product_eigenvalues
 from .._core.steps import step_grid
 from .._core.transition import step_transitions
-from .._core.validation import as_ltp, check_positive_int, steps_per_period
+from .._core.coerce import as_ltp
+from .._core.validation import check_positive_int, steps_per_period
 
 __all__ = ['floquet_modes', 'FloquetModes']
 

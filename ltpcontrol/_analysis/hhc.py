@@ -30,7 +30,8 @@ from control.exception import ControlDimension
 
 from .._core.ltpsys import LTPStateSpace
 from .._core.periodic_matrix import PeriodicMatrix
-from .._core.validation import as_ltp, check_positive, check_positive_int, real_array
+from .._core.coerce import as_ltp
+from .._core.validation import check_positive, check_positive_int, real_array
 from .._frequency.htf import HTFModel
 
 __all__ = ['hhc_tmatrix', 'hhc_controller']

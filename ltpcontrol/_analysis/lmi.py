@@ -31,7 +31,7 @@ from control.exception import ControlArgument
 
 from .._core.floquet import _log_multipliers
 from .._core.periodic_matrix import PeriodicMatrix
-from .._core.validation import as_ltp
+from .._core.coerce import as_ltp
 
 __all__ = ['lmi_statefbk', 'LMIDesign']
 
@@ -81,7 +81,7 @@ class LMIDesign:
     multipliers: np.ndarray
 
 
-def lmi_statefbk(sysd, Q=None, R=None, objective='h2', G=None, rate=None, solver=None):
+def lmi_statefbk(sysd, Q=None, R=None, *, objective='h2', G=None, rate=None, solver=None):
     """Periodic state feedback by convex optimization (LMIs, cvxpy).
 
     Parameters

@@ -30,7 +30,8 @@ from control.exception import ControlArgument, ControlDimension
 from .._core.floquet import _log_multipliers
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .._core.steps import step_grid, step_integrals
-from .._core.validation import as_ltp, real_array
+from .._core.coerce import as_ltp
+from .._core.validation import real_array
 
 __all__ = ['lyap', 'dlyap', 'gram']
 

@@ -36,7 +36,8 @@ from .lyapunov import cyclic_lyap, periodic_solution
 from .._core.periodic_matrix import PeriodicMatrix
 from .._core.steps import gram_weight, step_grid, step_integrals
 from .._core.transition import step_transitions
-from .._core.validation import as_ltp, check_method
+from .._core.coerce import as_ltp
+from .._core.validation import check_method
 
 __all__ = ['norm']
 

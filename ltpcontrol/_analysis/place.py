@@ -29,12 +29,13 @@ from control.exception import ControlArgument
 from .._core.discretize import sample_system
 from .._core.floquet import _log_multipliers
 from .._core.periodic_matrix import PeriodicMatrix
-from .._core.validation import as_ltp, real_array
+from .._core.coerce import as_ltp
+from .._core.validation import real_array
 
 __all__ = ['place']
 
 
-def place(sys, p, step=None, dt=None):
+def place(sys, p, *, step=None, dt=None):
     """Periodic state feedback with prescribed closed-loop poles, as `control.place`.
 
     Parameters

@@ -33,7 +33,8 @@ from control.exception import ControlArgument
 from .._core.ltpsys import LTPStateSpace
 from .lyapunov import dlyap
 from .periodic_balancing import gramians, hankel_svd, truncate
-from .._core.validation import as_ltp, check_positive_int, real_array
+from .._core.coerce import as_ltp
+from .._core.validation import check_positive_int, real_array
 
 __all__ = ['hsvd', 'balred', 'minreal']
 
@@ -91,7 +92,7 @@ def hsvd(sys, t=None, *, nsteps=None):
     return hankel_svd(P(t), Q(t))[3]
 
 
-def balred(sys, orders, method='truncate', return_bound=False, *, nsteps=None):
+def balred(sys, orders, method='truncate', *, return_bound=False, nsteps=None):
     """Periodic balanced truncation, as `control.balred`.
 
     Discrete time: per-step balancing projections of the periodic gramians.

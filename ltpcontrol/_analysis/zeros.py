@@ -22,11 +22,14 @@ from control.exception import ControlDimension
 
 from .._frequency.harmonic_ss import _toeplitz
 from .._core.lifting import lift
-from .._core.validation import as_ltp, check_positive_int
+from .._core.coerce import as_ltp
+from .._core.validation import check_positive_int
+from .._core.registry import method_alias
 
 __all__ = ['zeros']
 
 
+@method_alias
 def zeros(sys, nharmonics=None, *, rtol=1e-8):
     """Transmission zeros of a square LTP system.
 

@@ -29,7 +29,9 @@ import control as ct
 from .ltpsys import LTPStateSpace
 from .periodic_matrix import PeriodicMatrix
 from .transition import expm_batch, step_transitions
-from .validation import as_ltp, check_positive, steps_per_period
+from .coerce import as_ltp
+from .validation import check_positive, steps_per_period
+from .registry import method_alias
 
 __all__ = ['sample_system', 'd2c']
 
@@ -39,6 +41,7 @@ _LABEL_KEYS = ('inputs', 'outputs', 'states')
 _COND_MAX = 1e12
 
 
+@method_alias
 def sample_system(sys, Ts, method='zoh', alpha=None, prewarp_frequency=None,
                   name=None, copy_names=True, *, inputs=None, outputs=None, states=None):
     """Discretize a continuous-time LTP system.

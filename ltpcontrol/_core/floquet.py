@@ -33,7 +33,9 @@ from .periodic_schur import product_eigenvalues
 from .pm_ops import register_func
 from .steps import step_grid
 from .transition import expm_batch, step_transitions
-from .validation import as_ltp, check_kwargs, check_positive_int, steps_per_period
+from .coerce import as_ltp
+from .validation import check_positive_int, steps_per_period
+from .registry import method_alias
 
 __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
            'is_stable', 'floquet_transform']
@@ -44,6 +46,7 @@ _COND_MAX = 1e10
 _CHEB_DEG = 24
 
 
+@method_alias
 def monodromy(sys, nsteps=None):
     """Monodromy (period) matrix ``Φ(T, 0)`` of an LTP system.
 
@@ -83,6 +86,7 @@ def monodromy(sys, nsteps=None):
     return out
 
 
+@method_alias
 def floquet_multipliers(sys, nsteps=None):
     """Characteristic (Floquet) multipliers: eigenvalues of ``Φ(T, 0)``.
 
@@ -121,6 +125,7 @@ def floquet_multipliers(sys, nsteps=None):
     return mu
 
 
+@method_alias
 def floquet_exponents(sys, nsteps=None):
     """Characteristic (Floquet) exponents of an LTP system.
 
@@ -206,6 +211,7 @@ def lti_representatives(values, A, *, period=None, nper=None):
     return np.array(out, complex)
 
 
+@method_alias
 def is_stable(sys, tol=1e-10, nsteps=None, *, autonomous=False):
     """True when every Floquet multiplier satisfies ``|μ| < 1 - tol``.
 
@@ -254,7 +260,7 @@ def _without_phase_multiplier(logmod, arg):
     return np.delete(logmod, np.argmin(np.hypot(logmod, arg)))
 
 
-def floquet_transform(sys, real=True, nsteps=None, **kwargs):
+def floquet_transform(sys, real=True, nsteps=None):
     """Floquet (Lyapunov) transform to a system with constant A.
 
     With ``x = P(t) z`` (thesis eqs. 4.30-4.35), ``Φ(t, 0) = P(t) e^{Ft}``,
@@ -335,7 +341,6 @@ def floquet_transform(sys, real=True, nsteps=None, **kwargs):
     >>> np.allclose(P(0.0), np.eye(2)), np.allclose(P(1.0), np.eye(2))
     (True, True)
     """
-    check_kwargs(kwargs, 'floquet_transform')
     if not isinstance(real, (bool, np.bool_)):
         raise ControlArgument(f"real must be True or False, got {real!r}")
     grid, factors = _factors(sys, nsteps)

@@ -26,7 +26,8 @@ from control.exception import ControlArgument, ControlDimension
 
 from .ltpsys import LTPStateSpace
 from .periodic_matrix import PeriodicMatrix
-from .validation import as_ltp, check_positive, commensurate, real_array
+from .coerce import as_ltp
+from .validation import check_positive, commensurate, real_array
 
 __all__ = ['clarke_matrix', 'park_matrix', 'frame_transform', 'park', 'clarke',
            'sequence_components']

@@ -20,7 +20,6 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
-from ..interop import original
 from .ltpsys import LTPStateSpace, _loop_inverse, _period_and_dt, _to_ltp, append
 
 __all__ = ['interconnect']
@@ -97,7 +96,7 @@ def interconnect(syslist, connections=None, inplist=None, outlist=None, **kwargs
                                   "LTP, LTI and static blocks give an LTPStateSpace (use "
                                   "control.interconnect for nonlinear blocks)")
         blocks.append(s)
-    ic = original('interconnect')(blocks, connections=connections, inplist=inplist,
+    ic = _control_interconnect()(blocks, connections=connections, inplist=inplist,
                                   outlist=outlist, **kwargs)
     ltp_blocks = [_to_ltp(s, period, dt) for s in ic.syslist]
     big = append(*ltp_blocks)
@@ -113,3 +112,9 @@ def interconnect(syslist, connections=None, inplist=None, outlist=None, **kwargs
     D = (Pw @ big.D + Pv) @ Uu
     return LTPStateSpace(A, B, C, D, period, dt=dt, name=ic.name, inputs=ic.input_labels,
                          outputs=ic.output_labels, states=ic.state_labels)
+
+
+def _control_interconnect():
+    """python-control's own `control.interconnect` (unwrapped if the bridge wraps it)."""
+    fn = ct.interconnect
+    return getattr(fn, '__wrapped__', fn)

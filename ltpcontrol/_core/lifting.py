@@ -29,13 +29,13 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument
 
-from .validation import as_ltp, check_kwargs, check_positive_int
+from .coerce import as_ltp
+from .validation import check_positive_int
 
 __all__ = ['lift']
 
 
-def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, start=0,
-         **kwargs):
+def lift(sysd, *, method='frequency', real=True, nharmonics=None, name=None, start=0):
     """Lift a discrete-time LTP system to an equivalent LTI system.
 
     Parameters
@@ -112,7 +112,6 @@ def lift(sysd, method='frequency', real=True, nharmonics=None, name=None, start=
     >>> ltp.lift(sysd, method='time', start=1).B[0, 0]     # Φ(5, 2) B[1]
     np.float64(0.0625)
     """
-    check_kwargs(kwargs, 'lift')
     sysd = as_ltp(sysd, 'sysd', discrete=True)
     if method not in ('frequency', 'time'):
         raise ValueError(f"method must be 'frequency' or 'time', got {method!r}")

@@ -22,10 +22,10 @@ from control.iosys import _process_iosys_keywords
 from control.nlsys import NonlinearIOSystem
 
 from .display import html, text
-from .._frequency.htf import htf
 from .periodic_matrix import PeriodicMatrix, as_periodic
-from .validation import (as_ltp, check_period, check_positive, commensurate, real_array,
-                          steps_per_period)
+from .refusals import refusal, refusal_error
+from .registry import aliased
+from .validation import check_period, check_positive, commensurate, real_array, steps_per_period
 
 __all__ = ['LTPStateSpace', 'ltpss', 'series', 'parallel', 'feedback',
            'append', 'negate']
@@ -216,8 +216,7 @@ class LTPStateSpace(NonlinearIOSystem):
         return ct.ss(self.A(t), self.B(t), self.C(t), self.D(t), self.dt, **kwargs)
 
     def __call__(self, *args, **kwargs):
-        from ..interop import _refusal
-        raise _refusal("evaluation sys(s) of a transfer function",
+        raise refusal_error("evaluation sys(s) of a transfer function",
                        "ltp.htf(sys, nharmonics)(s), the harmonic transfer function")
 
     def average(self, **kwargs):
@@ -246,18 +245,15 @@ class LTPStateSpace(NonlinearIOSystem):
 
     def monodromy(self, **kwargs):
         """State transition matrix over one period, ``Φ(T, 0)``; see `ltpcontrol.monodromy`."""
-        from .floquet import monodromy
-        return monodromy(self, **kwargs)
+        return aliased('monodromy')(self, **kwargs)
 
     def floquet_multipliers(self, **kwargs):
         """Characteristic multipliers; see `ltpcontrol.floquet_multipliers`."""
-        from .floquet import floquet_multipliers
-        return floquet_multipliers(self, **kwargs)
+        return aliased('floquet_multipliers')(self, **kwargs)
 
     def floquet_exponents(self, **kwargs):
         """Characteristic exponents; see `ltpcontrol.floquet_exponents`."""
-        from .floquet import floquet_exponents
-        return floquet_exponents(self, **kwargs)
+        return aliased('floquet_exponents')(self, **kwargs)
 
     def poles(self):
         """Poles of the system: the Floquet (characteristic) exponents.
@@ -273,33 +269,28 @@ class LTPStateSpace(NonlinearIOSystem):
     # -- LTI-only requests: a clear pointer to the LTP counterpart --
     def frequency_response(self, omega=None, squeeze=None):
         """Not defined for an LTP system: its frequency response is the HTF (`ltpcontrol.htf`)."""
-        from ..interop import refusal
         raise refusal('frequency_response')
 
     def dcgain(self, warn_infinite=False):
         """Not defined for an LTP system; see `ltpcontrol.htf`."""
-        from ..interop import refusal
         raise refusal('dcgain')
 
     def zeros(self, nharmonics=None, *, rtol=1e-8):
         """Transmission zeros; see `ltpcontrol.zeros` (so `control.zeros` works)."""
-        from .._analysis.zeros import zeros
-        return zeros(self, nharmonics, rtol=rtol)
+        return aliased('zeros')(self, nharmonics, rtol=rtol)
 
     def is_stable(self, **kwargs):
         """True when all Floquet multipliers lie inside the unit circle."""
-        from .floquet import is_stable
-        return is_stable(self, **kwargs)
+        return aliased('is_stable')(self, **kwargs)
 
     def htf(self, nharmonics, **kwargs):
         """Harmonic transfer function truncated to K harmonics; see `ltpcontrol.htf`."""
-        return htf(self, nharmonics, **kwargs)
+        return aliased('htf')(self, nharmonics, **kwargs)
 
     def sample(self, Ts, method='zoh', alpha=None, prewarp_frequency=None,
                name=None, copy_names=True, **kwargs):
         """Discretize the system; see `ltpcontrol.sample_system`."""
-        from .discretize import sample_system
-        return sample_system(self, Ts, method=method, alpha=alpha,
+        return aliased('sample_system')(self, Ts, method=method, alpha=alpha,
                              prewarp_frequency=prewarp_frequency, name=name,
                              copy_names=copy_names, **kwargs)
 
@@ -629,7 +620,8 @@ def negate(sys, **kwargs):
     >>> (-P).D(0.0)
     array([[-0.5]])
     """
-    sys = as_ltp(sys)
+    if not isinstance(sys, LTPStateSpace):
+        raise ControlArgument(f"sys must be an LTPStateSpace, got {type(sys).__name__}")
     kwargs.setdefault('inputs', sys.input_labels)
     kwargs.setdefault('outputs', sys.output_labels)
     kwargs.setdefault('states', sys.state_labels)

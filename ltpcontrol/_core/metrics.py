@@ -41,6 +41,10 @@ def nrmse(y, y_hat):
     float
         The ratio of the 2-norms (0 for a perfect prediction).
 
+    See Also
+    --------
+    e_rms : the same error in percent, ``100 * nrmse`` (thesis eq. 3.59).
+
     Examples
     --------
     >>> y = np.sin(np.linspace(0, 2 * np.pi, 100, endpoint=False))
@@ -71,6 +75,10 @@ def e_rms(y, y_hat):
     -------
     float
         Error in percent.
+
+    See Also
+    --------
+    nrmse : the same error as a ratio.
 
     Examples
     --------

@@ -24,7 +24,8 @@ from scipy.integrate import solve_ivp
 
 from .gridmarch import grid_march
 from .march import periodic_march
-from .validation import as_ltp, check_kwargs, check_positive, real_array
+from .coerce import as_ltp
+from .validation import check_kwargs, check_positive, real_array
 
 __all__ = ['forced_response', 'step_response', 'initial_response', 'impulse_response']
 

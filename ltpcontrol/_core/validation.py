@@ -2,9 +2,10 @@
 
 Each helper raises python-control's exceptions (`ControlDimension` is a
 `ValueError`, `ControlArgument` a `TypeError`) or a builtin with a message
-that names the offending argument.  There is one helper per concept:
+that names the offending argument.  There is one helper per concept (the
+system argument, which needs the system class, is checked by
+``_core/coerce.py``):
 
-- `as_ltp`: a system argument (an `LTPStateSpace`, or an LTI system given a period),
 - `check_period`: a period; `check_positive`: any other positive quantity
   (``dt``, ``Ts``, durations, frequencies, tolerances),
 - `check_positive_int`: counts and orders,
@@ -27,55 +28,6 @@ __all__ = []
 #: Relative deviation of the sample steps from their mean below which a time
 #: vector counts as uniformly sampled.
 TIME_RTOL = 1e-6
-
-
-def as_ltp(sys, name="sys", *, period=None, discrete=None, lti_hint=None):
-    """Return `sys` as an `LTPStateSpace`, or raise naming the argument.
-
-    Parameters
-    ----------
-    sys : LTPStateSpace or control.StateSpace or control.TransferFunction
-        The system argument.
-    name : str
-        Argument name used in error messages.
-    period : float, optional
-        If given, an LTI `sys` is converted with ``ltpss(sys, period)``;
-        passing it with an `LTPStateSpace` is an error.
-    discrete : bool, optional
-        Require a discrete-time (True) or continuous-time (False) system.
-    lti_hint : str, optional
-        The python-control function to suggest when `sys` is LTI and no
-        `period` is given.
-
-    Examples
-    --------
-    >>> from ltpcontrol._core.validation import as_ltp
-    >>> as_ltp(ct.ss(-1, 1, 1, 0), period=2.0).period
-    2.0
-    >>> as_ltp(ct.ss(-1, 1, 1, 0), lti_hint='control.forced_response')
-    Traceback (most recent call last):
-    ...
-    control.exception.ControlArgument: sys must be an LTPStateSpace; it is an LTI system: use control.forced_response, or convert it with ltpss(sys, period)
-    """
-    # _ltpsys imports this module: the system class is looked up at call time
-    from .ltpsys import LTPStateSpace, ltpss
-    if isinstance(sys, LTPStateSpace):
-        if period is not None:
-            raise TypeError(f"the period is taken from the LTPStateSpace {name}; "
-                            "do not pass period")
-    elif isinstance(sys, (ct.StateSpace, ct.TransferFunction)):
-        if period is None:
-            use = f"use {lti_hint}, or " if lti_hint else ""
-            raise ControlArgument(f"{name} must be an LTPStateSpace; it is an LTI system: "
-                                  f"{use}convert it with ltpss(sys, period)")
-        sys = ltpss(sys, check_period(period))
-    else:
-        raise ControlArgument(f"{name} must be an LTPStateSpace, got {type(sys).__name__}")
-    if discrete is not None and sys.isdtime(strict=True) != discrete:
-        kind = "discrete" if discrete else "continuous"
-        raise ValueError(f"{name} must be a {kind}-time system, got a "
-                         f"{'continuous' if discrete else 'discrete'}-time one")
-    return sys
 
 
 def check_kwargs(kwargs, where):

@@ -28,7 +28,8 @@ from tqdm.auto import tqdm
 
 from .. import config
 from .._core.lifting import _frequency_lift, _full_harmonics, _harmonic_labels, _real_basis
-from .._core.validation import as_ltp, check_positive_int
+from .._core.coerce import as_ltp
+from .._core.validation import check_positive_int
 
 __all__ = ['harmonic_ss']
 

@@ -23,7 +23,9 @@ from control.exception import ControlArgument, ControlDimension
 
 from .. import config
 from .harmonic_ss import build, real_ss
-from .._core.validation import as_ltp, check_period, check_positive_int, real_array
+from .._core.coerce import as_ltp
+from .._core.validation import check_period, check_positive_int, real_array
+from .._core.registry import aliased, method_alias
 
 __all__ = ['HTF', 'HTFModel', 'HTFData', 'htf']
 
@@ -312,9 +314,7 @@ class HTF(abc.ABC):
         >>> type(ltp.htf(sys, 1).plot(omega_num=20)).__name__
         'ControlPlot'
         """
-        # _htfplot draws HTF objects, so it imports this module: a true cycle
-        from .htfplot import bode_htf
-        return bode_htf(self, *args, **kwargs)
+        return aliased('bode_htf')(self, *args, **kwargs)
 
     #
     # What each kind provides
@@ -516,6 +516,7 @@ class HTFData(HTF):
         return G
 
 
+@method_alias
 def htf(sys, nharmonics, *, internal_harmonics=None, method='auto', period=None):
     """Harmonic transfer function of an LTP system, truncated to K harmonics.
 

@@ -16,6 +16,7 @@ from control.exception import ControlArgument
 
 from .htf import HTF, HTFData, _harmonic, default_omega
 from .._core.validation import real_array
+from .._core.registry import method_alias
 
 __all__ = ['htf_response', 'bode_htf', 'htf_map_plot']
 
@@ -71,6 +72,7 @@ def htf_response(htfs, omega=None, harmonics=(-1, 0, 1), *, omega_limits=None,
     return out
 
 
+@method_alias
 def bode_htf(htfs, omega=None, *fmt, harmonics=None, omega_limits=None,
              omega_num=None, plot_phase=None, label=None, ax=None, title=None,
              progress=None, **kwargs):

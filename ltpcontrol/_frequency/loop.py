@@ -17,7 +17,8 @@ from control.exception import ControlArgument, ControlDimension
 from .htf import HTFModel
 from .._core.floquet import floquet_exponents
 from .._core.ltpsys import LTPStateSpace, series
-from .._core.validation import as_ltp, check_positive_int
+from .._core.coerce import as_ltp
+from .._core.validation import check_positive_int
 
 __all__ = []
 

@@ -28,7 +28,8 @@ from .htf import HTFModel, default_omega
 from .loop import LoopHTF, as_loop
 from .._core.ltpsys import LTPStateSpace, feedback, ltpss
 from .._core.periodic_matrix import PeriodicMatrix
-from .._core.validation import as_ltp, check_positive_int, real_array
+from .._core.coerce import as_ltp
+from .._core.validation import check_positive_int, real_array
 
 __all__ = ['sensitivity_htf', 'complementary_sensitivity_htf', 'siso_equivalent',
            'harmonic_admittance', 'harmonic_impedance']

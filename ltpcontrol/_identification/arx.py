@@ -22,41 +22,34 @@ import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
 from .._core.ltpsys import LTPStateSpace
-from .._core.validation import (check_kwargs, check_period, check_positive_int, real_array,
+from .records import as_records, common_grid, refuse_ambiguous
+from .._core.validation import (check_period, check_positive_int, real_array,
                           steps_per_period)
 
 __all__ = ['identify_arx']
 
 
 def _records(data):
-    """``(t, U, Y)`` with U, Y of shape (nexp, L)."""
-    if not isinstance(data, tuple) or len(data) != 3:
-        raise ControlArgument("data must be a tuple (timepts, inputs, outputs)")
-    t = real_array(data[0], 'timepts', ndim=1)
-    U = real_array(data[1], 'inputs', ndim=(1, 2))
-    Y = real_array(data[2], 'outputs', ndim=(1, 2))
-    U, Y = np.atleast_2d(U), np.atleast_2d(Y)
-    if U.shape != Y.shape or U.shape[1] != t.size:
-        raise ControlDimension(f"inputs and outputs must both have shape (nexp, {t.size}) "
-                               f"or ({t.size},), got {U.shape} and {Y.shape}")
-    if t.size < 2:
-        raise ValueError("timepts must hold at least 2 samples")
-    dt = np.diff(t)
-    if np.any(dt <= 0) or np.ptp(dt) > 1e-9 * dt.mean():
-        raise ValueError("timepts must be uniformly spaced and increasing")
-    return t, U, Y
+    """``(t, U, Y)`` with U, Y of shape (nexp, L): SISO records on one time grid."""
+    refuse_ambiguous(data, 'data', 'identify_arx')
+    t, _, U, Y = common_grid(as_records(data, 'data'), 'data')
+    if U.shape[0] != 1 or Y.shape[0] != 1:
+        raise ControlDimension(f"identify_arx identifies SISO models: data has {U.shape[0]} "
+                               f"inputs and {Y.shape[0]} outputs")
+    return t, U[0], Y[0]
 
 
-def identify_arx(data, period, na, nb, *, ridge=0.0, name=None, **kwargs):
+def identify_arx(data, period, na, nb, *, ridge=0.0, name=None):
     """Identify a periodic ARX model of a SISO LTP system from sampled records.
 
     Parameters
     ----------
-    data : tuple
+    data : tuple, control.TimeResponseData or list
         ``(timepts, inputs, outputs)``: uniform sample times (absolute:
         ``t = 0`` is the phase reference of the period), and input and
-        output samples of shape ``(L,)`` or ``(nexp, L)`` (several records on
-        the same time grid).  The input is taken as held between samples
+        output samples of shape ``(L,)``, or ``(1, nexp, L)`` for several
+        records on the same time grid; or a `control.TimeResponseData`, or
+        a list of records on the same grid.  The input is taken as held between samples
         (zero-order hold).
     period : float
         Period T; ``T / dt`` must be an integer N.
@@ -96,7 +89,6 @@ def identify_arx(data, period, na, nb, *, ridge=0.0, name=None, **kwargs):
     >>> bool(np.allclose(model.C.sample(N)[:, 0, 0], a))
     True
     """
-    check_kwargs(kwargs, 'identify_arx')
     t, U, Y = _records(data)
     period = check_period(period)
     na = check_positive_int(na, 'na')

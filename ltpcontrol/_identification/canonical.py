@@ -31,7 +31,8 @@ from .._core.ltpsys import ltpss
 from .._core.floquet import floquet_exponents
 from .._core.timeresp import forced_response
 from .._frequency.htf import htf
-from .._core.validation import as_ltp, check_kwargs, check_positive_int, real_array
+from .._core.coerce import as_ltp
+from .._core.validation import check_positive_int, real_array
 
 __all__ = ['to_canonical', 'matrix_errors', 'MatrixErrors', 'compare_ltp', 'LTPComparison']
 
@@ -39,7 +40,7 @@ __all__ = ['to_canonical', 'matrix_errors', 'MatrixErrors', 'compare_ltp', 'LTPC
 _COND_MAX = 1e12
 
 
-def to_canonical(sys, input=0, name=None, **kwargs):
+def to_canonical(sys, input=0, name=None):
     """Controllable canonical form of an LTP system in Floquet form.
 
     Parameters
@@ -90,7 +91,6 @@ def to_canonical(sys, input=0, name=None, **kwargs):
     array([[0.],
            [1.]])
     """
-    check_kwargs(kwargs, 'to_canonical')
     sys = as_ltp(sys)
     if not sys.is_floquet_form:
         raise ValueError("sys must be in Floquet form (constant A); apply "
@@ -145,7 +145,7 @@ class MatrixErrors(NamedTuple):
     D: float
 
 
-def matrix_errors(est, true, nsamples=512, **kwargs):
+def matrix_errors(est, true, nsamples=512):
     """Normalised errors between the matrices of two LTP systems (eq. 4.125).
 
     Parameters
@@ -185,7 +185,6 @@ def matrix_errors(est, true, nsamples=512, **kwargs):
     >>> round(err.A, 6), err.B, err.C
     (0.1, 0.0, 0.0)
     """
-    check_kwargs(kwargs, 'matrix_errors')
     _check_pair(est, true)
     nsamples = true.nsteps if true.isdtime(strict=True) else \
         check_positive_int(nsamples, 'nsamples')
@@ -298,7 +297,7 @@ def _signal(signal, true, omega, seed):
     return t, u
 
 
-def compare_ltp(est, true, omega, nharmonics='all', *, signal=None, seed=0, **kwargs):
+def compare_ltp(est, true, omega, nharmonics='all', *, signal=None, seed=0):
     """Compare two LTP systems by their HTFs and Floquet exponents.
 
     Both quantities are invariant under any (periodic) change of state
@@ -368,7 +367,6 @@ def compare_ltp(est, true, omega, nharmonics='all', *, signal=None, seed=0, **kw
     >>> bool(cmp.time_nrmse < 1e-10)
     True
     """
-    check_kwargs(kwargs, 'compare_ltp')
     _check_pair(est, true)
     omega = real_array(omega, 'omega', ndim=(0, 1)).ravel()
     if omega.size == 0:

@@ -32,7 +32,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 from control.exception import ControlArgument
 
-from .._core.validation import (check_kwargs, check_period, check_positive, check_positive_int,
+from .._core.validation import (check_period, check_positive, check_positive_int,
                           real_array, steps_per_period)
 
 __all__ = ['chirp_replicas', 'multisine', 'sine_experiments', 'Excitation']
@@ -131,8 +131,7 @@ def _replicas(nreplicas, nharmonics, plant_harmonics, what):
 
 
 def chirp_replicas(period, nreplicas, duration, f0, f1, *, dt,
-                   amplitude=1.0, gap=0.0, nharmonics=None, plant_harmonics=None,
-                   **kwargs):
+                   amplitude=1.0, gap=0.0, nharmonics=None, plant_harmonics=None):
     """Phase-shifted replicas of a linear chirp for HTF identification.
 
     Replica ``r = 0..R-1`` occupies its own record window
@@ -199,7 +198,6 @@ def chirp_replicas(period, nreplicas, duration, f0, f1, *, dt,
     >>> float(np.round(exc.signal(np.array([600 * 0.01 + 1 / 3]))[0], 12))
     0.0
     """
-    check_kwargs(kwargs, "chirp_replicas")
     period = check_period(period)
     nrep = _replicas(nreplicas, nharmonics, plant_harmonics, "nreplicas")
     duration = check_positive(duration, "duration")
@@ -329,7 +327,7 @@ def _joint(signal, shifts):
 
 
 def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
-                     amplitude=1.0, unusable='warn', ninputs=None, **kwargs):
+                     amplitude=1.0, unusable='warn', ninputs=None):
     """One sinusoid per experiment, on the DFT grid of the analysis window.
 
     Experiment ``e`` is ``amplitude · cos(ω_e t)`` for
@@ -377,7 +375,6 @@ def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
     >>> exc.frequencies.tolist(), exc.inputs.shape, exc.segments.tolist()
     ([1.25, 2.25], (2, 600), [[200, 600]])
     """
-    check_kwargs(kwargs, "sine_experiments")
     period, dt, nperiods, settle = _check_common(period, dt, nperiods, settle)
     amplitude = float(real_array(amplitude, "amplitude", ndim=0))
     omega, _ = _grid_frequencies(frequencies, nperiods * period, "frequencies")
@@ -410,7 +407,7 @@ def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
 
 def multisine(frequencies, period, *, dt, nperiods, nexperiments=None, settle=0,
               amplitude=1.0, phases='schroeder', seed=None, nharmonics=None,
-              plant_harmonics=None, ninputs=None, **kwargs):
+              plant_harmonics=None, ninputs=None):
     """Multisine experiments time-shifted by fractions of the period.
 
     All experiments share the multisine
@@ -469,7 +466,6 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=None, settle=0,
     >>> exc.inputs.shape
     (3, 160)
     """
-    check_kwargs(kwargs, "multisine")
     period, dt, nperiods, settle = _check_common(period, dt, nperiods, settle)
     nexp = _replicas(1 if nexperiments is None and nharmonics is None else nexperiments,
                      nharmonics, plant_harmonics, "nexperiments")

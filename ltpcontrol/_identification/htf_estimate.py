@@ -37,10 +37,10 @@ import scipy.optimize
 import scipy.sparse as sp
 import scipy.stats
 from control.exception import ControlArgument, ControlDimension
-from control.timeresp import TimeResponseData
 from tqdm.auto import tqdm
 
 from .._frequency.htf import HTFData
+from .records import as_records
 from .._core.validation import (check_period, check_positive_int,
                           real_array, steps_per_period)
 
@@ -128,48 +128,12 @@ class HTFEstimateInfo:
 # ---------------------------------------------------------------- data input
 def _as_records(data):
     """Return a list of ``(t, u, y, labels)`` with u (nu, nt) and y (ny, nt)."""
-    if isinstance(data, (TimeResponseData, tuple)):
-        data = [data]
-    if not isinstance(data, list) or len(data) == 0:
-        raise ControlArgument(
-            "data must be a TimeResponseData, a tuple (t, u, y) or a non-empty "
-            f"list of these, got {type(data).__name__}")
-    records = []
-    for i, rec in enumerate(data):
-        name = f"data[{i}]"
-        if isinstance(rec, TimeResponseData):
-            if rec.u is None:
-                raise ControlArgument(f"{name} has no inputs")
-            t, u, y = rec.t, np.asarray(rec.u), np.asarray(rec.y)
-            labels = {"inputs": rec.input_labels, "outputs": rec.output_labels}
-            if u.ndim == 3:          # (nu, ntraces, nt): one record per trace
-                for j in range(u.shape[1]):
-                    records.append(_check_record(t, u[:, j], y[:, j], f"{name} trace {j}")
-                                   + (labels,))
-                continue
-        elif isinstance(rec, tuple) and len(rec) == 3:
-            t, u, y = rec
-            labels = {}
-        else:
-            raise ControlArgument(f"{name} must be a TimeResponseData or a tuple (t, u, y)")
-        records.append(_check_record(t, u, y, name) + (labels,))
-    return records
-
-
-def _check_record(t, u, y, name):
-    t = real_array(t, f"{name} time", ndim=1)
-    u = np.atleast_2d(real_array(u, f"{name} inputs", ndim=(1, 2)))
-    y = np.atleast_2d(real_array(y, f"{name} outputs", ndim=(1, 2)))
-    if t.size < 2:
-        raise ValueError(f"{name} time must hold at least 2 samples")
-    if u.shape[1] != t.size or y.shape[1] != t.size:
-        raise ControlDimension(
-            f"{name}: inputs {u.shape} and outputs {y.shape} must have the "
-            f"time axis last with {t.size} samples")
-    step = np.diff(t)
-    if np.any(step <= 0) or np.ptp(step) > 1e-6 * step[0]:
-        raise ValueError(f"{name} time must be uniformly sampled and increasing")
-    return t, u, y
+    out = []
+    for rec in as_records(data, 'data'):
+        labels = {} if rec.output_labels is None else {"inputs": list(rec.input_labels),
+                                                       "outputs": list(rec.output_labels)}
+        out.append((rec.t, rec.u, rec.y, labels))
+    return out
 
 
 def _spectra(records, period, nharmonics, segments):

@@ -25,7 +25,7 @@ import scipy.optimize
 from control.exception import ControlArgument, ControlDimension
 
 from .._frequency.htf import HTF, HTFData
-from .._core.validation import check_kwargs, real_array
+from .._core.validation import real_array
 
 __all__ = ['fit_htf', 'estimate_delays', 'HTFFit', 'DelayEstimate']
 
@@ -176,7 +176,7 @@ def _model_harmonics(model, params, omega):
 
 
 def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
-            magnitude_only=False, weights=None, bounds=None, **kwargs):
+            magnitude_only=False, weights=None, bounds=None):
     """Fit a parameterised model family to an estimated HTF.
 
     Minimises ``Σ_{k, ω} |w (G_k(jω; p) - Ĝ_k(jω))|²`` (complex components)
@@ -222,7 +222,6 @@ def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
     >>> np.round(fit.params, 6).tolist()
     [-2.0]
     """
-    check_kwargs(kwargs, "fit_htf")
     if not callable(model):
         raise ControlArgument("model must be callable: model(params, omega)")
     omega, comps, std, _ = _estimate_arrays(estimate)
@@ -292,7 +291,7 @@ def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
 
 
 def estimate_delays(estimate, reference, *, harmonics=(-1, 0, 1), omega_limits=None,
-                    max_delay=None, input=0, output=0, **kwargs):
+                    max_delay=None, input=0, output=0):
     """Estimate input and measurement delays from HTF phases (thesis §3.6).
 
     Fits ``∠Ĥ_k(jω) = ∠G_k(jω) - (ω - kω_p) τ_u - ω τ_y`` (eq. 3.47) with
@@ -339,7 +338,6 @@ def estimate_delays(estimate, reference, *, harmonics=(-1, 0, 1), omega_limits=N
     >>> round(d.input_delay, 6), round(d.output_delay, 6)
     (0.04, 0.05)
     """
-    check_kwargs(kwargs, "estimate_delays")
     w, ks, weight, obs, period = _delay_data(estimate, reference, harmonics,
                                              omega_limits, input, output)
     tmax = period if max_delay is None else float(real_array(max_delay, "max_delay", ndim=0))

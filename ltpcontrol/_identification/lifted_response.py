@@ -28,8 +28,9 @@ from tqdm.auto import tqdm
 from .._frequency.htf import HTF, HTFData
 from .._core.lifting import _harmonic_labels, _real_basis
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
-from .._core.validation import (check_kwargs, check_period, check_positive, check_positive_int,
-                          real_array, steps_per_period, time_record)
+from .records import as_records, common_grid, refuse_ambiguous
+from .._core.validation import (check_period, check_positive, check_positive_int,
+                          real_array, steps_per_period)
 
 __all__ = ['lifted_frequency_response']
 
@@ -48,7 +49,7 @@ _HOLDS = (None, 'foh', 'zoh')
 def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
                               transient=0.0, input_hold=None, hold_step=None,
                               feedthrough=None, real=True, unusable='raise', batch_size=64,
-                              progress=False, name=None, **kwargs):
+                              progress=False, name=None):
     r"""Lifted frequency response of an LTP system from sine experiments.
 
     Each experiment applies real sinusoids (single sines) or sums of
@@ -70,13 +71,14 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     Parameters
     ----------
     response : control.TimeResponseData, tuple or HTFData
-        The experiments: a response of `ltpcontrol.forced_response` with
-        several traces, or a tuple ``(timepts, inputs, outputs)`` with
-        ``inputs`` of shape ``(nexp, L)`` (single input) or ``(ninputs,
-        nexp, L)`` and ``outputs`` of shape ``(nexp, L)`` (single output)
-        or ``(noutputs, nexp, L)``.  ``timepts`` (length L, uniform step
-        ``Ts``) are absolute times: ``t = 0`` is the phase reference of the
-        period.  Or a data HTF (`ltpcontrol.estimate_htf`); the record
+        The experiments, all on one time grid: a `control.TimeResponseData`
+        (a response of `ltpcontrol.forced_response` with several traces, or
+        one built by hand), a tuple ``(timepts, inputs, outputs)`` with
+        ``inputs`` of shape ``(ninputs, nexp, L)`` and ``outputs`` of shape
+        ``(noutputs, nexp, L)`` (channels first, time last; ``(L,)`` for
+        one channel and one experiment), or a list of such records.  ``timepts``
+        (length L, uniform step ``Ts``) are absolute times: ``t = 0`` is
+        the phase reference of the period.  Or a data HTF (`ltpcontrol.estimate_htf`); the record
         options (`frequencies`, `transient`, `input_hold`, `hold_step`,
         `batch_size`) then do not apply.
     period : float
@@ -217,7 +219,6 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
            [1. , 2. ],
            [0.5, 0. ]])
     """
-    check_kwargs(kwargs, 'lifted_frequency_response')
     period = check_period(period)
     if isinstance(response, HTF):
         K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
@@ -270,37 +271,13 @@ def _feedthrough(value, period, shape):
 
 def _parse_response(response):
     """``(t, Ts, u (nu, nexp, L), y (ny, nexp, L), output labels, input labels)``."""
-    if isinstance(response, ct.TimeResponseData):
-        t, u, y = response.time, response.u, response.y
-        if u is None:
-            raise ControlArgument("response carries no inputs; pass (timepts, inputs, "
-                                  "outputs) instead")
-        ylabels = list(response.output_labels)
-        ulabels = list(response.input_labels) if response.ninputs else None
-        if u.ndim == 2:                          # single trace
-            u, y = u[:, None, :], y[:, None, :]
-    elif isinstance(response, tuple) and len(response) == 3:
-        t, u, y = response
-        u = real_array(u, 'inputs', ndim=(1, 2, 3))
-        y = real_array(y, 'outputs', ndim=(1, 2, 3))
-        u = u.reshape((1,) * (3 - u.ndim) + u.shape)
-        y = y.reshape((1,) * (3 - y.ndim) + y.shape)
-        ylabels, ulabels = [f'y[{i}]' for i in range(y.shape[0])], None
-    else:
-        raise ControlArgument("response must be a control.TimeResponseData or a tuple "
-                              f"(timepts, inputs, outputs), got {type(response).__name__}")
-    u = real_array(u, 'inputs', ndim=3)
-    y = real_array(y, 'outputs', ndim=3)
-    if u.shape[1:] != y.shape[1:]:
-        raise ControlDimension(
-            f"inputs (experiments, samples) = {u.shape[1:]} and outputs "
-            f"{y.shape[1:]} are inconsistent: every experiment needs input and "
-            "output records of the same length")
-    t, dt, (uf, yf) = time_record(t, {'the records': u.reshape(-1, u.shape[2]),
-                                      'outputs': y.reshape(-1, y.shape[2])},
-                                  tname='timepts')
-    ulabels = ulabels or [f'u[{j}]' for j in range(u.shape[0])]
-    return t, dt, uf.reshape(u.shape), yf.reshape(y.shape), ylabels, ulabels
+    refuse_ambiguous(response, 'response', 'lifted_frequency_response')
+    records = as_records(response, 'response')
+    t, dt, u, y = common_grid(records, 'response')
+    rec = records[0]
+    ylabels = list(rec.output_labels or [f'y[{i}]' for i in range(y.shape[0])])
+    ulabels = list(rec.input_labels or [f'u[{j}]' for j in range(u.shape[0])])
+    return t, dt, u, y, ylabels, ulabels
 
 
 def _analysis_window(t, u, y, dt, N, transient):

@@ -32,12 +32,13 @@ from .._core.discretize import d2c
 from .fdsubspace import fdsubspace, FDSubspaceInfo
 from .floquet_fit import _harmonic_data, _harmonic_response, fit_floquet
 from .._frequency.htf import HTF
+from .records import as_records, refuse_ambiguous
 from .lifted_response import lifted_frequency_response
 from .._core.ltpsys import LTPStateSpace
 from .._core.periodic_matrix import PeriodicMatrix
 from .realization import FloquetRealization, floquet_realization
 from .refine import RefineInfo, _harmonics, refine_ltp
-from .._core.validation import (check_kwargs, check_period, check_positive, check_positive_int,
+from .._core.validation import (check_period, check_positive, check_positive_int,
                                 steps_per_period)
 
 __all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
@@ -126,8 +127,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
                  refit_harmonics='auto', refine=None, refine_options=None,
                  estimate_d=True, frequencies=None, transient=None, input_hold=None,
                  hold_step=None, batch_size=None, seed=None, holdout=4,
-                 validation_tol=0.05, progress=False, return_info=False, name=None,
-                 **kwargs):
+                 validation_tol=0.05, progress=False, return_info=False, name=None):
     r"""Identify a continuous-time LTP model from sine experiments (thesis §4.2).
 
     Runs the whole frequency-domain subspace pipeline: lifted frequency
@@ -364,7 +364,6 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     >>> round(float((B[2] / B[1]).real), 4)
     0.25
     """
-    check_kwargs(kwargs, 'identify_ltp')
     period = check_period(period)
     nstates = check_positive_int(nstates, 'nstates')
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
@@ -597,22 +596,12 @@ def _lifted_data(data, period, Kd, progress, options, K=0):
                     continue
             return lifted_frequency_response(data, period, K)
         return data
-    dt = _record_step(data)
-    if dt is not None:
-        Kd = min(Kd, (int(round(period / dt)) - 1) // 2)
+    # time records: parsed once here, so that errors name this function's argument
+    refuse_ambiguous(data, 'data', 'identify_ltp')
+    dt = as_records(data, 'data')[0].dt
+    Kd = min(Kd, (int(round(period / dt)) - 1) // 2)
     return lifted_frequency_response(data, period, Kd, progress=progress,
                                      unusable='skip', **given)
-
-
-def _record_step(data):
-    """Sampling time of time records (None if it cannot be read; the lifted
-    response then reports the error)."""
-    try:
-        t = data.time if isinstance(data, ct.TimeResponseData) else data[0]
-        t = np.asarray(t, dtype=float).ravel()
-        return float(t[1] - t[0]) if t.size > 1 and t[1] > t[0] else None
-    except (TypeError, IndexError, ValueError, AttributeError):
-        return None
 
 
 def _check_lifted_data(G, period, K, nstates, q):

@@ -8,10 +8,12 @@ pool on one machine, or any backend made active with
 """
 
 import multiprocessing
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
 from joblib import Parallel, delayed
+from joblib.parallel import get_active_backend
 from tqdm.auto import tqdm
 
 from .._core.validation import check_positive_int
@@ -98,6 +100,9 @@ def monte_carlo(func, ndraws, *, seed=None, n_jobs=None, timeout=None, progress=
     n_jobs : int, optional
         Number of joblib workers (default: that of the active
         ``joblib.parallel_config``, i.e. 1 unless set; -1 uses all cores).
+        With a local backend (processes or threads) it is capped to the
+        cores this process may run on (``os.sched_getaffinity``), so that
+        workers never outnumber the cores of a shared machine.
     timeout : float, optional
         Seconds after which a draw that has not finished raises
         `TimeoutError` (process backends), so a stuck worker does not hang
@@ -149,8 +154,7 @@ def monte_carlo(func, ndraws, *, seed=None, n_jobs=None, timeout=None, progress=
     if not callable(func):
         raise TypeError(f"func must be callable, got {type(func).__name__}")
     ndraws = check_positive_int(ndraws, 'ndraws')
-    if n_jobs is not None:
-        n_jobs = int(n_jobs)
+    n_jobs = local_workers(n_jobs)
     kwargs = {} if kwargs is None else dict(kwargs)
     root = np.random.SeedSequence(seed)
     tasks = (delayed(_draw)(func, i, seq, tuple(args), kwargs)
@@ -174,3 +178,35 @@ def monte_carlo(func, ndraws, *, seed=None, n_jobs=None, timeout=None, progress=
     shape = samples.shape[1:]
     return MonteCarloResult(samples=samples, mean=mean.reshape(shape), cov=cov,
                             sem=sem.reshape(shape), seed=root.entropy)
+
+
+def available_cores():
+    """Cores this process may run on (its CPU affinity where the OS reports it)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:                       # macOS, Windows
+        return max(1, os.cpu_count() or 1)
+
+
+def local_workers(n_jobs):
+    """`n_jobs` capped to `available_cores` when joblib's active backend is local.
+
+    A distributed backend (Dask) keeps `n_jobs` as given; -1 means every
+    available core, -2 all but one, as in joblib.
+    """
+    if n_jobs is None:
+        return None
+    n_jobs = int(n_jobs)
+    if n_jobs == 0:
+        raise ValueError("n_jobs must be a nonzero integer (-1: every available core)")
+    backend, _ = get_active_backend()
+    if type(backend).__name__ not in _LOCAL_BACKENDS:
+        return n_jobs
+    cores = available_cores()
+    if n_jobs < 0:
+        return max(1, cores + 1 + n_jobs)
+    return max(1, min(n_jobs, cores))
+
+
+_LOCAL_BACKENDS = {'LokyBackend', 'MultiprocessingBackend', 'ThreadingBackend',
+                   'SequentialBackend'}

@@ -62,7 +62,7 @@ from tqdm.auto import tqdm
 
 from .._core.lifting import _real_basis, lift
 from .._core.ltpsys import LTPStateSpace, ltpss
-from .._core.validation import check_kwargs, check_period, check_positive, check_positive_int
+from .._core.validation import check_period, check_positive, check_positive_int
 
 __all__ = ['floquet_realization', 'FloquetRealization']
 
@@ -129,7 +129,7 @@ class FloquetRealization:
 def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct',
                         input_harmonics='all', distance='corrected', tol=1e-4,
                         fit_tol=0.05, ladder_tol=0.1, seed=None, progress=False, pso_options=None,
-                        minimize_options=None, return_info=False, name=None, **kwargs):
+                        minimize_options=None, return_info=False, name=None):
     """Floquet-form LTP realization of an identified lifted LTI model.
 
     Finds a real similarity T that gives the identified model the
@@ -250,7 +250,6 @@ def floquet_realization(sys, nharmonics, nsteps, *, period=None, method='direct'
     >>> np.round(real.B.sample(8)[:3, 0, 0] / real.B.sample(8)[0, 0, 0], 4)
     array([1.    , 0.9024, 0.6667])
     """
-    check_kwargs(kwargs, 'floquet_realization')
     problem = _Problem.from_system(sys, nharmonics, nsteps, period, input_harmonics)
     if method not in ('direct', 'pso'):
         raise ValueError(f"method must be 'direct' or 'pso', got {method!r}")

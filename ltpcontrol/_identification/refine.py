@@ -50,7 +50,8 @@ from .floquet_fit import _harmonic_data
 from .._frequency.htf import HTF, HTFData
 from .._core.ltpsys import LTPStateSpace
 from .._core.periodic_matrix import PeriodicMatrix
-from .._core.validation import as_ltp, check_kwargs, check_positive_int, real_array, steps_per_period
+from .._core.coerce import as_ltp
+from .._core.validation import check_positive_int, real_array, steps_per_period
 
 __all__ = ['refine_ltp', 'RefineInfo']
 
@@ -414,8 +415,7 @@ def _harmonics(harmonics, sys, K):
 
 
 def refine_ltp(sys, data, *, std=None, harmonics=None, weighted=True, stable=False, refine_a=True,
-               estimate_d=None, maxiter=200, tol=1e-10, return_info=False, name=None,
-               **kwargs):
+               estimate_d=None, maxiter=200, tol=1e-10, return_info=False, name=None):
     r"""Maximum-likelihood refinement of a Floquet-form LTP model on frequency data.
 
     Fits a continuous-time LTP system in Floquet form (constant A,
@@ -532,7 +532,6 @@ def refine_ltp(sys, data, *, std=None, harmonics=None, weighted=True, stable=Fal
     >>> info.success, info.names[0]
     (True, 'lambda[0]')
     """
-    check_kwargs(kwargs, 'refine_ltp')
     if as_ltp(sys).isdtime():
         raise ControlArgument("sys must be a continuous-time LTPStateSpace, got a "
                               "discrete-time one")

@@ -32,7 +32,7 @@ from tqdm.auto import tqdm
 from .._core.lifting import _real_basis
 from .floquet_fit import _harmonic_data, _harmonic_response
 from .ltp_subspace import identify_ltp
-from .._core.validation import check_kwargs, check_period, check_positive_int, steps_per_period
+from .._core.validation import check_period, check_positive_int, steps_per_period
 
 __all__ = ['select_structure', 'StructureSelection']
 
@@ -117,7 +117,7 @@ class StructureSelection:
 
 
 def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion='validation',
-                     q=None, progress=False, **kwargs):
+                     q=None, progress=False):
     """Choose the order n_p and the harmonics K of an LTP model from data.
 
     Parameters
@@ -168,7 +168,6 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
     >>> sel.best
     (1, 1)
     """
-    check_kwargs(kwargs, 'select_structure')
     if not isinstance(data, ct.FrequencyResponseData) or not data.dt or data.dt is True:
         raise ControlArgument("data must be discrete-time lifted frequency-response data "
                               "(from lifted_frequency_response)")

@@ -24,7 +24,8 @@ from control.exception import ControlArgument
 from scipy.optimize import linear_sum_assignment
 
 from .._analysis.floquet_modes import floquet_modes
-from .._core.validation import as_ltp, real_array
+from .._core.coerce import as_ltp
+from .._core.validation import real_array
 
 __all__ = ['campbell', 'CampbellDiagram']
 

@@ -28,7 +28,8 @@ import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
 from .._core.periodic_matrix import PeriodicMatrix
-from .._core.validation import as_ltp, check_positive_int
+from .._core.coerce import as_ltp
+from .._core.validation import check_positive_int
 from .rotor_model import RotorStateSpace, sampled_matrix
 
 __all__ = ['mbc', 'coleman_matrix']

@@ -1,4 +1,7 @@
-"""Block march kernel: equal to the plain recurrence it replaces, for every shape."""
+"""Block march kernel: equal to the plain recurrence it replaces, for every shape.
+
+Tests of internals: they import private names (see the Developer notes).
+"""
 
 import numpy as np
 import pytest

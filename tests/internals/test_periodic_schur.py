@@ -1,4 +1,7 @@
-"""Eigenvalues of matrix products by the periodic Schur form."""
+"""Eigenvalues of matrix products by the periodic Schur form.
+
+Tests of internals: they import private names (see the Developer notes).
+"""
 
 import warnings
 

@@ -1,4 +1,7 @@
-"""Simulation on grids whose step does not divide the period: exact, like the aligned grid."""
+"""Simulation on grids whose step does not divide the period: exact, like the aligned grid.
+
+Tests of internals: they import private names (see the Developer notes).
+"""
 
 import numpy as np
 import pytest

@@ -1,4 +1,7 @@
-"""The shared input coercions of ``_validation``: one per concept."""
+"""The shared input checks of ``_core/validation.py`` and ``_core/coerce.py``: one per concept.
+
+Tests of internals: they import private names (see the Developer notes).
+"""
 
 import control as ct
 import numpy as np
@@ -6,8 +9,8 @@ import pytest
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
-from ltpcontrol._core.validation import (TIME_RTOL, as_ltp, check_period, check_positive,
-                                    time_record)
+from ltpcontrol._core.coerce import as_ltp
+from ltpcontrol._core.validation import TIME_RTOL, check_period, check_positive, time_record
 
 SYS = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
 

@@ -1,4 +1,7 @@
-"""Step transitions: splitting at switching instants and piecewise-constant steps."""
+"""Step transitions: splitting at switching instants and piecewise-constant steps.
+
+Tests of internals: they import private names (see the Developer notes).
+"""
 
 import numpy as np
 import pytest

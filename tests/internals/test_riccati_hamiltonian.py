@@ -1,4 +1,7 @@
-"""The Hamiltonian of `ltp.care` in closed Fourier form equals its pointwise form."""
+"""The Hamiltonian of `ltp.care` in closed Fourier form equals its pointwise form.
+
+Tests of internals: they import private names (see the Developer notes).
+"""
 
 import numpy as np
 import pytest

@@ -4,6 +4,8 @@
 Fourth-order Magnus on ``nsub`` sub-steps, ``nsub = 2, 4, ...`` doubled
 until two resolutions agree on every step, Richardson-extrapolated; here
 one step and one sub-step at a time with `scipy.linalg.expm`.
+
+Tests of internals: they import private names (see the Developer notes).
 """
 
 import numpy as np

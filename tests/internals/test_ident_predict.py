@@ -1,9 +1,10 @@
 """Identified models predict: every produced harmonic fitted, held-out validation,
 time-domain comparison, refinement fallback (independent truth: simulation of the
-true plant by forced_response)."""
+true plant by forced_response).
 
-import os
-import sys
+Tests of internals: they import private names (see the Developer notes).
+"""
+
 import warnings
 
 import numpy as np
@@ -14,9 +15,11 @@ import ltpcontrol as ltp
 import ltpcontrol._identification.ltp_subspace as subspace
 from ltpcontrol._identification.floquet_fit import _harmonic_data, _harmonic_response, fit_floquet
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "examples"))
-from random_ltp_plants import design_lines, lifted_data, random_ltp  # noqa: E402
-from ident_prediction_study import evaluate, plant_classes  # noqa: E402
+from examples.random_ltp_plants import design_lines, lifted_data, random_ltp
+from example_scripts import import_script
+
+study = import_script('ident_prediction_study')
+evaluate, plant_classes = study.evaluate, study.plant_classes
 
 T, DT = 1.0, 1 / 64
 LINES = design_lines(T, 60)

@@ -1,5 +1,8 @@
 """Memory- and time-safe HTF evaluation: chunking, path choice, refusal, one
-evaluation per bode_htf."""
+evaluation per bode_htf.
+
+Tests of internals: they import private names (see the Developer notes).
+"""
 
 import tracemalloc
 
