@@ -119,7 +119,8 @@ __all__ = [
     'save', 'load',
 ]
 
-# python-control's entry points dispatch LTP systems to ltpcontrol (see interop)
+# the python-control bridge (see interop): on unless ltp.config says otherwise
 from . import config  # noqa: E402
-from .interop import install as _install_interop  # noqa: E402
-_install_interop()
+from . import interop  # noqa: E402
+if config.defaults['interop.enabled']:
+    interop.enable()

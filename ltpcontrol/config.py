@@ -12,6 +12,12 @@
     (`htf_response`, `bode_htf`, `HTF.components`).
 ``htf.progress`` : bool, default False
     Show a progress bar over the frequency chunks of long evaluations.
+``interop.enabled`` : bool, default True
+    python-control's entry points called on an LTP system give ltpcontrol's
+    answer or a clear error (``ltpcontrol.interop``).  False turns the
+    installed dispatchers into pass-throughs; `ltpcontrol.interop.disable`
+    removes them.  The environment variable ``LTPCONTROL_INTEROP=0`` sets
+    the default to False (read when ltpcontrol is imported).
 ``period.max_multiple`` : int, default 100
     Largest integer ``q`` accepted in a common period ``T = q T_1 = p T_2``
     when systems of different periods are combined.
@@ -28,6 +34,7 @@ Examples
 """
 
 import contextlib
+import os
 
 __all__ = ['defaults', 'set_defaults', 'reset_defaults', 'defaults_context']
 
@@ -35,6 +42,8 @@ _DEFAULTS = {
     'htf.max_memory': 1e9,
     'htf.omega_num': 500,
     'htf.progress': False,
+    'interop.enabled': os.environ.get('LTPCONTROL_INTEROP', '1').strip() not in ('0', 'false',
+                                                                              'False'),
     'period.max_multiple': 100,
     'period.rtol': 1e-9,
 }

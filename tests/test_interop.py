@@ -228,46 +228,72 @@ def _assert_same(got, want):
     np.testing.assert_allclose(np.asarray(got, complex), np.asarray(want, complex), atol=1e-10)
 
 
-def test_hook_dispatches_to_the_ltpcontrol_function():
-    np.testing.assert_array_equal(ct.zeros(P), ltp.zeros(P))
-    sysd = ltp.sample_system(P, P.period / 8)
-    np.testing.assert_array_equal(ct.zeros(sysd), ltp.zeros(sysd))
-    G = ct.tf([1.0, 2.0], [1.0, 3.0, 1.0])
-    np.testing.assert_allclose(ct.zeros(G), [-2.0])        # LTI calls unaffected
-
-
 REFUSED_CALLS = {
-    'frequency_response': lambda: ct.frequency_response(P, [1.0]),
-    'nyquist_response': lambda: ct.nyquist_response(P[0, 0]),
     'bode_plot': lambda: ct.bode_plot(P),
     'nyquist_plot': lambda: ct.nyquist_plot(P[0, 0]),
+    'nyquist_response': lambda: ct.nyquist_response(P[0, 0]),
     'nichols_plot': lambda: ct.nichols_plot(P[0, 0]),
-    'singular_values_response': lambda: ct.singular_values_response(P),
     'singular_values_plot': lambda: ct.singular_values_plot(P),
-    'evalfr': lambda: ct.evalfr(P, 1j),
-    'dcgain': lambda: ct.dcgain(P),
     'margin': lambda: ct.margin(P[0, 0]),
     'stability_margins': lambda: ct.stability_margins(P[0, 0]),
     'disk_margins': lambda: ct.disk_margins(P[0, 0], [1.0]),
     'bandwidth': lambda: ct.bandwidth(P[0, 0]),
     'damp': lambda: ct.damp(P),
-    'pole_zero_map': lambda: ct.pole_zero_map(P),
-    'pole_zero_plot': lambda: ct.pole_zero_plot(P),
     'root_locus_map': lambda: ct.root_locus_map(P[0, 0]),
     'root_locus_plot': lambda: ct.root_locus_plot(P[0, 0]),
     'step_info': lambda: ct.step_info(P),
     'similarity_transform': lambda: ct.similarity_transform(P, np.eye(3)),
     'canonical_form': lambda: ct.canonical_form(P),
+    'reachable_form': lambda: ct.reachable_form(P[0, 0]),
+    'observable_form': lambda: ct.observable_form(P[0, 0]),
+    'modal_form': lambda: ct.modal_form(P),
     'ss': lambda: ct.ss(P),
     'tf': lambda: ct.tf(P),
     'ss2tf': lambda: ct.ss2tf(P),
+    'tf2ss': lambda: ct.tf2ss(P),
     'mixsyn': lambda: ct.mixsyn(P),
+    'h2syn': lambda: ct.h2syn(P, 1, 1),
+    'hinfsyn': lambda: ct.hinfsyn(P, 1, 1),
+    'augw': lambda: ct.augw(P),
     'find_operating_point': lambda: ct.find_operating_point(P, np.zeros(3)),
+    'create_statefbk_iosystem': lambda: ct.create_statefbk_iosystem(P, np.ones((2, 3))),
+    'create_estimator_iosystem': lambda: ct.create_estimator_iosystem(P, np.eye(2),
+                                                                      np.eye(2)),
+    'describing_function_response': lambda: ct.describing_function_response(
+        P[0, 0], ct.saturation_nonlinearity(1), [1.0]),
+    'lyap': lambda: ct.lyap(P, np.eye(3)),
+    'dlyap': lambda: ct.dlyap(P, np.eye(3)),
+    'care': lambda: ct.care(P, np.eye(3), np.eye(3)),
+    'dare': lambda: ct.dare(P, np.eye(3), np.eye(3), np.eye(2)),
+    'ctrb': lambda: ct.ctrb(P, np.eye(3)),
+    'pole_zero_plot': lambda: ct.pole_zero_plot(P),
+    'phase_crossover_frequencies': lambda: ct.phase_crossover_frequencies(P[0, 0]),
+    'phase_plane_plot': lambda: ct.phase_plane_plot(P[:2, :2]),
+    'phase_plot': lambda: ct.phase_plot(P),
+    'frd': lambda: ct.frd(P, [1.0]),
+    'ssdata': lambda: ct.ssdata(P),
+    'disk_margins': lambda: ct.disk_margins(P[0, 0], [1.0]),
+    'nlsys': lambda: ct.nlsys(P),
+    'tfdata': lambda: ct.tfdata(P),
+    'split_tf': lambda: ct.split_tf(P),
+    'bdschur': lambda: ct.bdschur(P),
+    'model_reduction': lambda: ct.model_reduction(P, [0]),
+    'ispassive': lambda: ct.ispassive(P),
+    'solve_passivity_LMI': lambda: ct.solve_passivity_LMI(P),
+    'get_input_ff_index': lambda: ct.get_input_ff_index(P),
+    'get_output_fb_index': lambda: ct.get_output_fb_index(P),
+    'obsv': lambda: ct.obsv(P, np.eye(3)),
 }
 
 
 def test_every_refused_entry_point_is_tested():
-    assert set(REFUSED_CALLS) == set(_interop.REFUSED)
+    assert set(REFUSED_CALLS) == set(_interop._REFUSED_SYS)
+
+
+def test_every_refusal_text_is_used():
+    used = (set(_interop._REFUSED_SYS) | set(_interop._MATRIX_REFUSED)
+            | {'frequency_response', 'dcgain', 'evaluation'})    # methods of the system
+    assert set(_interop.REFUSALS) == used
 
 
 @pytest.mark.parametrize('name', sorted(REFUSED_CALLS))
@@ -292,6 +318,15 @@ def test_aliases_are_refused_under_their_function_name():
         ct.find_eqpt(P, np.zeros(3))
 
 
+def test_periodic_matrices_are_refused_by_matrix_functions():
+    A = ltp.PeriodicMatrix([[[0.25]], [[-1.0]], [[0.25]]], T)
+    for call in (lambda: ct.lyap(A, np.eye(1)), lambda: ct.care(A, [[1.0]], [[1.0]]),
+                 lambda: ct.ctrb(A, [[1.0]]),
+                 lambda: ct.create_statefbk_iosystem(ct.ss(-1, 1, 1, 0), A)):
+        with pytest.raises(ControlArgument, match=r"PeriodicMatrix\): use ltp\."):
+            call()
+
+
 def test_methods_python_control_calls_give_the_same_errors():
     for name in ('frequency_response', 'dcgain'):
         with pytest.raises(ControlArgument, match=rf"^{name} does not apply.*ltp\.htf"):
@@ -309,14 +344,65 @@ def test_bode_alias_and_lti_calls_untouched():
     np.testing.assert_allclose(resp.frdata[0, 0, 0], 1 / (1j + 1))
 
 
-def test_every_listed_entry_point_exists_and_is_wrapped():
-    names = set(_interop.ROUTES) | set(_interop.HOOKS) | set(_interop.REFUSED)
-    for name in names:
+def test_every_bridged_entry_point_exists_and_is_wrapped():
+    for name in _interop.BRIDGED:
         fn = getattr(ct, name)
-        assert hasattr(fn, '_ltp_route'), name
-        assert fn.__wrapped__.__name__ in (name, fn.__name__)
+        assert fn.__wrapped__ is _interop.original(fn._ltp_bridge)   # aliases share one
     # the defining module holds the same dispatcher (internal calls see it)
     import control.timeresp
     assert control.timeresp.forced_response is ct.forced_response
-    _interop.install()                                  # idempotent
-    assert not hasattr(ct.forced_response.__wrapped__, '_ltp_route')
+    _interop.enable()                                   # idempotent
+    assert not hasattr(ct.forced_response.__wrapped__, '_ltp_bridge')
+
+
+def test_footprint_is_narrow():
+    # only entry points python-control cannot reach through the system's methods
+    reached_by_methods = {'series', 'parallel', 'negate', 'zeros', 'poles', 'dcgain',
+                          'evalfr', 'frequency_response', 'sample_system', 'c2d',
+                          'linearize', 'singular_values_response', 'pole_zero_map'}
+    assert not reached_by_methods & set(_interop.BRIDGED)
+
+
+def _control_attributes():
+    import sys
+    return {(n, a): v for n, m in list(sys.modules.items())
+            if m is not None and (n == 'control' or n.startswith('control.'))
+            for a, v in vars(m).items() if callable(v)}
+
+
+def test_disable_restores_python_control_and_enable_reinstalls():
+    before = _control_attributes()
+    with _interop.disable():
+        assert not _interop.is_enabled()
+        now = _control_attributes()
+        bridged = {k for k, v in before.items() if hasattr(v, '_ltp_bridge')}
+        assert bridged and all(not hasattr(now[k], '_ltp_bridge') for k in bridged)
+        assert all(now[k] is before[k] for k in before if k not in bridged)
+        assert all(now[k] is _interop.original(before[k]._ltp_bridge) for k in bridged)
+        # python-control alone: its ODE solver, with a warning saying so
+        with pytest.warns(UserWarning, match="not by ltpcontrol's exact simulation"):
+            ct.forced_response(P, t, U)
+    assert _interop.is_enabled()
+    assert all(_control_attributes()[k] is v for k, v in before.items())
+
+
+def test_config_switch_turns_dispatchers_into_pass_throughs():
+    with ltp.config.defaults_context({'interop.enabled': False}):
+        assert not _interop.is_enabled()
+        with pytest.raises(TypeError, match="Can't convert"):
+            ct.append(ct.ss(-1, 1, 1, 0), P)             # python-control's own error
+    np.testing.assert_allclose(ct.append(ct.ss(-1, 1, 1, 0), P).nstates, 4)
+
+
+def test_enable_inside_disabled_block_restores_disabled_state():
+    with _interop.disable():
+        with _interop.enable():
+            assert _interop.is_enabled()
+        assert not _interop.is_enabled()
+    assert _interop.is_enabled()
+
+
+def test_exact_simulation_does_not_warn():
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        ct.forced_response(P, t, U)

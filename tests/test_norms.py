@@ -113,8 +113,12 @@ def test_norm_bad_input():
         assert ltp.norm(unstable, 2) == np.inf     # as ct.norm
     with pytest.raises(ValueError, match="unstable"):
         ltp.norm(unstable, 'hankel')
-    with pytest.warns(UserWarning, match="unstable"):
-        assert ltp.norm(unstable, 'inf') == np.inf
+    # L∞ of an unstable system: finite, as ct.norm (1/(s - 0.2) peaks at ω = 0)
+    assert np.isclose(ltp.norm(unstable, 'inf', tol=1e-9),
+                      ct.norm(ct.ss(0.2, 1, 1, 0), 'inf'), rtol=1e-8)
+    integrator = ltp.ltpss([[0.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    with pytest.warns(UserWarning, match="imaginary axis"):
+        assert ltp.norm(integrator, 'inf') == np.inf
     stable = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0.5, period=1.0)
     with pytest.warns(UserWarning, match="feedthrough"):
         assert ltp.norm(stable, 2) == np.inf

@@ -29,7 +29,7 @@ from .._core.validation import check_method, real_array
 __all__ = ['lqr', 'dlqr', 'lqe', 'dlqe', 'lqg']
 
 
-def lqr(sys, Q, R, N=None, nsteps=None, *, method=None):
+def lqr(sys, Q, R, N=None, nsteps=None, *, integral_action=None, method=None):
     """Periodic linear quadratic regulator, as `control.lqr`.
 
     Minimizes ``∫ (xᵀQx + uᵀRu + 2xᵀNu) dt`` for ``ẋ = A(t)x + B(t)u``
@@ -47,6 +47,11 @@ def lqr(sys, Q, R, N=None, nsteps=None, *, method=None):
     nsteps : int, optional
         Continuous time: steps per period of the Riccati solver (see
         `ltpcontrol.care`).
+    integral_action : ndarray, optional
+        Matrix ``C_i`` (nint, n), as in `control.lqr`: the plant is
+        augmented with integrators ``ż = C_i x`` (discrete time ``z[k+1] =
+        z[k] + C_i x[k]``), Q and N then have ``n + nint`` rows and K has
+        ``n + nint`` columns.
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
         call works; the periodic algorithm is always used.
@@ -78,12 +83,13 @@ def lqr(sys, Q, R, N=None, nsteps=None, *, method=None):
     """
     check_method(method)
     if _discrete(sys, nsteps):
-        return dlqr(sys, Q, R, N)
-    X, E, K = care(sys.A, sys.B, Q, R, N, period=sys.period, nsteps=nsteps)
+        return dlqr(sys, Q, R, N, integral_action=integral_action)
+    A, B = _with_integrators(sys, integral_action, 'lqr')
+    X, E, K = care(A, B, Q, R, N, period=sys.period, nsteps=nsteps)
     return K, X, E
 
 
-def dlqr(sys, Q, R, N=None, *, method=None):
+def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None):
     """Periodic discrete-time linear quadratic regulator, as `control.dlqr`.
 
     Minimizes ``Σ_k (x_kᵀQ_kx_k + u_kᵀR_ku_k + 2x_kᵀN_ku_k)`` for
@@ -97,6 +103,9 @@ def dlqr(sys, Q, R, N=None, *, method=None):
         Weights: a 2D array (the same at every step), an array of shape
         (N, rows, cols) (one matrix per step), or a periodic matrix sampled
         at ``t = k dt``.  N (cross weight) is zero by default.
+    integral_action : ndarray, optional
+        Matrix ``C_i`` (nint, n): integrators ``z[k+1] = z[k] + C_i x[k]``
+        augment the plant, as in `control.dlqr`.
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
         call works; the periodic algorithm is always used.
@@ -124,7 +133,8 @@ def dlqr(sys, Q, R, N=None, *, method=None):
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqr: sys must be a discrete-time system (use lqr)")
     steps = sys.nsteps
-    A, B = sys.A.sample(steps), sys.B.sample(steps)
+    A, B = _with_integrators(sys, integral_action, 'dlqr')
+    A, B = A.sample(steps), B.sample(steps)
     X, E, K = dare(A, B, _steps(Q, sys, 'Q'), _steps(R, sys, 'R'),
                    None if N is None else _steps(N, sys, 'N'))
     return _held(K, sys), _held(X, sys), E
@@ -352,6 +362,23 @@ def _filtered_lqg(sys, Q, R, QN, RN, F, name):
 #
 # Helpers
 #
+
+def _with_integrators(sys, C, where):
+    """A and B of the plant augmented with integrators of ``C x`` (python-control's
+    ``integral_action``): ``[[A, 0], [C, 0]]`` (discrete ``[[A, 0], [C, I]]``), ``[B; 0]``."""
+    if C is None:
+        return sys.A, sys.B
+    if not isinstance(C, np.ndarray) or C.ndim != 2 or C.shape[1] != sys.nstates:
+        raise ControlArgument(f"{where}: integral_action must be an array with "
+                              f"{sys.nstates} columns (one per state), got "
+                              f"{getattr(C, 'shape', type(C).__name__)}")
+    C = real_array(C, 'integral_action', ndim=2)
+    k = C.shape[0]
+    last = np.eye(k) if sys.isdtime(strict=True) else np.zeros((k, k))
+    A = PeriodicMatrix.block([[sys.A, np.zeros((sys.nstates, k))], [C, last]])
+    B = PeriodicMatrix.block([[sys.B], [np.zeros((k, sys.ninputs))]])
+    return A, B
+
 
 def _discrete(sys, nsteps):
     """True for a discrete-time plant (which takes no nsteps)."""

@@ -55,14 +55,18 @@ def norm(sys, p=2, tol=1e-6, print_warning=True, method=None, *,
         Continuous- or discrete-time LTP system.
     p : {2, 'inf', 'hankel'}
         2: the H2 norm, per-period average (Conventions page); 'inf': the
-        L∞ norm (induced L2 gain, ``sup_ω σ_max`` of the HTF); 'hankel': the
+        L∞ norm (``sup_ω σ_max`` of the HTF; for a stable system the H∞
+        norm, the induced L2 gain; for an unstable one the L∞ norm, as
+        python-control returns; inf when a Floquet multiplier lies on the
+        unit circle); 'hankel': the
         largest Hankel singular value over all start times in the period.
     tol : float, optional
         Relative accuracy of the L∞ norm (bisection between certified
         bounds); ignored for the other norms, which are exact.
     print_warning : bool, optional
-        Warn when the H2 or L∞ norm of an unstable system is returned as
-        inf (as python-control does), or the H2 norm of a continuous system
+        Warn when the H2 norm of an unstable system, or the L∞ norm of a
+        system with a multiplier on the unit circle, is returned as inf (as
+        python-control does), or the H2 norm of a continuous system
         with feedthrough.
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
@@ -115,9 +119,14 @@ def norm(sys, p=2, tol=1e-6, print_warning=True, method=None, *,
     if return_frequency and p != 'inf':
         raise ValueError("return_frequency applies to p='inf' only")
     if p == 'inf':
-        if not sys.is_stable():
+        # the L∞ norm (python-control's answer, also for unstable systems);
+        # infinite when a multiplier lies on the unit circle (|μ| = 1 ± 1e-8)
+        mu = np.abs(np.linalg.eigvals(sys.monodromy())) if sys.nstates else np.zeros(0)
+        if np.any(np.isclose(mu, 1.0, rtol=0, atol=1e-8)):
             if print_warning:
-                warnings.warn("System is unstable!", UserWarning, stacklevel=2)
+                where = ("complex unit circle" if sys.isdtime() else "imaginary axis")
+                warnings.warn(f"Poles close to, or on, the {where}.", UserWarning,
+                              stacklevel=2)
             return (float('inf'), np.nan) if return_frequency else float('inf')
         value, freq = (_linf_discrete(sys, tol) if sys.isdtime()
                        else _linf_continuous(sys, tol, nsteps))

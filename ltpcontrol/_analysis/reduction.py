@@ -189,7 +189,7 @@ def balred(sys, orders, method='truncate', *, return_bound=False, nsteps=None):
     return (rsys, bound) if return_bound else rsys
 
 
-def minreal(sys, tol=None, *, nsteps=None):
+def minreal(sys, tol=None, *, verbose=False, nsteps=None):
     """Remove the uncontrollable and unobservable periodic modes, as `control.minreal`.
 
     Balanced truncation of the states whose Hankel singular values stay
@@ -208,6 +208,11 @@ def minreal(sys, tol=None, *, nsteps=None):
         Relative tolerance on the Hankel singular values (default
         ``sqrt(eps)``, about 1.5e-8, in discrete time; 1e-6 for continuous
         periodic matrices, whose gramians are integrated to about 1e-12).
+        Constant continuous-time matrices use `control.minreal` with this
+        `tol` (default python-control's).
+    verbose : bool, optional
+        Print the number of removed states, as `control.minreal` (whose
+        default is True; here False).
     nsteps : int, optional
         Continuous time only: uniform steps of the period grid (`lyap`).
 
@@ -230,15 +235,27 @@ def minreal(sys, tol=None, *, nsteps=None):
     >>> ltp.minreal(sysd).nstates
     1
     """
+    red = _minreal(sys, tol, nsteps)
+    if not isinstance(verbose, (bool, np.bool_)):
+        raise ValueError(f"verbose must be True or False, got {verbose!r}")
+    if verbose and red.nstates < sys.nstates:
+        print(f"{sys.nstates - red.nstates} states have been removed from the model")
+    return red
+
+
+def _minreal(sys, tol, nsteps):
     periodic_ct = not sys.isdtime(strict=True) and not sys.is_lti \
         if isinstance(sys, LTPStateSpace) else False
-    if tol is None:
+    lti_ct = isinstance(sys, LTPStateSpace) and not sys.isdtime(strict=True) and sys.is_lti
+    if tol is None and not lti_ct:
         tol = 1e-6 if periodic_ct else np.sqrt(np.finfo(float).eps)
-    if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, (int, float, np.floating)) \
-            or not 0 <= tol < 1:
+    if tol is not None and (isinstance(tol, (bool, np.bool_))
+                            or not isinstance(tol, (int, float, np.floating))
+                            or not 0 <= tol < 1):
         raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
     _check(sys)
-    if not sys.isdtime(strict=True) and sys.is_lti:
+    if lti_ct:
+        # python-control's algorithm and default tolerance for constant matrices
         red = ct.minreal(sys.to_ss(), tol=tol, verbose=False)
         return LTPStateSpace(red.A, red.B, red.C, red.D, sys.period,
                              inputs=sys.input_labels, outputs=sys.output_labels,

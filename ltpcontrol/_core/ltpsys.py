@@ -15,6 +15,8 @@ interconnects with python-control), never an LTI system.
 
 import numbers
 
+import warnings
+
 import numpy as np
 import control as ct
 from control.exception import ControlArgument, ControlDimension
@@ -214,6 +216,15 @@ class LTPStateSpace(NonlinearIOSystem):
         for key in ('inputs', 'outputs', 'states'):
             kwargs.setdefault(key, getattr(self, key[:-1] + '_labels'))
         return ct.ss(self.A(t), self.B(t), self.C(t), self.D(t), self.dt, **kwargs)
+
+    def _update_params(self, params):
+        # python-control calls this before it integrates the system itself
+        warnings.warn(
+            f"python-control simulates the LTPStateSpace {self.name!r} as a generic "
+            "nonlinear system (an ODE solver at its tolerances), not by ltpcontrol's exact "
+            "simulation: use ltp.forced_response (or ltp.interop.enable())", UserWarning,
+            stacklevel=3)
+        super()._update_params(params)
 
     def __call__(self, *args, **kwargs):
         raise refusal_error("evaluation sys(s) of a transfer function",

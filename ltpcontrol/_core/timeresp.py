@@ -51,9 +51,11 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
     ----------
     sys : LTPStateSpace
         System to simulate.
-    timepts : array_like or float
+    timepts : array_like or float, optional
         Increasing time points (1D).  A scalar gives ``[0, timepts]`` with
-        50 samples per period.  Discrete-time systems need multiples of `dt`.
+        50 samples per period.  Discrete-time systems need multiples of `dt`;
+        without `timepts` they take ``k dt`` for the samples of `inputs`,
+        as `control.forced_response`.
     inputs : array_like or float
         Input values, shape ``(ninputs, len(timepts))``, or ``(ninputs,
         ntraces, len(timepts))`` to simulate several input signals in one
@@ -103,6 +105,9 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
     """
     check_kwargs(kwargs, 'forced_response')
     sys = as_ltp(sys, lti_hint='control.forced_response')
+    if timepts is None and sys.isdtime(strict=True) and np.ndim(inputs) > 0:
+        # python-control: a discrete-time input without timepts is sampled at k dt
+        timepts = np.arange(np.shape(inputs)[-1]) * sys.dt
     t = _time_vector(sys, timepts)
     u, ntraces = _input_array(sys, inputs, len(t))
     x0 = _initial_state(sys, initial_state, ntraces)
