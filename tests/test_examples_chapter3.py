@@ -151,7 +151,7 @@ def test_vhop_noise_study_lowers_error_at_1hz():
 
 
 @pytest.mark.slow
-def test_vhop_ml_refinement_beats_subspace_at_1hz():
+def test_vhop_subspace_and_ml_models_predict_at_1hz():
     # truth: an LTP plant with the VHOP's matrices; quick chirps, input and output
     # noise at SNR 12.5, one seeded draw
     plant = _vhop_like_plant()
@@ -167,8 +167,9 @@ def test_vhop_ml_refinement_beats_subspace_at_1hz():
     y_sine = ltp.forced_response(plant, t, u).outputs[-n:]
     t, u = t[-n:], u[-n:]
     errors = [ltp.e_rms(y_sine, vh.model_prediction(m, t, u)) for m in (sub, ml)]
-    assert errors[1] < errors[0]
-    assert errors[1] < 15.0
+    # identify_ltp refits its subspace model on every harmonic of the data, so both
+    # models meet the example's 10 % target at 1 Hz (the raw subspace model misses it)
+    assert max(errors) < 10.0
     # the weighted residual per degree of freedom is at most that of the data's std
     # (0.45 here: the pooled noise variance is conservative for this plant), so the
     # reported covariance (inverse Fisher information) is not optimistic

@@ -1,0 +1,82 @@
+"""Run the project's checks side by side and report each one's output.
+
+The checks are independent commands (the test suite, the documentation
+build, ...); they run in parallel, at most as many at a time as the
+machine has cores, longest first.  Each check's output is printed whole
+when it ends, and the script exits non-zero when any check fails.
+
+    python tools/check.py            # every check
+    python tools/check.py tests docs # the named checks only
+"""
+
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor, as_completed
+
+PYTHON = sys.executable
+BIN = os.path.dirname(PYTHON)
+
+#: name -> command (started in this order)
+CHECKS = {
+    'imports': [PYTHON, 'tools/import_graph.py'],
+    'tests': [PYTHON, '-m', 'pytest'],
+    'docs': [os.path.join(BIN, 'sphinx-build'), '-W', '-q', '-b', 'html', 'docs',
+             'docs/_build/html'],
+}
+
+
+def cores():
+    """Cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:                                  # not on Linux
+        return os.cpu_count() or 1
+
+
+#: one BLAS thread per check: checks already run side by side on the cores
+SINGLE_THREAD = {name: '1' for name in ('OMP_NUM_THREADS', 'OPENBLAS_NUM_THREADS',
+                                        'MKL_NUM_THREADS')}
+
+
+def run(name, command, env):
+    """Run one check; its exit code, duration and output."""
+    start = time.perf_counter()
+    with tempfile.TemporaryFile('w+') as out:
+        code = subprocess.call(command, stdout=out, stderr=subprocess.STDOUT, env=env)
+        out.seek(0)
+        return name, code, time.perf_counter() - start, out.read()
+
+
+def main(names):
+    unknown = sorted(set(names) - set(CHECKS))
+    if unknown:
+        sys.exit(f"unknown check(s) {unknown}; the checks are {list(CHECKS)}")
+    chosen = {n: c for n, c in CHECKS.items() if not names or n in names}
+    failed = []
+    results = {}
+    workers = max(1, min(cores(), len(chosen)))
+    env = dict(os.environ, **(SINGLE_THREAD if workers > 1 else {}))
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        jobs = [pool.submit(run, n, c, env) for n, c in chosen.items()]
+        for job in as_completed(jobs):
+            name, code, seconds, output = job.result()
+            results[name] = (code, seconds, output)
+            print(f"{name}: {'passed' if code == 0 else f'FAILED (exit {code})'} "
+                  f"in {seconds:.0f} s", flush=True)
+    # the test suite's output last, so that its closing line ends the log
+    for name in sorted(results, key=lambda n: n == 'tests'):
+        code, seconds, output = results[name]
+        print(f"\n===== {name} ({'passed' if code == 0 else f'FAILED, exit {code}'}, "
+              f"{seconds:.0f} s): {' '.join(chosen[name])}")
+        print(output, end='' if output.endswith('\n') else '\n', flush=True)
+        if code:
+            failed.append(name)
+    if failed:
+        sys.exit(f"failed checks: {', '.join(failed)}")
+
+
+if __name__ == '__main__':
+    main(sys.argv[1:])
