@@ -26,8 +26,36 @@ def test_ci_command_installs_the_cluster_extra_and_prints_the_import_graph():
     ci = readme_commands()[1]
     extras = re.search(r'-e "\.\[([\w,]+)\]"', ci).group(1).split(',')
     assert {'test', 'docs', 'cluster'} <= set(extras)
-    assert ci.index('tools/import_graph.py') < ci.index('-m pytest')
+    assert ci.endswith('.venv/bin/python tools/check.py')
     assert 'CI=' in (ROOT / '.ci' / 'run').read_text()
+
+
+def _check_script():
+    import importlib.util
+    spec = importlib.util.spec_from_file_location('check', ROOT / 'tools' / 'check.py')
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_check_script_runs_the_import_graph_the_suite_and_the_strict_docs_build():
+    checks = _check_script().CHECKS
+    assert checks['imports'][1:] == ['tools/import_graph.py']
+    assert checks['tests'][1:] == ['-m', 'pytest']
+    assert checks['docs'][0].endswith('sphinx-build') and '-W' in checks['docs']
+
+
+def test_check_script_reports_a_failing_check(monkeypatch, capsys):
+    check = _check_script()
+    monkeypatch.setattr(check, 'CHECKS', {
+        'good': [check.PYTHON, '-c', 'print("fine")'],
+        'bad': [check.PYTHON, '-c', 'import sys; print("broken"); sys.exit(3)']})
+    with pytest.raises(SystemExit, match="failed checks: bad"):
+        check.main([])
+    out = capsys.readouterr().out
+    assert 'fine' in out and 'broken' in out and 'FAILED, exit 3' in out
+    with pytest.raises(SystemExit, match="unknown check"):
+        check.main(['nothing'])
 
 
 @pytest.mark.skipif(not IN_CI, reason="checks the CI settings (CI=true)")
