@@ -36,7 +36,7 @@ from ._identification.canonical import to_canonical, matrix_errors, MatrixErrors
 from ._identification.canonical import compare_ltp, LTPComparison
 from ._identification.structure import select_structure, StructureSelection
 from ._identification.ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
-from ._identification.arx import identify_arx
+from ._identification.arx import identify_arx, ARXInfo
 from ._orbits.closed_loop import ClosedLoopOrbit, closed_loop_response, closed_loop_orbit
 from ._analysis.lyapunov import lyap, dlyap, gram
 from ._analysis.norms import norm
@@ -101,7 +101,7 @@ __all__ = [
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
     'compare_ltp', 'LTPComparison', 'select_structure', 'StructureSelection',
-    'identify_arx',
+    'identify_arx', 'ARXInfo',
     # feedback around orbits of hybrid plants
     'ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit',
     # analysis: Lyapunov equations, gramians, zeros, norms
