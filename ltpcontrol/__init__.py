@@ -27,7 +27,7 @@ from ._orbits.autonomous import limit_cycle, poincare_map
 from ._orbits.continuation import Bifurcation, OrbitBranch, orbit_continuation
 from ._identification.excitation import Excitation, chirp_replicas, multisine, sine_experiments
 from ._identification.htf_estimate import estimate_htf, HTFEstimateInfo
-from ._identification.htf_fit import HTFFit, DelayEstimate, fit_htf, estimate_delays
+from ._identification.htf_fit import HTFFit, HTFFitInfo, DelayEstimate, fit_htf, estimate_delays
 from ._core.metrics import e_rms, nrmse
 from ._identification.fdsubspace import fdsubspace, FDSubspaceInfo
 from ._identification.hybrid_ls import hybrid_ls, HybridLSResult
@@ -95,7 +95,7 @@ __all__ = [
     'limit_cycle', 'poincare_map', 'Bifurcation', 'OrbitBranch', 'orbit_continuation',
     # identification
     'Excitation', 'chirp_replicas', 'multisine', 'sine_experiments',
-    'estimate_htf', 'HTFEstimateInfo', 'HTFFit', 'DelayEstimate', 'fit_htf', 'estimate_delays',
+    'estimate_htf', 'HTFEstimateInfo', 'HTFFit', 'HTFFitInfo', 'DelayEstimate', 'fit_htf', 'estimate_delays',
     'e_rms', 'nrmse',
     'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
