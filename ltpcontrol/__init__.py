@@ -27,7 +27,7 @@ from ._orbits.autonomous import limit_cycle, poincare_map
 from ._orbits.continuation import Bifurcation, OrbitBranch, orbit_continuation
 from ._identification.excitation import Excitation, chirp_replicas, multisine, sine_experiments
 from ._identification.htf_estimate import estimate_htf, HTFEstimateInfo
-from ._identification.htf_fit import HTFFit, DelayEstimate, fit_htf, estimate_delays
+from ._identification.htf_fit import HTFFit, HTFFitInfo, DelayEstimate, fit_htf, estimate_delays
 from ._core.metrics import e_rms, nrmse
 from ._identification.fdsubspace import fdsubspace, FDSubspaceInfo
 from ._identification.hybrid_ls import hybrid_ls, HybridLSResult
@@ -36,7 +36,7 @@ from ._identification.canonical import to_canonical, matrix_errors, MatrixErrors
 from ._identification.canonical import compare_ltp, LTPComparison
 from ._identification.structure import select_structure, StructureSelection
 from ._identification.ltp_subspace import lifted_frequency_response, identify_ltp, LTPSubspaceInfo
-from ._identification.arx import identify_arx
+from ._identification.arx import identify_arx, ARXInfo
 from ._orbits.closed_loop import ClosedLoopOrbit, closed_loop_response, closed_loop_orbit
 from ._analysis.lyapunov import lyap, dlyap, gram
 from ._analysis.norms import norm
@@ -95,13 +95,13 @@ __all__ = [
     'limit_cycle', 'poincare_map', 'Bifurcation', 'OrbitBranch', 'orbit_continuation',
     # identification
     'Excitation', 'chirp_replicas', 'multisine', 'sine_experiments',
-    'estimate_htf', 'HTFEstimateInfo', 'HTFFit', 'DelayEstimate', 'fit_htf', 'estimate_delays',
+    'estimate_htf', 'HTFEstimateInfo', 'HTFFit', 'HTFFitInfo', 'DelayEstimate', 'fit_htf', 'estimate_delays',
     'e_rms', 'nrmse',
     'fdsubspace', 'FDSubspaceInfo', 'hybrid_ls', 'HybridLSResult',
     'floquet_realization', 'FloquetRealization', 'to_canonical', 'matrix_errors',
     'MatrixErrors', 'lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo',
     'compare_ltp', 'LTPComparison', 'select_structure', 'StructureSelection',
-    'identify_arx',
+    'identify_arx', 'ARXInfo',
     # feedback around orbits of hybrid plants
     'ClosedLoopOrbit', 'closed_loop_response', 'closed_loop_orbit',
     # analysis: Lyapunov equations, gramians, zeros, norms

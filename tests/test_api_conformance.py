@@ -225,7 +225,7 @@ _RESULT_CLASSES |= {'ClosedLoopOrbit'}
 _RESULT_CLASSES |= {'OrbitBranch', 'Bifurcation'}
 _RESULT_CLASSES |= {'LMIDesign'}
 _RESULT_CLASSES |= {'RefineInfo', 'MonteCarloResult'}
-_RESULT_CLASSES |= {'HTFEstimateInfo'}
+_RESULT_CLASSES |= {'HTFEstimateInfo', 'ARXInfo', 'HTFFitInfo'}
 _RESULT_CLASSES |= {'FloquetModes', 'CampbellDiagram'}
 _RESULT_CLASSES |= {'HarmonicNyquistResponse', 'HarmonicMargins', 'MarginPoint'}
 

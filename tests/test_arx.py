@@ -50,6 +50,29 @@ def test_recovers_coefficients_and_response(coefficients):
     assert model.dt == pytest.approx(DT) and model.nstates == 5 and model.nsteps == N
 
 
+def test_return_info_gives_model_and_diagnostics(coefficients):
+    a, b = coefficients
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal((2, 300))
+    y = simulate(a, b, u)
+    noisy = y + 1e-3 * rng.standard_normal(y.shape)
+    data = (np.arange(300) * DT, u[None], noisy[None])
+    default = ltp.identify_arx(data, T, 2, 3)
+    assert isinstance(default, ltp.LTPStateSpace)          # default return unchanged
+    model, info = ltp.identify_arx(data, T, 2, 3, return_info=True)
+    assert isinstance(info, ltp.ARXInfo) and info.success and isinstance(info.message, str)
+    np.testing.assert_array_equal(model.C.sample(N), default.C.sample(N))
+    assert info.nsteps == N and info.nrecords == 2 and info.ridge == 0.0
+    # 2 records of 300 samples, the first 3 of each only as regressors
+    assert info.nequations.sum() == 2 * 297 and info.nequations.shape == (N,)
+    assert info.cond.shape == (N,) and np.all(info.cond >= 1)
+    # one-step residuals sit at the noise level
+    assert info.residual.shape == (N,) and np.all(info.residual < 5e-3)
+    assert np.all(info.residual > 1e-4)
+    with pytest.raises(AttributeError):
+        info.success = False                                # frozen
+
+
 def test_phase_follows_absolute_time(coefficients):
     # a record starting at step 4 of the period still maps phase k mod N
     a, b = coefficients

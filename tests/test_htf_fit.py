@@ -13,7 +13,7 @@ from ltpcontrol import chirp_replicas
 from ltpcontrol import HTFData, htf
 from ltpcontrol import estimate_htf
 from ltpcontrol import ltpss
-from ltpcontrol import estimate_delays, fit_htf
+from ltpcontrol import estimate_delays, fit_htf, HTFFit, HTFFitInfo
 from test_htf_estimate import ScalarLTP
 
 TRUE = np.array([-2.0, 0.8])                 # (a0, a1)
@@ -48,6 +48,24 @@ def test_fit_recovers_parameters(undelayed):
     assert np.allclose(fit.params, TRUE, rtol=1e-3)
     assert fit.components.shape == undelayed.components()[1].shape
     assert np.all(fit.std < 1e-2)
+
+
+def test_return_info_gives_fit_and_diagnostics(undelayed):
+    default = fit_htf(model, undelayed, [-1.0, 0.2], harmonics=[-1, 0, 1])
+    assert isinstance(default, HTFFit)                     # default return unchanged
+    fit, info = fit_htf(model, undelayed, [-1.0, 0.2], harmonics=[-1, 0, 1],
+                        return_info=True)
+    assert isinstance(fit, HTFFit) and isinstance(info, HTFFitInfo)
+    np.testing.assert_array_equal(fit.params, default.params)
+    assert info.success and isinstance(info.message, str) and info.message
+    # the info repeats the optimiser fields kept on the fit for compatibility
+    assert (info.success, info.message, info.cost, info.nfev) == \
+        (fit.success, fit.message, fit.cost, fit.nfev)
+    F = undelayed.components()[0].size
+    assert info.nresiduals == 2 * 3 * F and info.dof == info.nresiduals - 2
+    assert info.rms == pytest.approx(np.sqrt(2 * info.cost / info.nresiduals))
+    with pytest.raises(AttributeError):
+        info.cost = 0.0                                     # frozen
 
 
 def test_fit_with_noise_std_weights_covers_truth():

@@ -18,6 +18,8 @@ is a measured or applied signal, which makes it a natural model for an
 estimator-based (LQG) controller.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
@@ -26,7 +28,57 @@ from .records import as_records, common_grid, refuse_ambiguous
 from .._core.validation import (check_period, check_positive_int, real_array,
                           steps_per_period)
 
-__all__ = ['identify_arx']
+__all__ = ['identify_arx', 'ARXInfo']
+
+
+@dataclass(frozen=True)
+class ARXInfo:
+    """Diagnostics of `identify_arx` (``return_info=True``).
+
+    ``success`` and ``message`` follow `scipy.optimize.OptimizeResult`.
+
+    Attributes
+    ----------
+    success : bool
+        True: the fit is one regularized least-squares solve per phase, and
+        a phase that cannot be solved raises instead.
+    message : str
+        Description of the outcome.
+    nsteps : int
+        Number N of samples per period (phases).
+    nrecords : int
+        Number of records (experiments).
+    nequations : ndarray of int, shape (N,)
+        Equations (samples) of each phase.
+    cond : ndarray, shape (N,)
+        Condition number of the (regularized) normal equations of each
+        phase.
+    residual : ndarray, shape (N,)
+        Root-mean-square one-step prediction error ``y[k] - ŷ[k]`` of each
+        phase.
+    ridge : float
+        Tikhonov weight used (relative to the mean squared regressor).
+
+    Examples
+    --------
+    >>> N, rng = 4, np.random.default_rng(1)
+    >>> u = rng.standard_normal(200)
+    >>> y = np.concatenate([[0.0], 0.5 * u[:-1]])
+    >>> _, info = ltp.identify_arx((np.arange(200) * 0.25, u, y), 1.0, 1, 1,
+    ...                            return_info=True)
+    >>> info.success, info.nsteps, info.nequations.tolist()
+    (True, 4, [49, 50, 50, 50])
+    """
+
+    success: bool
+    message: str
+    nsteps: int
+    nrecords: int
+    nequations: np.ndarray
+    cond: np.ndarray
+    residual: np.ndarray
+    ridge: float
+
 
 
 def _records(data):
@@ -39,7 +91,7 @@ def _records(data):
     return t, U[0], Y[0]
 
 
-def identify_arx(data, period, na, nb, *, ridge=0.0, name=None):
+def identify_arx(data, period, na, nb, *, ridge=0.0, return_info=False, name=None):
     """Identify a periodic ARX model of a SISO LTP system from sampled records.
 
     Parameters
@@ -57,15 +109,20 @@ def identify_arx(data, period, na, nb, *, ridge=0.0, name=None):
         Numbers of past outputs and inputs (both at least 1).
     ridge : float, optional
         Tikhonov weight relative to the mean squared regressor (default 0).
+    return_info : bool, optional
+        Also return the fit diagnostics (default False).
     name : str, optional
         Name of the model (default ``'arx'``).
 
     Returns
     -------
-    LTPStateSpace
+    sys : LTPStateSpace
         Discrete-time model (``dt`` of the data, N steps per period) with
         ``na + nb`` states (past outputs and inputs), one input and one
         output; step k of the model is the sample at ``t = k dt``.
+    info : ARXInfo
+        Only with ``return_info=True``: equations, condition number and
+        one-step prediction residual of each phase.
 
     Raises
     ------
@@ -88,6 +145,13 @@ def identify_arx(data, period, na, nb, *, ridge=0.0, name=None):
     >>> model = ltp.identify_arx((np.arange(400) * 0.1, u, y), 0.8, 1, 1)
     >>> bool(np.allclose(model.C.sample(N)[:, 0, 0], a))
     True
+
+    With ``return_info=True`` the diagnostics of the fit come along:
+
+    >>> model, info = ltp.identify_arx((np.arange(400) * 0.1, u, y), 0.8, 1, 1,
+    ...                                return_info=True)
+    >>> info.success, info.nsteps, bool(info.residual.max() < 1e-10)
+    (True, 8, True)
     """
     t, U, Y = _records(data)
     period = check_period(period)
@@ -107,20 +171,30 @@ def identify_arx(data, period, na, nb, *, ridge=0.0, name=None):
     target = Y[:, lag:].reshape(-1)
     phase = np.tile(np.round(t[lag:] / dt).astype(int) % N, Y.shape[0])
     theta = np.empty((N, na + nb))
+    neq, cond, rms = np.zeros(N, int), np.empty(N), np.empty(N)
     scale = ridge * np.mean(phi ** 2)
     for p in range(N):
         rows = phase == p
+        neq[p] = rows.sum()
         if rows.sum() < na + nb:
             raise ValueError(f"phase {p} of {N} has {rows.sum()} equations for {na + nb} "
                              "coefficients: record more periods")
         P = phi[rows]
         gram = P.T @ P + scale * np.eye(na + nb)
-        if np.linalg.cond(gram) > 1e12:
+        cond[p] = np.linalg.cond(gram)
+        if cond[p] > 1e12:
             raise ValueError(f"the regressors of phase {p} of {N} are (nearly) linearly "
                              "dependent: excite the input more richly, lower na or nb, or "
                              "give a ridge weight")
         theta[p] = np.linalg.solve(gram, P.T @ target[rows])
-    return _realize(theta, na, nb, period, dt, name if name is not None else 'arx')
+        rms[p] = np.sqrt(np.mean((target[rows] - P @ theta[p]) ** 2))
+    sys = _realize(theta, na, nb, period, dt, name if name is not None else 'arx')
+    if not return_info:
+        return sys
+    info = ARXInfo(success=True, message=f"{N} phases fitted by least squares, largest "
+                   f"condition number {cond.max():.3g}", nsteps=N, nrecords=Y.shape[0],
+                   nequations=neq, cond=cond, residual=rms, ridge=ridge)
+    return sys, info
 
 
 def _realize(theta, na, nb, period, dt, name):

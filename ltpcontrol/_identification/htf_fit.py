@@ -27,7 +27,7 @@ from control.exception import ControlArgument, ControlDimension
 from .._frequency.htf import HTF, HTFData
 from .._core.validation import real_array
 
-__all__ = ['fit_htf', 'estimate_delays', 'HTFFit', 'DelayEstimate']
+__all__ = ['fit_htf', 'estimate_delays', 'HTFFit', 'HTFFitInfo', 'DelayEstimate']
 
 # largest number of total-delay grid points searched by `estimate_delays`
 _MAX_DELAY_GRID = 2 ** 18
@@ -37,7 +37,12 @@ _DELAY_CHUNK = 2 ** 20
 
 @dataclass(frozen=True)
 class HTFFit:
-    """Result of `fit_htf`.
+    """Fitted model of `fit_htf`: parameters, their covariance and the components.
+
+    `fit_htf` returns this object as its model; the diagnostics of the
+    optimisation come as an `HTFFitInfo` with ``return_info=True``.  The
+    fields `cost`, `success`, `message` and `nfev` repeat that information
+    and are kept for compatibility.
 
     Attributes
     ----------
@@ -80,6 +85,49 @@ class HTFFit:
     success: bool
     message: str
     nfev: int
+
+
+@dataclass(frozen=True)
+class HTFFitInfo:
+    """Diagnostics of `fit_htf` (``return_info=True``).
+
+    ``success``, ``message`` and ``nfev`` follow `scipy.optimize.OptimizeResult`.
+
+    Attributes
+    ----------
+    success : bool
+        Optimiser success flag.
+    message : str
+        Optimiser message.
+    cost : float
+        Final value of ``½ Σ r²``.
+    nfev : int
+        Number of model evaluations.
+    nresiduals : int
+        Number of real residuals of the fit.
+    dof : int
+        Residual degrees of freedom, ``nresiduals`` minus the number of
+        parameters (the covariance is NaN when it is not positive).
+    rms : float
+        Root-mean-square (weighted) residual ``sqrt(2 cost / nresiduals)``.
+
+    Examples
+    --------
+    >>> omega = np.linspace(0.1, 5, 20)
+    >>> model = lambda p, w: (p[0] / (1j * w + 1))[None, None, None, :]
+    >>> fit, info = ltp.fit_htf(model, ltp.HTFData(model([3.0], omega), omega, 1.0), [1.0],
+    ...                         return_info=True)
+    >>> info.success, info.nresiduals, info.dof
+    (True, 40, 39)
+    """
+
+    success: bool
+    message: str
+    cost: float
+    nfev: int
+    nresiduals: int
+    dof: int
+    rms: float
 
 
 @dataclass(frozen=True)
@@ -176,7 +224,7 @@ def _model_harmonics(model, params, omega):
 
 
 def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
-            magnitude_only=False, weights=None, bounds=None):
+            magnitude_only=False, weights=None, bounds=None, return_info=False):
     """Fit a parameterised model family to an estimated HTF.
 
     Minimises ``Σ_{k, ω} |w (G_k(jω; p) - Ĝ_k(jω))|²`` (complex components)
@@ -205,10 +253,17 @@ def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
         an array broadcastable to (nharm, ny, nu, F).
     bounds : (array_like, array_like), optional
         Lower and upper parameter bounds.
+    return_info : bool, optional
+        Also return the diagnostics of the optimisation (default False).
 
     Returns
     -------
-    HTFFit
+    fit : HTFFit
+        The fitted model: parameters, their covariance and standard
+        deviations, and the model's components on the estimate's grid.
+    info : HTFFitInfo
+        Only with ``return_info=True``: success flag, message, cost, number
+        of model evaluations and residual degrees of freedom.
 
     Examples
     --------
@@ -221,6 +276,12 @@ def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
     >>> fit = ltp.fit_htf(model, est, [-1.0])
     >>> np.round(fit.params, 6).tolist()
     [-2.0]
+
+    With ``return_info=True`` the optimiser's diagnostics come along:
+
+    >>> fit, info = ltp.fit_htf(model, est, [-1.0], return_info=True)
+    >>> info.success, bool(info.rms < 1e-8)
+    (True, True)
     """
     if not callable(model):
         raise ControlArgument("model must be callable: model(params, omega)")
@@ -285,9 +346,15 @@ def fit_htf(model, estimate, p0, *, harmonics=None, omega_limits=None,
     if extra.size:
         fitted[extra + K] = _model_components(model, res.x, omega, K, extra,
                                               comps.shape[1:3] + (omega.size,))
-    return HTFFit(params=res.x, cov=cov, std=np.sqrt(np.abs(np.diag(cov))),
-                  components=fitted, omega=omega, cost=float(res.cost),
-                  success=bool(res.success), message=str(res.message), nfev=int(res.nfev))
+    fit = HTFFit(params=res.x, cov=cov, std=np.sqrt(np.abs(np.diag(cov))),
+                 components=fitted, omega=omega, cost=float(res.cost),
+                 success=bool(res.success), message=str(res.message), nfev=int(res.nfev))
+    if not return_info:
+        return fit
+    info = HTFFitInfo(success=fit.success, message=fit.message, cost=fit.cost, nfev=fit.nfev,
+                      nresiduals=int(nres), dof=int(nres - npar),
+                      rms=float(np.sqrt(2 * res.cost / nres)))
+    return fit, info
 
 
 def estimate_delays(estimate, reference, *, harmonics=(-1, 0, 1), omega_limits=None,
