@@ -164,10 +164,11 @@ def care(A, B, Q, R, S=None, period=None, nsteps=None):
     solution = _RiccatiSolution(H, grid, Xg)
     X = PeriodicMatrix.from_function(solution, period, (n, n), breakpoints=grid[:-1],
                                      check=False)
-    G = PeriodicMatrix.pointwise(_gain, [B, R, S, X], (m, n), breakpoints=breaks)
-    G = _tabulated(G, grid)
+    exact = PeriodicMatrix.pointwise(_gain, [B, R, S, X], (m, n), breakpoints=breaks)
+    G = PeriodicMatrix.from_function(_GainTable(exact=exact, grid=grid), period, (m, n),
+                                     breakpoints=exact.breakpoints, check=False)
     if all(M.is_constant for M in ops):          # LTI data: the eigenvalues of A - BG
-        L = lti_representatives(L, A(0.0) - B(0.0) @ G(0.0), period=period)
+        L = lti_representatives(L, A(0.0) - B(0.0) @ exact(0.0), period=period)
     return X, L, G
 
 
@@ -180,7 +181,7 @@ register_op('riccati_gain', _gain)
 
 
 def _tabulated(G, grid):
-    """G as a verified piecewise Chebyshev table (`_GainTable`), or G itself.
+    """``(edges, coefs)`` of G as a verified piecewise Chebyshev table, or None.
 
     On every step ``[t_k, t_{k+1}]`` (where the data and the interpolant of X
     are smooth) G is sampled at the Chebyshev points of the first kind and
@@ -208,13 +209,11 @@ def _tabulated(G, grid):
         if not len(lo):
             break
     else:
-        return G                     # not verified at the finest subdivision: keep G
+        return None                  # not verified at the finest subdivision
     starts, coefs = np.concatenate(starts), np.concatenate(coefs)
     order = np.argsort(starts)
-    edges = np.append(starts[order], grid[-1])
-    table = _GainTable(edges, coefs[order].reshape(len(order), _GAIN_DEG + 1, m, n))
-    return PeriodicMatrix.from_function(table, G.period, (m, n), breakpoints=G.breakpoints,
-                                        check=False)
+    return (np.append(starts[order], grid[-1]),
+            coefs[order].reshape(len(order), _GAIN_DEG + 1, m, n))
 
 
 class _GainTable:
@@ -225,11 +224,18 @@ class _GainTable:
     on piece k.  Pieces are closed on the left: at an edge the piece that
     starts there is used (within ``1e-12 T``, as for switching matrices).
     `scalar` evaluates one time with Python floats and one small product.
+
+    Built from the exact gain (a `PeriodicMatrix`) and the step grid, the
+    table is tabulated on first use, or when pickled or saved; if it cannot
+    be verified, the exact gain is evaluated instead.
     """
 
-    def __init__(self, edges, coefs):
-        self.edges, self.coefs = np.asarray(edges, float), np.asarray(coefs, float)
-        self._setup()
+    def __init__(self, edges=None, coefs=None, exact=None, grid=None):
+        self.exact, self.grid, self.edges, self.coefs = exact, grid, None, None
+        self._ready = coefs is not None
+        if self._ready:
+            self.edges, self.coefs = np.asarray(edges, float), np.asarray(coefs, float)
+            self._setup()
 
     def _setup(self):
         P, D1, m, n = self.coefs.shape
@@ -239,15 +245,30 @@ class _GainTable:
         self._period = float(self.edges[-1])
         self._shape = (m, n)
 
+    def _build(self):
+        if not self._ready:
+            table = _tabulated(self.exact, self.grid)
+            if table is not None:
+                self.edges, self.coefs = table
+                self.exact = self.grid = None
+                self._setup()
+            self._ready = True
+        return self.coefs is not None
+
     def __getstate__(self):
-        return {'edges': self.edges, 'coefs': self.coefs}
+        self._build()
+        return {'edges': self.edges, 'coefs': self.coefs, 'exact': self.exact}
 
     def __setstate__(self, state):
-        self.edges, self.coefs = state['edges'], state['coefs']
-        self._setup()
+        self.__init__(state['edges'], state['coefs'], state['exact'])
+        self._ready = True
 
     def scalar(self, t):
         """Value at one float time t, shape (m, n)."""
+        if not self._ready:
+            self._build()
+        if self.coefs is None:
+            return self.exact(t)
         T, edges = self._period, self._list
         eps = 1e-12 * T
         tau = t % T
@@ -265,6 +286,8 @@ class _GainTable:
     def __call__(self, t):
         if np.ndim(t) == 0:
             return self.scalar(float(t))
+        if not self._build():
+            return self.exact(t)
         T, edges = self._period, self.edges
         eps = 1e-12 * T
         tau = np.mod(np.asarray(t, float), T)
@@ -276,6 +299,9 @@ class _GainTable:
         return np.einsum('tj,tjs->ts', basis, self._flat[k]).reshape((len(tau),) + self._shape)
 
     def _portable(self):
+        if not self._build():
+            raise TypeError("save: the gain could not be tabulated to its verified accuracy; "
+                            "save the Riccati solution X and compute the gain from it")
         return 'gain_table', {}, {'edges': self.edges, 'coefs': self.coefs}
 
     @classmethod
