@@ -301,3 +301,57 @@ def test_bad_input_names_the_argument():
         ltp.care(np.eye(2), np.ones((2, 1)), np.eye(2), [[1.0]])
     with pytest.raises(ControlArgument, match="dlqr"):
         ltp.dlqr(good, np.eye(2), [[1.0]])
+
+
+#
+# Tabulated gains
+#
+
+def _untabulated_gain(B, R, S, X, t):
+    t = np.atleast_1d(t)
+    return np.linalg.solve(R(t), np.swapaxes(B(t), 1, 2) @ X(t) + np.swapaxes(S(t), 1, 2))
+
+
+def test_gain_table_equals_untabulated_gain_with_varying_data():
+    T = 2 * np.pi
+    A = ltp.PeriodicMatrix.from_function(
+        lambda t: np.array([[0.0, 1.0], [-1 - 0.5 * np.cos(t), 0.1]]), T)
+    B = ltp.PeriodicMatrix([[[0.0], [0.15j]], [[0.0], [1.0]], [[0.0], [-0.15j]]], T)
+    R = ltp.PeriodicMatrix([[[0.25]], [[1.0]], [[0.25]]], T)
+    S = ltp.PeriodicMatrix.constant([[0.1], [0.0]], T)
+    X, _, G = ltp.care(A, B, np.eye(2), R, S)
+    t = np.concatenate([np.random.default_rng(3).uniform(-3 * T, 3 * T, 300),
+                        G.breakpoints[:5], G.breakpoints[:5] + 7 * T, [0.0, T, -T]])
+    exact = _untabulated_gain(B, R, S, X, t)
+    scale = 1 + np.abs(exact).max()
+    assert np.abs(G(t) - exact).max() <= 1e-9 * scale
+    scalar = np.array([G(float(ti)) for ti in t])
+    assert np.abs(scalar - exact).max() <= 1e-9 * scale
+    assert np.abs(scalar - G(t)).max() <= 1e-14 * scale
+    for ti in (1, np.float64(0.7), np.int64(2), -0.4):
+        assert G(ti).shape == (1, 2)
+        np.testing.assert_allclose(G(ti), _untabulated_gain(B, R, S, X, float(ti))[0],
+                                   rtol=0, atol=1e-9 * scale)
+
+
+def test_gain_table_of_switching_data_is_right_continuous():
+    sys = switching_mathieu()
+    K, X, _ = ltp.lqr(sys, np.eye(2), [[1.0]])
+    zero = ltp.PeriodicMatrix.constant(np.zeros((2, 1)), sys.period)
+    one = ltp.PeriodicMatrix.constant([[1.0]], sys.period)
+    t = np.concatenate([[0.0, 0.25, 0.5, 0.75, -0.25], np.linspace(-1, 1, 203)])
+    exact = _untabulated_gain(ltp.PeriodicMatrix.constant([[0.0], [1.0]], sys.period),
+                              one, zero, X, t)
+    assert np.abs(K(t) - exact).max() <= 1e-9 * (1 + np.abs(exact).max())
+    assert np.abs(np.array([K(ti) for ti in t]) - exact).max() <= 1e-9 * (1 + np.abs(exact).max())
+
+
+def test_gain_table_of_lti_data_equals_python_control():
+    A, B, _, _ = _rand(4, 3, 2, 1)
+    Q, R = np.diag([1.0, 2.0, 0.5]), np.array([[1.0, 0.2], [0.2, 2.0]])
+    K0 = ct.lqr(A, B, Q, R)[0]
+    K, _, _ = ltp.lqr(ltp.ltpss(A, B, np.eye(3), 0, period=0.7), Q, R)
+    t = np.random.default_rng(5).uniform(-5, 5, 50)
+    assert np.abs(K(t) - K0).max() <= 1e-10 * np.abs(K0).max()
+    assert max(np.abs(K(ti) - K0).max() for ti in t) <= 1e-10 * np.abs(K0).max()
+

@@ -14,6 +14,7 @@ A `PeriodicMatrix` ``P(t) = P(t + T)`` is stored in one of four forms:
 See the Conventions page of the documentation for the Fourier scaling.
 """
 
+import math
 import numbers
 import warnings
 
@@ -25,6 +26,9 @@ from .pm_ops import Block, Identity, Index, Scale, Transpose, add_series, mul_se
 from .validation import check_period, check_positive_int, commensurate, real_array
 
 __all__ = ['PeriodicMatrix']
+
+# scalar time types evaluated on the fast path of a data-backed table
+_FLOATS = (float, int, np.float64)
 
 # Gauss-Legendre nodes used for Fourier coefficients of piecewise-smooth data
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(20)
@@ -426,6 +430,10 @@ class PeriodicMatrix:
 
     def __call__(self, t):
         """Evaluate at scalar ``t`` (shape (n, m)) or 1D array (shape (len(t), n, m))."""
+        if type(t) in _FLOATS and self._func is not None and math.isfinite(t):
+            scalar = getattr(self._func, 'scalar', None)
+            if scalar is not None:          # data-backed table: one float, no validation
+                return scalar(float(t))
         tarr = real_array(t, 't', ndim=(0, 1))
         out = self._eval(np.atleast_1d(tarr))
         return out[0] if tarr.ndim == 0 else out
