@@ -118,7 +118,11 @@ def product_eigenvalues(factors, *, error=False, rank_tol=None):
         raise ValueError("factors must be finite")
     n = H.shape[1]
     zeros = 0 if rank_tol is None or n == 0 else _rank_deficiency(H, float(rank_tol))
-    logmod, arg, err = (np.zeros(0), np.zeros(0), 0.0) if n == 0 else _product_qr(H, zeros)
+    # eigenvalues left by factors singular to working precision are rounding noise:
+    # they are kept, but their (undetermined) moduli do not enter the error estimate
+    noise = 0 if n == 0 else max(0, _rank_deficiency(H, n * np.finfo(float).eps) - zeros)
+    logmod, arg, err = (np.zeros(0), np.zeros(0), 0.0) if n == 0 else \
+        _product_qr(H, zeros, noise)
     return (logmod, arg, err) if error else (logmod, arg)
 
 
@@ -142,10 +146,12 @@ def _rank_deficiency(F, tol):
     return int(np.max(np.count_nonzero(small, axis=1)))
 
 
-def _product_qr(F, zeros=0):
+def _product_qr(F, zeros=0, noise=0):
     """Block periodic Schur form by QR sweeps: sorted (log|μ|, arg μ, error).
 
-    The `zeros` smallest eigenvalues are exact zeros (singular factors).
+    The `zeros` smallest eigenvalues are exact zeros (singular factors); the
+    `noise` smallest of the others are rounding noise of factors singular to
+    working precision, left out of the error estimate.
     """
     n = F.shape[1]
     Q0, previous, changes = np.eye(n), None, []
@@ -162,7 +168,7 @@ def _product_qr(F, zeros=0):
         if zeros:
             smallest = np.lexsort((-arg, -logmod))[n - zeros:]
             logmod[smallest], arg[smallest] = -np.inf, 0.0
-        changes.append(_change(previous, blocks, logmod, arg))
+        changes.append(_change(previous, blocks, logmod, arg, zeros + noise))
         previous, Q0 = (blocks, logmod, arg), Q
         if sweep + 1 >= _MIN_SWEEPS and (changes[-1] <= _SETTLE_TOL or _at_floor(changes)):
             break
@@ -170,7 +176,8 @@ def _product_qr(F, zeros=0):
     # the remaining (geometric) convergence
     recent = [c for c in changes[-_FLOOR_SWEEPS:] if np.isfinite(c)]
     error = 2 * (changes[-1] if changes[-1] <= _SETTLE_TOL else max(recent, default=np.inf))
-    worst = error * (1 + np.abs(logmod[np.isfinite(logmod)]).max(initial=0.0))
+    determined = np.sort(logmod)[zeros + noise:]
+    worst = error * (1 + np.abs(determined[np.isfinite(determined)]).max(initial=0.0))
     if worst > _WARN_ERROR:
         warnings.warn(f"product_eigenvalues: eigenvalue moduli are accurate only to about "
                       f"{worst:.1g} relative (ill-conditioned product or eigenvalues of close "
@@ -179,10 +186,18 @@ def _product_qr(F, zeros=0):
     return logmod[order], arg[order], error
 
 
-def _change(previous, blocks, logmod, arg):
-    """Largest change of the eigenvalues since the previous sweep (inf if the blocks changed)."""
+def _change(previous, blocks, logmod, arg, skip=0):
+    """Largest change of the eigenvalues since the previous sweep (inf if the blocks changed).
+
+    The `skip` smallest eigenvalues (zeros and rounding noise) are not compared.
+    """
     if previous is None or previous[0] != blocks:
         return np.inf
+    if skip:
+        keep = np.zeros(len(logmod), bool)
+        keep[np.argsort(logmod)[skip:]] = True
+        logmod, arg = logmod[keep], arg[keep]
+        previous = (previous[0], previous[1][keep], previous[2][keep])
     finite = np.isfinite(logmod) & np.isfinite(previous[1])
     if np.any(np.isfinite(logmod) != np.isfinite(previous[1])):
         return np.inf

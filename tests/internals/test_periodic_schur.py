@@ -117,3 +117,23 @@ def test_ill_conditioned_product_is_announced():
     if err * 400 > 1e-6:
         assert any('accurate only' in str(w.message) for w in caught)
     assert actual <= 10 * err * 400
+
+
+def test_rounding_noise_of_numerically_singular_factors_is_not_announced():
+    # closed-loop factors of a periodic LQR (Hench & Laub 1994, example 2) are each
+    # singular to working precision: the product's third eigenvalue is rounding
+    # noise (true value 0); the determined ones are exact and nothing is announced
+    rng = np.random.default_rng(7)
+    factors = []
+    for _ in range(3):
+        U, _ = np.linalg.qr(rng.standard_normal((3, 3)))
+        V, _ = np.linalg.qr(rng.standard_normal((3, 3)))
+        factors.append(U @ np.diag([20.0, 5.0, 0.0]) @ V.T)      # rank 2, rounded
+    dense = np.linalg.eigvals(factors[2] @ factors[1] @ factors[0])
+    big = np.sort_complex(dense[np.abs(dense) > 1e-6])
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        logmod, arg = product_eigenvalues(factors)
+    mu = np.exp(logmod) * np.exp(1j * arg)
+    assert np.allclose(np.sort_complex(mu[:2]), big, rtol=1e-10)
+    assert abs(mu[2]) <= 1e-12 * abs(mu[0])
