@@ -355,3 +355,12 @@ def test_gain_table_of_lti_data_equals_python_control():
     assert np.abs(K(t) - K0).max() <= 1e-10 * np.abs(K0).max()
     assert max(np.abs(K(ti) - K0).max() for ti in t) <= 1e-10 * np.abs(K0).max()
 
+
+
+def test_lqe_gain_table_of_switching_data():
+    sys = switching_mathieu()
+    L, P, _ = ltp.lqe(sys, [[1.0]], [[0.1]])
+    t = np.concatenate([[0.0, 0.25, 0.5, 0.75, -0.25], np.linspace(-1, 1, 203)])
+    exact = P(t) @ np.swapaxes(sys.C(t), 1, 2) / 0.1
+    assert np.abs(L(t) - exact).max() <= 1e-9 * (1 + np.abs(exact).max())
+    assert np.abs(np.array([L(ti) for ti in t]) - exact).max() <= 1e-9 * (1 + np.abs(exact).max())

@@ -96,7 +96,8 @@ def test_riccati_solution_and_gains(how, tmp_path):
     sys = switching_mathieu()
     X, _, G = ltp.care(sys.A, sys.B, np.eye(2), [[1.0]])
     K, _, _ = ltp.lqr(damped_mathieu(), np.eye(2), [[1.0]])
-    for M in (X, G, K):
+    L, _, _ = ltp.lqe(damped_mathieu(), [[1.0]], [[0.1]])
+    for M in (X, G, K, L):
         assert_same_matrix(M, how(M, tmp_path))
 
 

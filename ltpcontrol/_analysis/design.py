@@ -22,7 +22,7 @@ from control.exception import ControlArgument, ControlDimension
 from .._core.floquet import lti_representatives
 from .._core.ltpsys import LTPStateSpace, series
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
-from .riccati import _check_weights, care, dare
+from .riccati import _GainTable, _check_weights, care, dare
 from .._core.coerce import as_ltp
 from .._core.validation import check_method, real_array
 
@@ -194,9 +194,9 @@ def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None):
     X, E, Gd = care(_reverse(sys.A, True), _reverse(sys.C, True),
                     _reverse(G @ QN @ G.T, False), _reverse(RN, False),
                     _reverse(G @ NN, False), period=T, nsteps=nsteps)
-    L = _reverse(Gd, True)
+    L, exact = _reversed_gain(Gd)
     if all(M.is_constant for M in (sys.A, G, sys.C, QN, RN, NN)):   # LTI data
-        E = lti_representatives(E, sys.A(0.0) - L(0.0) @ sys.C(0.0), period=T)
+        E = lti_representatives(E, sys.A(0.0) - exact(0.0) @ sys.C(0.0), period=T)
     return L, _reverse(X, False), E
 
 
@@ -409,6 +409,34 @@ def _shape_check(M, shape, name):
 
 def _held(values, sys):
     return PeriodicMatrix.from_samples(values, sys.period, kind='hold')
+
+
+def _reversed_gain(Gd):
+    """``(L, exact)``: ``L(t) = Gd(-t)ᵀ`` as a verified gain table, like `care`'s gains.
+
+    The table is tabulated from the exact reversed gain on the reversed step
+    grid of the dual problem, on first use (or when pickled or saved).
+    """
+    table = Gd._func
+    exact = PeriodicMatrix.from_function(_Reversed(table.exact, True), Gd.period,
+                                         Gd.shape[::-1],
+                                         breakpoints=np.mod(-table.exact.breakpoints, Gd.period),
+                                         check=False)
+    L = PeriodicMatrix.from_function(_GainTable(exact=exact, grid=Gd.period - table.grid[::-1]),
+                                     Gd.period, exact.shape, breakpoints=exact.breakpoints,
+                                     check=False)
+    return L, exact
+
+
+class _Reversed:
+    """``t -> M(-t)`` (transposed if asked), a picklable callable."""
+
+    def __init__(self, M, transpose):
+        self.M, self.transpose = M, transpose
+
+    def __call__(self, t):
+        out = self.M._eval(np.mod(-np.asarray(t, float), self.M.period))
+        return np.swapaxes(out, -1, -2) if self.transpose else out
 
 
 def _reverse(M, transpose):

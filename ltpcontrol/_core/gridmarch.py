@@ -39,6 +39,7 @@ block kernel of ``_march``, a chunk being one "period" of step data.
 """
 
 import math
+import warnings
 from fractions import Fraction
 
 import numpy as np
@@ -52,9 +53,13 @@ _CHUNK_STEPS = 4000          # steps of step data held at a time
 _FEW_TRACES = 16             # up to this many traces: march state by state
 _SEQ_BLOCK = 32              # block length of that march
 _MAX_CELLS = 2 ** 15         # cells of the phase table
+_FEW_CELLS = 16              # runs of fewer cells than this are tabulated
 _MAX_REPEAT = 4096           # longest repeating phase pattern used as a period
 _DEG = 10                    # degree of the partial-cell interpolants (equispaced nodes)
 _TABLE_TOL = 1e-13           # accepted interpolation error (relative to a cell's data)
+_PROBES = 32                 # probe intervals of the sub-step error estimate
+_MARGIN = 3.0                # its safety factor (the error between the probes)
+
 
 
 def grid_march(A, B, C, D, t, u, x0, hold, rtol, states=True):
@@ -223,13 +228,17 @@ def _table_steps(A, B, h, T, rtol):
     n, m = A.shape[0], B.shape[1]
     # cells shorter than the shortest step (so that a step spans a cell
     # boundary), made shorter when their node intervals would need more than
-    # four Magnus sub-steps (cheaper in total: the error per interval is ∝ δ⁵)
+    # four Magnus sub-steps (cheaper in total): the error estimate with two
+    # sub-steps, ∝ δ⁵, is measured at probe intervals and the cells shortened
+    # until it meets the tolerance with a margin, so that every node interval
+    # is accepted at the first comparison (two against four sub-steps)
     N0 = max(16, math.floor(T / hmin) + 1)
     info = {}
-    step_transitions(A, B, np.linspace(0, T, 8, endpoint=False),
-                     np.full(8, T / N0 / _DEG), rtol, info=info)
-    if info['substeps'] > 4:
-        N0 = math.ceil(N0 * (info['substeps'] / 4) ** 0.8)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')          # only the first comparison is needed
+        step_transitions(A, B, np.linspace(0, T, _PROBES, endpoint=False),
+                         np.full(_PROBES, T / N0 / _DEG), rtol, max_substeps=4, info=info)
+    N0 = math.ceil(N0 * max(1.0, _MARGIN * info['excess']) ** 0.2)
     for refine in (1, 2, 4):
         # split at the switching instants
         N = refine * N0
@@ -258,6 +267,13 @@ def _table_steps(A, B, h, T, rtol):
     for i in range(1, levels):
         nxt = (np.arange(N) + 2 ** (i - 1)) % N
         lift.append(lift[-1][nxt] @ lift[-1])
+    # steps spanning few cells: every run of c < 2^levels cells from every cell
+    runs = None
+    if 2 ** levels <= _FEW_CELLS:
+        runs = np.empty((2 ** levels, N) + cells.shape[1:])
+        runs[0] = np.eye(cells.shape[1])
+        for c in range(1, 2 ** levels):
+            runs[c] = cells[(np.arange(N) + c - 1) % N] @ runs[c - 1]
 
     def steps(tk, hk):
         theta = tk - T * np.floor(tk / T)
@@ -270,11 +286,14 @@ def _table_steps(A, B, h, T, rtol):
         (M,) = _interpolate((bwd,), edges, j, edges[j + 1] - theta)
         # the run of `count` cells after cell j, by the binary digits of count
         pos = (j + 1) % N
-        for i, run in enumerate(lift):
-            sel = (count >> i) & 1 == 1
-            if np.any(sel):
-                M[sel] = run[pos[sel]] @ M[sel]
-                pos = np.where(sel, (pos + 2 ** i) % N, pos)
+        if runs is not None:
+            M = runs[count, pos] @ M
+        else:
+            for i, run in enumerate(lift):
+                sel = (count >> i) & 1 == 1
+                if np.any(sel):
+                    M[sel] = run[pos[sel]] @ M[sel]
+                    pos = np.where(sel, (pos + 2 ** i) % N, pos)
         (tail,) = _interpolate((fwd,), edges, jb, phi - wraps * T - edges[jb])
         M = tail @ M
         return M[:, :n, :n], M[:, :n, n:n + m], M[:, :n, n + m:] / hk[:, None, None]
@@ -331,7 +350,8 @@ def _interpolate(partial, edges, j, length):
     w /= w.sum(axis=1, keepdims=True)
     # one matrix product per cell: weights (samples, D+1) times values (D+1, all entries)
     sizes = [int(np.prod(v.shape[2:])) for v in partial]
-    table = np.concatenate([v.reshape(v.shape[0], v.shape[1], -1) for v in partial], axis=2)
+    flat = [v.reshape(v.shape[0], v.shape[1], -1) for v in partial]
+    table = flat[0] if len(flat) == 1 else np.concatenate(flat, axis=2)
     order = np.argsort(j, kind='stable')
     js, ws = j[order], w[order]
     bounds = np.flatnonzero(np.diff(js)) + 1
@@ -357,8 +377,11 @@ def _partial_error(A, B, edges, partial, rtol):
     length = frac * (edges[j + 1] - edges[j])
     fwd, bwd = partial
     err = 0.0
-    for start, table in ((edges[j], fwd), (edges[j + 1] - length, bwd)):
-        exact = _pieces(A, B, start, length, rtol, A.shape[0])
+    # the pieces at both ends of the cells, integrated at once
+    both = _pieces(A, B, np.concatenate([edges[j], edges[j + 1] - length]),
+                   np.concatenate([length, length]), rtol, A.shape[0])
+    for end, table in enumerate((fwd, bwd)):
+        exact = tuple(v[end * len(j):(end + 1) * len(j)] for v in both)
         approx = _interpolate(table, edges, j, length)
         for i, (e, a, whole) in enumerate(zip(exact, approx, table)):
             if e.size:

@@ -114,3 +114,27 @@ def test_both_chunk_marches(monkeypatch, few):
     assert rel(resp.outputs, ref.outputs) < 1e-12
     fast = ltp.forced_response(sys, t, U, x0, compute_states=False)
     assert rel(fast.outputs, ref.outputs) < 1e-12
+
+
+@pytest.mark.parametrize("plant", [damped_mathieu, switching_mathieu])
+def test_table_of_short_runs_equals_binary_lifting(monkeypatch, plant):
+    sys = plant()
+    t = np.cumsum(np.concatenate([[0.0], sys.period / 7.3 * np.linspace(0.8, 1.2, 300)]))
+    h = np.diff(t)
+    steps = gridmarch._table_steps(sys.A, sys.B, h, sys.period, 1e-12)
+    monkeypatch.setattr(gridmarch, '_FEW_CELLS', 0)
+    lifted = gridmarch._table_steps(sys.A, sys.B, h, sys.period, 1e-12)
+    for a, b in zip(steps(t[:-1], h), lifted(t[:-1], h)):
+        assert rel(a, b) < 1e-13
+
+
+def test_substep_error_estimate_scales_as_the_fifth_power():
+    from ltpcontrol._core.transition import step_transitions
+    sys = damped_mathieu()
+    t0 = np.linspace(0, sys.period, 8, endpoint=False)
+    excess = []
+    for h in (0.2, 0.1):
+        info = {}
+        step_transitions(sys.A, sys.B, t0, h, 1e-12, info=info)
+        excess.append(info['excess'])
+    assert 16 < excess[0] / excess[1] < 64            # 2^5 = 32

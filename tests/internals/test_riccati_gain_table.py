@@ -46,3 +46,34 @@ def test_gain_not_verified_stays_untabulated(monkeypatch, tmp_path):
     np.testing.assert_allclose(G2(0.3), G0, rtol=1e-9)
     with pytest.raises(TypeError, match="could not be tabulated"):
         ltp.save(tmp_path / 'gain.npz', G)
+
+
+def test_lqe_gain_is_a_table_like_lqr():
+    T = 2 * np.pi
+    sys = ltp.ltpss(lambda t: np.array([[0.0, 1.0], [-1 - 0.5 * np.cos(t), -0.1]]),
+                    [[0.0], [1.0]], [[1.0, 0.0]], 0, period=T)
+    L, P, _ = ltp.lqe(sys, [[1.0]], [[0.1]])
+    assert isinstance(L._func, _GainTable) and L._func.coefs is None    # built on first use
+    exact = L._func.exact
+    t = np.random.default_rng(1).uniform(-T, 2 * T, 41)
+    np.testing.assert_allclose(L(t), exact(t), rtol=0, atol=1e-9 * np.abs(exact(t)).max())
+    assert L._func.coefs is not None and L._func.exact is None
+    # L = P Cᵀ R⁻¹ of the filter Riccati solution
+    np.testing.assert_allclose(L(t), P(t) @ np.array([[1.0], [0.0]]) / 0.1,
+                               rtol=0, atol=1e-8 * np.abs(L(t)).max())
+    np.testing.assert_allclose(np.array([L._func.scalar(ti) for ti in t]), L(t),
+                               rtol=0, atol=1e-14)
+    assert L(0.3).shape == (2, 1)
+    L2 = pickle.loads(pickle.dumps(L))           # data-backed although A is a local function
+    np.testing.assert_array_equal(L2(t), L(t))
+
+
+def test_lqe_gain_table_equals_python_control():
+    A, C = np.array([[0.0, 1.0], [-2.0, -0.3]]), np.array([[1.0, 0.5]])
+    sys = ltp.ltpss(A, B, C, 0, period=0.7)
+    L, _, _ = ltp.lqe(sys, [[1.0]], [[0.2]])
+    L0 = ct.lqe(ct.ss(A, B, C, 0), [[1.0]], [[0.2]])[0]
+    t = np.random.default_rng(2).uniform(0, 0.7, 25)
+    assert isinstance(L._func, _GainTable)
+    assert np.abs(L(t) - L0).max() <= 1e-10 * np.abs(L0).max()
+    assert max(np.abs(L(ti) - L0).max() for ti in t) <= 1e-10 * np.abs(L0).max()
