@@ -417,7 +417,7 @@ def _reversed_gain(Gd):
     The table is tabulated from the exact reversed gain on the reversed step
     grid of the dual problem, on first use (or when pickled or saved).
     """
-    table = Gd._func
+    table = Gd.function
     exact = PeriodicMatrix.from_function(_Reversed(table.exact, True), Gd.period,
                                          Gd.shape[::-1],
                                          breakpoints=np.mod(-table.exact.breakpoints, Gd.period),

@@ -411,6 +411,19 @@ class PeriodicMatrix:
         return self._func is not None
 
     @property
+    def function(self):
+        """The callable ``t -> M(t)`` of a matrix made by `from_function`, else None.
+
+        Examples
+        --------
+        >>> f = lambda t: np.array([[np.cos(t)]])
+        >>> P = ltp.PeriodicMatrix.from_function(f, 2 * np.pi)
+        >>> P.function is f, ltp.PeriodicMatrix.constant([[1.0]], 1.0).function
+        (True, None)
+        """
+        return self._func
+
+    @property
     def nharmonics(self):
         """Number K of harmonics of an exact Fourier form, else None."""
         return None if self._coeffs is None else self._coeffs.shape[0] // 2
