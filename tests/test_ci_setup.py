@@ -65,4 +65,5 @@ def test_hypothesis_is_derandomized_in_ci():
 
 @pytest.mark.skipif(not IN_CI, reason="checks the CI settings (CI=true)")
 def test_cluster_extra_is_installed_in_ci():
-    import dask.distributed  # noqa: F401  (the Dask test is run, not skipped)
+    import dask.distributed       # the Dask test is run, not skipped
+    assert callable(dask.distributed.LocalCluster)

@@ -90,8 +90,9 @@ def assert_same_spectrum(got, want, atol):
 
 
 def continuous_exponents_equal(got, want, atol):
-    """Floquet exponents are defined modulo jω_p: compare the multipliers."""
+    """Floquet exponents are defined modulo jω_p: compare the multipliers (asserts)."""
     assert_same_spectrum(np.exp(np.asarray(got) * T), np.exp(np.asarray(want) * T), atol)
+    return True
 
 
 # Systems of python-control's statefbk/sysnorm tests
@@ -366,7 +367,7 @@ def test_zeros(mod):
     G = ct.ss(ct.tf([1.0, 0.5], [1.0, 3.0, 2.0]))                 # zero -0.5
     want = ct.zeros(G)
     for sys, _ in ((as_periodic(G), None), periodic_basis(G, seed=6)):
-        continuous_exponents_equal(mod.zeros(sys), want, 1e-8)
+        assert continuous_exponents_equal(mod.zeros(sys), want, 1e-8)
 
 
 #

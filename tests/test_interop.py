@@ -405,4 +405,5 @@ def test_enable_inside_disabled_block_restores_disabled_state():
 def test_exact_simulation_does_not_warn():
     with warnings.catch_warnings():
         warnings.simplefilter('error')
-        ct.forced_response(P, t, U)
+        resp = ct.forced_response(P, t, U)
+    np.testing.assert_array_equal(resp.outputs, ltp.forced_response(P, t, U).outputs)
