@@ -27,7 +27,8 @@ from .display import html, text
 from .periodic_matrix import PeriodicMatrix, as_periodic
 from .refusals import refusal, refusal_error
 from .registry import aliased
-from .validation import check_period, check_positive, commensurate, real_array, steps_per_period
+from .validation import (check_period, check_positive, commensurate, index_list, real_array,
+                         steps_per_period)
 
 __all__ = ['LTPStateSpace', 'ltpss', 'series', 'parallel', 'feedback',
            'append', 'negate']
@@ -346,8 +347,8 @@ class LTPStateSpace(NonlinearIOSystem):
             raise ControlArgument("index a system as sys[outputs, inputs], got "
                                   f"{key!r}")
         rows, cols = key
-        outs = _index_list(rows, self.output_labels, 'output')
-        ins = _index_list(cols, self.input_labels, 'input')
+        outs = index_list(rows, self.output_labels, 'output')
+        ins = index_list(cols, self.input_labels, 'input')
         return LTPStateSpace(self.A, self.B[:, ins], self.C[outs, :], self.D[outs, :][:, ins],
                              self.period, dt=self.dt, name=self.name + '$indexed',
                              inputs=[self.input_labels[i] for i in ins],
@@ -780,22 +781,3 @@ def _common(sys1, sys2):
     if isinstance(sys2, (int, float)) and s1.noutputs != 1:
         s2 = _to_ltp(float(sys2) * np.eye(s1.noutputs), period, dt)
     return s1, s2, period, dt
-
-
-def _index_list(spec, labels, what):
-    if isinstance(spec, slice):
-        return list(range(len(labels)))[spec]
-    specs = spec if isinstance(spec, (list, tuple, np.ndarray)) else [spec]
-    out = []
-    for s in specs:
-        if isinstance(s, str):
-            if s not in labels:
-                raise ValueError(f"unknown {what} name {s!r}")
-            out.append(labels.index(s))
-        elif isinstance(s, (int, np.integer)):
-            if not -len(labels) <= s < len(labels):
-                raise ValueError(f"{what} index {s} out of range")
-            out.append(int(s) % len(labels))
-        else:
-            raise ControlArgument(f"invalid {what} index {s!r}")
-    return out

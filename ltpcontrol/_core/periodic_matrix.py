@@ -23,7 +23,7 @@ from control.exception import ControlDimension
 
 from .display import describe
 from .pm_ops import Block, Identity, Index, Scale, Transpose, add_series, mul_series
-from .validation import check_period, check_positive_int, commensurate, real_array
+from .validation import as_matrix, check_period, check_positive_int, commensurate, real_array
 
 __all__ = ['PeriodicMatrix']
 
@@ -157,7 +157,7 @@ class PeriodicMatrix:
         >>> P(0.3)
         array([[1., 2.]])
         """
-        M = _as_matrix(M, 'M')
+        M = as_matrix(M, 'M')
         return cls(M[np.newaxis], period)
 
     @classmethod
@@ -201,13 +201,13 @@ class PeriodicMatrix:
         period = check_period(period)
         if not check and shape is not None:
             return cls._new(period, shape, func=func, breakpoints=breakpoints)
-        value = _as_matrix(func(0.0), 'func(0)')
+        value = as_matrix(func(0.0), 'func(0)')
         if shape is not None and tuple(shape) != value.shape:
             raise ValueError(f"func returns shape {value.shape}, expected {tuple(shape)}")
         probe = np.array([0.123456, 0.5, 0.876543]) * period if check else ()
         for t in probe:
-            a = _as_matrix(func(t), 'func(t)')
-            b = _as_matrix(func(t + period), 'func(t + period)')
+            a = as_matrix(func(t), 'func(t)')
+            b = as_matrix(func(t + period), 'func(t + period)')
             if a.shape != value.shape:
                 raise ValueError(f"func returns inconsistent shapes {value.shape} and {a.shape}")
             if not np.allclose(a, b, rtol=1e-8, atol=1e-10 * max(1.0, np.abs(a).max())):
@@ -360,7 +360,7 @@ class PeriodicMatrix:
                     raise ValueError(f"pieces[{i}] has period {piece.period}, which does "
                                      f"not divide the period {period}") from None
             elif callable(piece):
-                mats.append(cls._new(period, _as_matrix(piece(times[i]), f'pieces[{i}]').shape,
+                mats.append(cls._new(period, as_matrix(piece(times[i]), f'pieces[{i}]').shape,
                                      func=piece))
             else:
                 mats.append(cls.constant(piece, period))
@@ -624,7 +624,7 @@ class PeriodicMatrix:
 
     def _binary(self, other, op, shape, fourier_op):
         if not isinstance(other, PeriodicMatrix):
-            other = PeriodicMatrix.constant(_as_matrix(other, 'operand'), self.period)
+            other = PeriodicMatrix.constant(as_matrix(other, 'operand'), self.period)
             other_period = self.period
         else:
             other_period = other.period
@@ -638,7 +638,7 @@ class PeriodicMatrix:
     def __add__(self, other):
         if not _is_operand(other):
             return NotImplemented
-        shape = self.shape if isinstance(other, PeriodicMatrix) else _as_matrix(other, 'operand').shape
+        shape = self.shape if isinstance(other, PeriodicMatrix) else as_matrix(other, 'operand').shape
         if shape != self.shape:
             raise ValueError(f"cannot add shapes {self.shape} and {shape}")
         return self._binary(other, np.add, self.shape, add_series)
@@ -672,7 +672,7 @@ class PeriodicMatrix:
     def __matmul__(self, other):
         if not _is_operand(other):
             return NotImplemented
-        oshape = other.shape if isinstance(other, PeriodicMatrix) else _as_matrix(other, 'operand').shape
+        oshape = other.shape if isinstance(other, PeriodicMatrix) else as_matrix(other, 'operand').shape
         if self.shape[1] != oshape[0]:
             raise ValueError(f"cannot multiply shapes {self.shape} and {oshape}")
         return self._binary(other, np.matmul, (self.shape[0], oshape[1]), mul_series)
@@ -680,7 +680,7 @@ class PeriodicMatrix:
     def __rmatmul__(self, other):
         if not _is_operand(other):
             return NotImplemented
-        return PeriodicMatrix.constant(_as_matrix(other, 'operand'), self.period) @ self
+        return PeriodicMatrix.constant(as_matrix(other, 'operand'), self.period) @ self
 
     @property
     def T(self):
@@ -713,7 +713,7 @@ class PeriodicMatrix:
         (2, 2)
         """
         flat = [m for row in rows for m in row]
-        shapes = [[m.shape if isinstance(m, PeriodicMatrix) else _as_matrix(m, 'block').shape
+        shapes = [[m.shape if isinstance(m, PeriodicMatrix) else as_matrix(m, 'block').shape
                    for m in row] for row in rows]
         for i, row in enumerate(shapes):
             if len({sh[0] for sh in row}) != 1:
@@ -723,7 +723,7 @@ class PeriodicMatrix:
                 raise ValueError(f"block: the column widths of row {i} do not match row 0")
         periods = [m.period for m in flat if isinstance(m, PeriodicMatrix)]
         if not periods:
-            return PeriodicMatrix.constant(np.block([[_as_matrix(m, 'block') for m in r]
+            return PeriodicMatrix.constant(np.block([[as_matrix(m, 'block') for m in r]
                                                      for r in rows]), 1.0)
         period = periods[0]
         for p in periods[1:]:
@@ -762,7 +762,7 @@ def as_periodic(value, period, name, shape=None):
         except (ValueError, TypeError) as exc:
             raise type(exc)(f"{name}: {exc}") from None
     else:
-        value = PeriodicMatrix.constant(_as_matrix(value, name), period)
+        value = PeriodicMatrix.constant(as_matrix(value, name), period)
     if shape is not None and value.shape != tuple(shape):
         raise ControlDimension(f"{name} must have shape {tuple(shape)}, got {value.shape}")
     return value
@@ -778,15 +778,6 @@ def _callables(P):
     for piece in P._pieces or ():
         out += _callables(piece)
     return out
-
-
-def _as_matrix(value, name):
-    arr = real_array(value, name, ndim=(0, 1, 2))
-    if arr.ndim == 0:
-        arr = arr.reshape(1, 1)
-    elif arr.ndim == 1:
-        arr = arr[np.newaxis, :]
-    return arr
 
 
 def _is_operand(x):

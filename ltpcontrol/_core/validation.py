@@ -261,3 +261,33 @@ def time_record(t, signals, *, tname="t", min_samples=2):
     if L > 1 and (dt <= 0 or np.max(np.abs(np.diff(t) - dt)) > TIME_RTOL * dt):
         raise ValueError(f"{tname} must be increasing and uniformly spaced")
     return t, float(dt), arrays
+
+
+def as_matrix(value, name):
+    """A real matrix from a scalar (1 x 1), a row (1 x n) or a matrix; `name` in errors."""
+    arr = real_array(value, name, ndim=(0, 1, 2))
+    if arr.ndim == 0:
+        arr = arr.reshape(1, 1)
+    elif arr.ndim == 1:
+        arr = arr[np.newaxis, :]
+    return arr
+
+
+def index_list(spec, labels, what):
+    """Indices of signals named or numbered in `spec` (a slice, a name, an index or a list)."""
+    if isinstance(spec, slice):
+        return list(range(len(labels)))[spec]
+    specs = spec if isinstance(spec, (list, tuple, np.ndarray)) else [spec]
+    out = []
+    for s in specs:
+        if isinstance(s, str):
+            if s not in labels:
+                raise ValueError(f"unknown {what} name {s!r}")
+            out.append(labels.index(s))
+        elif isinstance(s, (int, np.integer)):
+            if not -len(labels) <= s < len(labels):
+                raise ValueError(f"{what} index {s} out of range")
+            out.append(int(s) % len(labels))
+        else:
+            raise ControlArgument(f"invalid {what} index {s!r}")
+    return out
