@@ -136,7 +136,16 @@ class Block:
 
 
 def add_series(a, b):
-    """Fourier coefficients of a sum."""
+    """Fourier coefficients of a sum.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.pm_ops import add_series
+    >>> a = np.ones((3, 1, 1)); b = 2 * np.ones((1, 1, 1))      # K = 1 and K = 0
+    >>> add_series(a, b)[:, 0, 0].real
+    array([1., 3., 1.])
+    """
+
     Ka, Kb = a.shape[0] // 2, b.shape[0] // 2
     K = max(Ka, Kb)
     out = np.zeros((2 * K + 1,) + a.shape[1:], complex)
@@ -146,7 +155,18 @@ def add_series(a, b):
 
 
 def mul_series(a, b):
-    """Fourier coefficients of a product."""
+    """Fourier coefficients of a product.
+
+    Examples
+    --------
+    (cos t)² = 1/2 + cos(2t)/2: coefficients 1/4, 0, 1/2, 0, 1/4
+
+    >>> from ltpcontrol._core.pm_ops import mul_series
+    >>> c = np.array([0.5, 0, 0.5]).reshape(3, 1, 1)
+    >>> mul_series(c, c)[:, 0, 0].real
+    array([0.25, 0.  , 0.5 , 0.  , 0.25])
+    """
+
     # (PQ)_k = Σ_l P_l Q_{k-l}: a discrete convolution over harmonics
     Ka, Kb = a.shape[0] // 2, b.shape[0] // 2
     out = np.zeros((2 * (Ka + Kb) + 1, a.shape[1], b.shape[2]), complex)

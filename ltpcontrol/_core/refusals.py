@@ -114,6 +114,15 @@ def refusal(name):
 
 
 def refusal_error(what, hint):
-    """The error for `what` on an LTP system, pointing to `hint`."""
+    """The error for `what` on an LTP system, pointing to `hint`.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.refusals import refusal_error
+    >>> print(refusal_error('ct.margin', 'ltp.stability_margins(L, nharmonics)'))
+    ct.margin does not apply to a linear time-periodic system (LTPStateSpace): use
+    ltp.stability_margins(L, nharmonics)
+    """
+
     return ControlArgument(f"{what} does not apply to a linear time-periodic system "
                            f"(LTPStateSpace): use {hint}")

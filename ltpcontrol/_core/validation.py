@@ -264,7 +264,19 @@ def time_record(t, signals, *, tname="t", min_samples=2):
 
 
 def as_matrix(value, name):
-    """A real matrix from a scalar (1 x 1), a row (1 x n) or a matrix; `name` in errors."""
+    """A real matrix from a scalar (1 x 1), a row (1 x n) or a matrix; `name` in errors.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.validation import as_matrix
+    >>> as_matrix(2.0, 'k').shape, as_matrix([1, 2], 'k').shape
+    ((1, 1), (1, 2))
+    >>> as_matrix([[1, np.nan]], 'k')
+    Traceback (most recent call last):
+    ...
+    ValueError: k contains NaN or inf
+    """
+
     arr = real_array(value, name, ndim=(0, 1, 2))
     if arr.ndim == 0:
         arr = arr.reshape(1, 1)
@@ -274,7 +286,19 @@ def as_matrix(value, name):
 
 
 def index_list(spec, labels, what):
-    """Indices of signals named or numbered in `spec` (a slice, a name, an index or a list)."""
+    """Indices of signals named or numbered in `spec` (a slice, a name, an index or a list).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.validation import index_list
+    >>> index_list(['y', 0], ['x', 'y'], 'output'), index_list(slice(1, None), ['x', 'y'], 'output')
+    ([1, 0], [1])
+    >>> index_list('z', ['x', 'y'], 'output')
+    Traceback (most recent call last):
+    ...
+    ValueError: unknown output name 'z'
+    """
+
     if isinstance(spec, slice):
         return list(range(len(labels)))[spec]
     specs = spec if isinstance(spec, (list, tuple, np.ndarray)) else [spec]

@@ -181,7 +181,16 @@ def monte_carlo(func, ndraws, *, seed=None, n_jobs=None, timeout=None, progress=
 
 
 def available_cores():
-    """Cores this process may run on (its CPU affinity where the OS reports it)."""
+    """Cores this process may run on (its CPU affinity where the OS reports it).
+
+    Examples
+    --------
+    >>> import os
+    >>> from ltpcontrol._identification.montecarlo import available_cores
+    >>> 1 <= available_cores() <= (os.cpu_count() or 1)
+    True
+    """
+
     try:
         return max(1, len(os.sched_getaffinity(0)))
     except AttributeError:                       # macOS, Windows
