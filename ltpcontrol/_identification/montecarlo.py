@@ -202,6 +202,14 @@ def local_workers(n_jobs):
 
     A distributed backend (Dask) keeps `n_jobs` as given; -1 means every
     available core, -2 all but one, as in joblib.
+
+    Examples
+    --------
+    >>> from ltpcontrol._identification.montecarlo import available_cores, local_workers
+    >>> local_workers(10 ** 6) == available_cores(), local_workers(-1) == available_cores()
+    (True, True)
+    >>> local_workers(None) is None
+    True
     """
     if n_jobs is None:
         return None

@@ -112,26 +112,31 @@ def as_records(data, name='data', *, min_samples=2, min_duration=None, what=None
     return records
 
 
-def experiments_first_2d(data):
-    """True when `data` is a tuple ``(t, u, y)`` with u and y 2D and k > 1 rows each.
+def refuse_ambiguous(data, name, where):
+    """Raise for a tuple ``(t, u, y)`` with 2D ``(k, L)`` u and y, k > 1.
 
     Under the one axis order those are k channels of one experiment; entry
     points that earlier read such arrays as k experiments of one channel
-    refuse them (`refuse_ambiguous`), never misread them.
+    refuse them rather than misread them.
+
+    Examples
+    --------
+    >>> from ltpcontrol._identification.records import refuse_ambiguous
+    >>> t = np.arange(5.0)
+    >>> refuse_ambiguous((t, np.ones((1, 2, 5)), np.ones((1, 2, 5))), 'data', 'f')  # 3D: clear
+    >>> refuse_ambiguous((t, np.ones((2, 5)), np.ones((2, 5))), 'data', 'f')
+    Traceback (most recent call last):
+    ...
+    control.exception.ControlDimension: f: data has inputs and outputs of shape (2, L), ...
     """
     if not (isinstance(data, tuple) and len(data) == 3):
-        return False
+        return
     try:
         u, y = np.asarray(data[1], dtype=float), np.asarray(data[2], dtype=float)
     except (TypeError, ValueError):          # ragged or non-numeric: as_records names it
-        return False
-    return u.ndim == 2 and y.ndim == 2 and u.shape[0] == y.shape[0] > 1
-
-
-def refuse_ambiguous(data, name, where):
-    """Raise for 2D ``(k, L)`` inputs and outputs (see `experiments_first_2d`)."""
-    if experiments_first_2d(data):
-        k = np.shape(data[1])[0]
+        return
+    if u.ndim == 2 and y.ndim == 2 and u.shape[0] == y.shape[0] > 1:
+        k = u.shape[0]
         raise ControlDimension(
             f"{where}: {name} has inputs and outputs of shape ({k}, L), which are {k} "
             f"channels of one experiment (channels first, time last); give {k} "
