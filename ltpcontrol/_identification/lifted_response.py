@@ -219,10 +219,22 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
            [1. , 2. ],
            [0.5, 0. ]])
     """
+    return _lifted_records(response, period, nharmonics, frequencies=frequencies,
+                           transient=transient, input_hold=input_hold, hold_step=hold_step,
+                           feedthrough=feedthrough, real=real, unusable=unusable,
+                           batch_size=batch_size, progress=progress, name=name)[0]
+
+
+def _lifted_records(response, period, nharmonics, *, frequencies=None, transient=0.0,
+                    input_hold=None, hold_step=None, feedthrough=None, real=True,
+                    unusable='raise', batch_size=64, progress=False, name=None):
+    """`lifted_frequency_response` and the noise variance of the complex lifted
+    response, ``(M, (2K+1) ny, nu)`` (rows harmonic-major; None for an HTF, NaN where
+    no DFT bin near an output frequency is free of the response; `_output_noise`)."""
     period = check_period(period)
     if isinstance(response, HTF):
         K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
-        return _htf_lifted(response, period, K, real, name)
+        return _htf_lifted(response, period, K, real, name), None
     t, dt, u, y, ylabels, ulabels = _parse_response(response)
     N = steps_per_period(period, dt, 'the time step of timepts')
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
@@ -241,24 +253,26 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
         raise ValueError(f"transient must be >= 0, got {transient}")
 
     tw, uw, yw = _analysis_window(t, u, y, dt, N, transient)
+    window = tw.size * dt
+    lines = _lines(uw, frequencies, window, dt, period, unusable == 'skip')
+    var_y = _output_noise(yw, lines, N, K, dt)
     direct = input_hold is not None and feedthrough is not None
     if direct:
         # y = y_dyn + D(t_k) u_k: analyse both parts, the direct one without the hold
         D = _feedthrough(feedthrough, period, (yw.shape[0], uw.shape[0]))
         yd = np.einsum('koj,jek->oek', D(tw), uw)
         yw = np.concatenate([yw - yd, yd])
-    window = tw.size * dt
-    lines = _lines(uw, frequencies, window, dt, period, unusable == 'skip')
     omega, U, Y = _line_spectra(tw, uw, yw, lines, N, K, period, batch_size, progress)
     hold = _hold_factor(omega, hold_step, input_hold)[:, None]
     if direct:
         # harmonic-major rows of Y: (2K+1) blocks of [dynamic outputs, direct outputs]
         Y = Y.reshape(Y.shape[0], 2 * K + 1, 2, -1)
-        lines, G = _solve_lines(omega, U * hold, Y[:, :, 0].reshape(Y.shape[0], -1), window)
+        lines, G, var = _solve_lines(omega, U * hold, Y[:, :, 0].reshape(Y.shape[0], -1),
+                                     window, var_y)
         G = G + _solve_lines(omega, U, Y[:, :, 1].reshape(Y.shape[0], -1), window)[1]
     else:
-        lines, G = _solve_lines(omega, U * hold, Y, window)
-    return _lifted_frd(G, lines, dt, K, N, real, ylabels, ulabels, name)
+        lines, G, var = _solve_lines(omega, U * hold, Y, window, var_y)
+    return _lifted_frd(G, lines, dt, K, N, real, ylabels, ulabels, name), var
 
 
 def _feedthrough(value, period, shape):
@@ -319,12 +333,16 @@ def _line_spectra(tw, uw, yw, lines, N, K, period, batch_size, progress):
     return omega, np.concatenate(U), np.concatenate(Y)
 
 
-def _solve_lines(omega, U, Y, window):
-    """Lifted response ``G (M, (2K+1) ny, nu)`` on the M distinct lines (increasing).
+def _solve_lines(omega, U, Y, window, var_y=None):
+    """Lines, lifted response ``G (M, (2K+1) ny, nu)`` on the M distinct lines
+    (increasing) and its noise variance (None without `var_y`).
 
     Each pair e gives ``Y^{(e)} = G U^{(e)}``; the pairs of one line give G by
     least squares with weights ``1/‖U^{(e)}‖²``:  ``G Σ_e U U^H/‖U‖² =
-    Σ_e Y U^H/‖U‖²`` (for one input the mean of ``Y/U``).
+    Σ_e Y U^H/‖U‖²`` (for one input the mean of ``Y/U``).  With independent
+    errors of variance ``var_y`` in Y, ``G = Σ_e Y^{(e)} w_e^T/‖U^{(e)}‖`` with
+    ``w_e = (U^{(e)H} Gram^{-1})^T/‖U^{(e)}‖`` has the variance
+    ``Σ_e var_y^{(e)} |w_e|²/‖U^{(e)}‖²``.
     """
     key, inverse = np.unique(np.round(omega * window / (2 * np.pi), 6), return_inverse=True)
     Un = U / np.linalg.norm(U, axis=1, keepdims=True)
@@ -352,7 +370,52 @@ def _solve_lines(omega, U, Y, window):
                       UserWarning, stacklevel=3)
     # G gram = rhs  <=>  gram^T G^T = rhs^T (gram Hermitian)
     G = np.linalg.solve(gram.conj(), rhs.transpose(0, 2, 1)).transpose(0, 2, 1)
-    return lines, G
+    if var_y is None:
+        return lines, G, None
+    w = np.einsum('ej,ejk->ek', Un.conj(), np.linalg.inv(gram)[inverse])
+    norm2 = np.sum(np.abs(U) ** 2, axis=1)
+    var = np.zeros(G.shape)
+    np.add.at(var, inverse, var_y[:, :, None] * (np.abs(w) ** 2 / norm2[:, None])[:, None, :])
+    return lines, G, var
+
+
+def _output_noise(yw, lines, N, K, dt, nbins=4):
+    """Noise variance of the output coefficients ``Y_n`` of every (experiment, line)
+    pair, ``(pairs, (2K+1) ny)`` in the order of `_line_spectra`.
+
+    In the window of P periods, ω_p is P DFT bins; the response of an
+    experiment with lines at bins l occupies the bins ``±l + mP`` and ``mP``
+    (a periodic operating point).  The other bins hold noise only (in
+    steady state): ``var Y_n`` is the mean of ``|Y_b|²`` over the `nbins`
+    free bins nearest to ``l + nP`` (``E|Y_b|² = σ²/L`` for white noise of
+    variance σ², the same as that of ``Y_n``).  NaN where no bin is free or
+    a line is off the DFT grid.
+    """
+    ny, nexp, Lw = yw.shape
+    P = Lw // N
+    binw = 2 * np.pi / (Lw * dt)
+    harm = np.arange(-K, K + 1)
+    out = []
+    for e, Om in enumerate(lines):
+        var = np.full((Om.size, 2 * K + 1, ny), np.nan)
+        idx = Om / binw
+        if Om.size and np.all(np.abs(idx - np.round(idx)) < 1e-6):
+            idx = np.round(idx).astype(int)
+            occupied = np.zeros(P, bool)
+            occupied[0] = True
+            occupied[idx % P] = occupied[-idx % P] = True
+            if not occupied.all():
+                spec = np.abs(np.fft.fft(yw[:, e], axis=-1)) ** 2 / Lw ** 2     # (ny, Lw)
+                # offsets to the nearest free bins; the same for every harmonic n
+                offsets = np.concatenate([[d, -d] for d in range(1, P + nbins * P)])
+                for r in np.unique(idx % P):
+                    d = offsets[~occupied[(r + offsets) % P]][:nbins]
+                    on = idx % P == r
+                    # bins (lines, 2K+1, nbins) near l + nP
+                    bins = (idx[on, None, None] + harm[:, None] * P + d) % Lw
+                    var[on] = spec[:, bins].mean(-1).transpose(1, 2, 0)
+        out.append(var.reshape(Om.size, (2 * K + 1) * ny))
+    return np.concatenate(out)
 
 
 def _htf_lifted(H, period, K, real, name):
