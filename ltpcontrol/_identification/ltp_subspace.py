@@ -14,7 +14,7 @@ Pipeline
 4. *Continuous time*: inverse Tustin (eq. 4.104), the matrix logarithm of the
    exactly sampled ``A_d`` (``A = log(A_d)/Ts``), or that ``A`` followed by a
    least-squares refit of ``B(t), C(t), D(t)`` on the continuous harmonic
-   response (see `identify_ltp`).
+   response (see `identify_ltp` and ``refit.py``).
 
 Sampled data of a continuous system identify the exactly sampled Floquet
 multipliers ``e^{λ Ts}``, so inverse Tustin biases ``A`` by about
@@ -26,20 +26,19 @@ from dataclasses import dataclass
 
 import numpy as np
 import control as ct
-from control.exception import ControlArgument
+from control.exception import ControlArgument, ControlDimension
 
 from .._core.discretize import d2c
 from .fdsubspace import fdsubspace, FDSubspaceInfo
-from .floquet_fit import _harmonic_data, _harmonic_response, fit_floquet
+from .floquet_fit import _harmonic_data, _harmonic_response
 from .._frequency.htf import HTF
 from .records import as_records, refuse_ambiguous
-from .lifted_response import lifted_frequency_response
-from .._core.ltpsys import LTPStateSpace
-from .._core.periodic_matrix import PeriodicMatrix
+from .lifted_response import _lifted_records, lifted_frequency_response
 from .realization import FloquetRealization, floquet_realization
 from .refine import RefineInfo, _harmonics, refine_ltp
+from .refit import _refit
 from .._core.validation import (check_period, check_positive, check_positive_int,
-                                steps_per_period)
+                                real_array, steps_per_period)
 
 __all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
 
@@ -55,9 +54,11 @@ class LTPSubspaceInfo:
     Attributes
     ----------
     success : bool
-        The model is trustworthy: with 'refit', the least-squares refit
-        converged and its relative residual is at most the realization's
-        ``fit_tol`` (default 0.05); with 'log' or 'tustin', the Floquet
+        The model is trustworthy: with 'refit', its relative residual is
+        at most the realization's ``fit_tol`` (default 0.05) and the
+        least-squares refit converged or, if it stopped before converging,
+        the model predicts its held-out lines (``holdout_nrmse <=
+        validation_tol``); with 'log' or 'tustin', the Floquet
         realization succeeded with all K harmonics; with ``refine='ml'``
         also the refinement converged.
     message : str
@@ -91,6 +92,13 @@ class LTPSubspaceInfo:
         Normalized RMS error of the model identified without the held-out
         lines on those lines (time-domain steady-state output, all
         harmonics of the data; see `identify_ltp`); NaN without validation.
+    holdout_noise : float
+        NRMSE of the noise alone on the held-out entries (see
+        `identify_ltp`); NaN when the noise is unknown.
+    holdout_error : float
+        The model's share of the held-out NRMSE, ``sqrt(holdout_nrmse² -
+        holdout_noise²)`` (``holdout_nrmse`` when the noise is unknown):
+        compared with ``validation_tol``.
     holdout_lines : ndarray
         The held-out lines (rad/s); empty without validation.
     data_harmonics : int
@@ -117,6 +125,8 @@ class LTPSubspaceInfo:
     realized_harmonics: int
     refinement: RefineInfo = None
     holdout_nrmse: float = np.nan
+    holdout_noise: float = np.nan
+    holdout_error: float = np.nan
     holdout_lines: np.ndarray = None
     data_harmonics: int = 0
     refine_fallback: bool = False
@@ -127,7 +137,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
                  refit_harmonics='auto', refine=None, refine_options=None,
                  estimate_d=True, frequencies=None, transient=None, input_hold=None,
                  hold_step=None, batch_size=None, seed=None, holdout=4,
-                 validation_tol=0.05, progress=False, return_info=False, name=None):
+                 validation_tol=0.05, std=None, progress=False, return_info=False,
+                 name=None):
     r"""Identify a continuous-time LTP model from sine experiments (thesis §4.2).
 
     Runs the whole frequency-domain subspace pipeline: lifted frequency
@@ -221,17 +232,23 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         Validation on held-out lines (default 4): every `holdout`-th line
         (starting with the second) is kept out of the identification; the
         model identified from the other lines predicts them, and its
-        normalized RMS error ``info.holdout_nrmse`` decides ``success``
-        (see Notes).  The returned model is then refitted on all lines
-        from the validated one ('refit'; identified again from all lines
-        for 'log', 'tustin' and ``refit_a=False``, whose A is that of the
-        realization).  None (or too few lines for the subspace
-        step without them, with a warning) skips the validation.
+        normalized RMS error ``info.holdout_nrmse``, less the share of the
+        noise (``info.holdout_error``), decides ``success`` (see Notes).
+        The returned model is then refitted on all lines from the
+        validated one ('refit'; identified again from all lines for 'log',
+        'tustin' and ``refit_a=False``, whose A is that of the
+        realization).  None (or too few lines for the subspace step
+        without them, with a warning) skips the validation.
     validation_tol : float, optional
-        Largest held-out NRMSE of a successful model (default 0.05).
-        Noise in the held-out data raises the NRMSE of a perfect model: at
-        an output SNR of 20 dB, with 20 periods of 40 samples per line, to
-        about 0.02.
+        Largest held-out model error ``info.holdout_error`` of a successful
+        model (default 0.05): the held-out NRMSE with the share of the noise
+        removed when the noise is known (time records, or `std`; see Notes).
+    std : array_like, optional
+        Lifted frequency-response data only: standard deviation of the
+        errors of its entries, a scalar or an array that broadcasts to
+        ``data.frdata.shape`` (lifted outputs, inputs, lines).  It sets the
+        noise share of the held-out NRMSE; the noise of time records is
+        estimated from their DFT.
     progress : bool, optional
         Show progress bars (experiment batches, realization, refit; default
         False).
@@ -256,21 +273,26 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         `q`, the data do not have ``2K+1`` harmonics per output, an option
         is unknown, no lifted model of harmonics -k..k (k <= K) has a
         Floquet realization (repeated eigenvalues), or for the data errors
-        of `lifted_frequency_response`.
+        of `lifted_frequency_response`; if `std` is negative or not finite.
     ControlArgument
         If `data` has the wrong type or is not discrete-time.
+    ControlDimension
+        If `std` does not broadcast to the shape of `data`.
     TypeError
         For unknown keyword arguments, or the time-record options
-        (`frequencies`, `transient`, ...) given with frequency-response data.
+        (`frequencies`, `transient`, ...) given with frequency-response data,
+        or `std` given with time records or an HTF.
 
     Warns
     -----
     UserWarning
-        If the model misses its held-out lines by more than
-        `validation_tol` (the warning names ``holdout_nrmse``).  With
+        If the model's share of its held-out error exceeds
+        `validation_tol` (the warning names ``holdout_error`` and
+        ``holdout_nrmse``).  With
         'refit': if the returned model misses the data by more than
         the realization's ``fit_tol`` (default 0.05, relative residual) or
-        the refit stops before converging.  With 'log' or 'tustin': if the
+        the refit stops before converging without a validation on held-out
+        lines.  With 'log' or 'tustin': if the
         realization does not find the Floquet structure or had to use
         fewer harmonics.  Lines of time records at multiples of ``ω_p/2``
         are skipped with a warning.  If the returned model is unstable
@@ -337,7 +359,20 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     model's steady-state output in the time domain, for the held-out
     single-sine records of equal amplitude (or one multisine of the
     held-out lines): the whole output the model predicts, since it has no
-    harmonics beyond ``K_d``.  With ``refine='ml'`` the refined model is
+    harmonics beyond ``K_d``.
+
+    Noise in the held-out data raises the NRMSE of a perfect model.  When
+    the noise is known, ``holdout_noise = sqrt(Σ σ²) / ‖G‖`` is the NRMSE
+    of the noise alone over the same entries and ``holdout_error =
+    sqrt(holdout_nrmse² - holdout_noise²)`` (0 if negative) the model's
+    share, which decides ``success``.  Time records give σ² themselves: in
+    the analysis window of P periods ω_p is P DFT bins and the response to
+    a line at bin l occupies only the bins ``±l + mP`` (and ``mP``); the
+    mean power of the nearest four free bins around each output frequency
+    is the variance of its coefficient (``σ²/L`` for white noise), carried
+    through the least-squares solution of every line.  For lifted data
+    give `std`; without it (and for HTFs) ``holdout_error =
+    holdout_nrmse``.  With ``refine='ml'`` the refined model is
     kept only if it predicts the held-out lines at least as well as its
     start; otherwise the start is returned and ``info.message`` says so.
 
@@ -384,7 +419,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         K if refit_harmonics == 'auto' else refit_harmonics)
     record_options = dict(frequencies=frequencies, transient=transient,
                           input_hold=input_hold, hold_step=hold_step, batch_size=batch_size)
-    G = _lifted_data(data, period, 2 * K + Hb, progress, record_options, K)
+    G, noise_var = _lifted_data(data, period, 2 * K + Hb, progress, record_options, K, std)
     ny, N, Kd = _check_lifted_data(G, period, K, nstates, q)
     name = 'ltp_subspace' if name is None else name
     labels = dict(name=name, inputs=[lab.rsplit('_', 1)[0] for lab in G.input_labels],
@@ -404,12 +439,13 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
                input_hold=input_hold, record_options=record_options, refine=refine,
                refine_options=refine_options, realization=realization, seed=seed,
                progress=progress, realization_options=realization_options)
-    holdout_nrmse, fallback, nfev = np.nan, False, 0
+    holdout_nrmse, holdout_noise, fallback, nfev = np.nan, np.nan, False, 0
     if held.any():
         # 2-6 without the held-out lines; their prediction validates the structure
         val = _identify_lines(G, ~held, ctx, htf=None)
         nfev += val['nfev']
         holdout_nrmse = _nrmse(val['sys'], G, held, Kd, N, ny)
+        holdout_noise = _noise_nrmse(noise_var, G, held, Kd, N, ny)
         if val['ml'] is not None:
             before = _nrmse(val['start'], G, held, Kd, N, ny)
             if holdout_nrmse > before:
@@ -433,13 +469,21 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         nfev += res['nfev']
     sysc, converged, ml, Kr = res['sys'], res['converged'], res['ml'], res['Kr']
     real = res['realization']
-    if conversion == 'refit' and not converged:
+    # the model's share of the held-out error: the noise's share removed (in squares)
+    holdout_error = holdout_nrmse if not np.isfinite(holdout_noise) else float(
+        np.sqrt(max(holdout_nrmse ** 2 - holdout_noise ** 2, 0.0)))
+    # a refit that stopped early is doubtful unless the held-out lines validate it
+    validated = bool(held.any() and holdout_error <= validation_tol)
+    if conversion == 'refit' and not converged and not validated:
         warnings.warn("the least-squares refit did not converge", UserWarning, stacklevel=2)
     Gc = _harmonic_data(G.frdata, Kd, N, ny)
     relres = float(np.linalg.norm(_harmonic_response(sysc, G.omega, Kd) - Gc)
                    / np.linalg.norm(Gc))
-    success, message = _quality(real, Kr, K, conversion, relres, converged, ml,
-                                realization_options)
+    success, message = _quality(real, Kr, K, conversion, relres, converged or validated,
+                                ml, realization_options)
+    if conversion == 'refit' and not converged and validated:
+        message = message.replace('refit converged', 'refit stopped before converging '
+                                  '(validated by the held-out lines)')
     produced = 2 * K + max(K, sysc.B.nharmonics or 0)
     if Kd < produced:
         message += (f"; the data hold the output harmonics |n| <= {Kd}, the model produces "
@@ -448,13 +492,18 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         message += ("; the ML refinement predicted the held-out lines worse than its "
                     "start, which is kept")
     if held.any():
-        message += f"; held-out NRMSE {holdout_nrmse:.3g} (validation_tol {validation_tol:g})"
-        if not holdout_nrmse <= validation_tol:
+        noise = (f", of which noise {holdout_noise:.3g}: model error {holdout_error:.3g}"
+                 if np.isfinite(holdout_noise) else "")
+        message += (f"; held-out NRMSE {holdout_nrmse:.3g}{noise} (validation_tol "
+                    f"{validation_tol:g})")
+        if not validated:
             success = False
+            figure = (f"holdout_error {holdout_error:.3g} (holdout_nrmse "
+                      f"{holdout_nrmse:.3g}, noise {holdout_noise:.3g})"
+                      if np.isfinite(holdout_noise) else f"holdout_nrmse {holdout_nrmse:.3g}")
             warnings.warn(f"the identified model does not predict its held-out lines: "
-                          f"holdout_nrmse {holdout_nrmse:.3g} > validation_tol "
-                          f"{validation_tol:g}; try other nstates, nharmonics or more "
-                          "data", UserWarning, stacklevel=2)
+                          f"{figure} > validation_tol {validation_tol:g}; try other "
+                          "nstates, nharmonics or more data", UserWarning, stacklevel=2)
     if not sysc.is_stable():
         # steady-state responses exist only for a stable plant: an unstable fit is doubtful
         growth = float(np.max(np.linalg.eigvals(sysc.A(0.0)).real))
@@ -469,7 +518,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         success=success, message=message, nfev=nfev, data=G, lifted=res['lifted'],
         subspace=res['subspace'], realization=real, conversion=conversion,
         relative_residual=relres, realized_harmonics=Kr, refinement=ml,
-        holdout_nrmse=float(holdout_nrmse), holdout_lines=G.omega[held],
+        holdout_nrmse=float(holdout_nrmse), holdout_noise=float(holdout_noise),
+        holdout_error=float(holdout_error), holdout_lines=G.omega[held],
         data_harmonics=Kd, refine_fallback=fallback)
 
 
@@ -514,7 +564,7 @@ def _identify_lines(G, lines, ctx, htf):
                           ctx['realization_options'], ctx['conversion'], ctx['labels'])
     # 5-6. structured refit and optional maximum-likelihood refinement
     fit = dict(_fit_args(ctx), G=G, lines=lines, htf=htf)
-    chosen, trial = 0, _fit_and_refine(candidates[0][-1], **fit)
+    chosen, trial = 0, _fit_and_refine(candidates[0][-1], k0=candidates[0][-2], **fit)
     nfev = trial[2]
     if not trial[0].is_stable() and len(candidates) > 1:
         # steady-state data come from a stable plant: a local fit that left the
@@ -522,7 +572,7 @@ def _identify_lines(G, lines, ctx, htf):
         # fit of lowest cost, if any
         best = None
         for i, cand in enumerate(candidates[1:], start=1):
-            other = _fit_and_refine(cand[-1], **fit)
+            other = _fit_and_refine(cand[-1], k0=cand[-2], **fit)
             nfev += other[2]
             if other[0].is_stable():
                 cost = _fit_cost(other, Kd, N, ny)
@@ -537,21 +587,21 @@ def _identify_lines(G, lines, ctx, htf):
 
 def _fit_and_refine(start, *, data, period, G, lines, htf, K, Kd, N, ny, conversion,
                     refit_harmonics, estimate_d, refit_a, labels, input_hold,
-                    record_options, refine, refine_options, progress):
-    """Steps 5-6 from the realization `start` on the lines `lines` of G:
-    ``(model, converged, nfev, ml, G, Gc, model before refinement)``."""
+                    record_options, refine, refine_options, progress, k0=None):
+    """Steps 5-6 from the realization `start` (of `k0` harmonics, default K) on the
+    lines `lines` of G: ``(model, converged, nfev, ml, G, Gc, model before refinement)``."""
     sysc, nfev, converged = start, 0, True
     Gl = _select_lines(G, lines, Kd, ny)
     Gc = _harmonic_data(Gl.frdata, Kd, N, ny)
     if conversion == 'refit':
         sysc, converged, nfev = _refit(sysc, Gc, Gl.omega, K, refit_harmonics, estimate_d,
-                                       refit_a, labels, progress)
+                                       refit_a, labels, progress, k0)
         if estimate_d and input_hold is not None and not isinstance(
                 data, (ct.FrequencyResponseData, HTF)):
             # the direct term sees the samples, not the held input: redo the
             # hold correction with the fitted D(t) and refit once more
             options = dict(record_options, feedthrough=sysc.D)
-            Gall = _lifted_data(data, period, Kd, False, options)
+            Gall = _lifted_data(data, period, Kd, False, options)[0]
             Gl = _select_lines(Gall, np.isin(Gall.omega, Gl.omega), Kd, ny)
             Gc = _harmonic_data(Gl.frdata, Kd, N, ny)
             sysc, converged, more = _refit(sysc, Gc, Gl.omega, K, refit_harmonics, True,
@@ -578,30 +628,63 @@ def _fit_cost(fit, Kd, N, ny):
     return float(np.linalg.norm(_harmonic_response(sysc, G.omega, Kd) - Gc))
 
 
-def _lifted_data(data, period, Kd, progress, options, K=0):
+def _lifted_data(data, period, Kd, progress, options, K=0, std=None):
     """Step 1: the real lifted response, given or computed from time records (with
-    the harmonics -Kd..Kd, at most (N-1)/2; from an HTF at least K)."""
+    the harmonics -Kd..Kd, at most (N-1)/2; from an HTF at least K), and the noise
+    variance of its entries ``(M, rows, inputs)`` (from `std` for lifted data, estimated
+    for time records, None when unknown)."""
     given = {key: val for key, val in options.items() if val is not None}
     if isinstance(data, (ct.FrequencyResponseData, HTF)):
         if given:
             raise TypeError(f"identify_ltp: {sorted(given)} only apply to time "
                             "records, not to frequency-response data")
         if isinstance(data, HTF):
+            if std is not None:
+                raise TypeError("identify_ltp: std applies to lifted frequency-response "
+                                "data; an HTF carries its own std")
             # the most harmonics known together at some frequencies (band-limited
             # chirps know few); the ML refinement fits all components of the HTF
             for k in range(min(Kd, data.nharmonics), K, -1):
                 try:
-                    return lifted_frequency_response(data, period, k)
+                    return lifted_frequency_response(data, period, k), None
                 except ValueError:
                     continue
-            return lifted_frequency_response(data, period, K)
-        return data
+            return lifted_frequency_response(data, period, K), None
+        return data, None if std is None else _data_variance(std, data)
+    if std is not None:
+        raise TypeError("identify_ltp: std applies to lifted frequency-response data; "
+                        "the noise of time records is estimated from them")
     # time records: parsed once here, so that errors name this function's argument
     refuse_ambiguous(data, 'data', 'identify_ltp')
     dt = as_records(data, 'data')[0].dt
     Kd = min(Kd, (int(round(period / dt)) - 1) // 2)
-    return lifted_frequency_response(data, period, Kd, progress=progress,
-                                     unusable='skip', **given)
+    return _lifted_records(data, period, Kd, progress=progress, unusable='skip', **given)
+
+
+def _data_variance(std, data):
+    """``std²`` broadcast to the entries of the lifted data, ``(M, rows, inputs)``."""
+    std = real_array(std, 'std')
+    if np.any(std < 0) or not np.all(np.isfinite(std)):
+        raise ValueError("std must be finite and >= 0")
+    try:
+        var = np.broadcast_to(std ** 2, data.frdata.shape)
+    except ValueError:
+        raise ControlDimension(f"std of shape {std.shape} does not broadcast to the "
+                               f"data's shape {data.frdata.shape} (outputs, inputs, "
+                               "lines)") from None
+    return var.transpose(2, 0, 1)
+
+
+def _noise_nrmse(var, G, lines, Kd, N, ny):
+    """The held-out NRMSE of the noise alone: ``sqrt(Σ var) / ‖G‖`` over the lines
+    `lines` (the trace of the noise covariance is that of any unitary basis of the
+    harmonics); NaN when the noise is unknown there."""
+    if var is None:
+        return np.nan
+    power = float(np.sum(var[lines]))
+    Gc = _harmonic_data(G.frdata, Kd, N, ny)[..., lines]
+    return np.sqrt(power) / max(np.linalg.norm(Gc), np.finfo(float).tiny) \
+        if np.isfinite(power) else np.nan
 
 
 def _check_lifted_data(G, period, K, nstates, q):
@@ -666,58 +749,6 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
     if not candidates:
         raise ValueError(f"the Floquet realization failed: {real.message}")
     return [c[1:] for c in sorted(candidates, key=lambda c: c[0])]
-
-
-def _refit(sys, Gc, omega, K, harmonics, estimate_d, fit_a, labels, progress=False):
-    """Step 5: the refit with ``H = harmonics`` harmonics in B; for 'auto' the refits
-    with H = K and H = K + 1 (both from `sys`), K + 1 kept if it earns its place."""
-    fit = dict(estimate_d=estimate_d, fit_a=fit_a, progress=progress, **labels)
-    model, res, converged, nfev = _staged_fit(sys, Gc, omega, K, (
-        K if harmonics == 'auto' else harmonics), fit)
-    if harmonics == 'auto' and K > 0:            # K = 0: B_{±1} would meet no C harmonic
-        wide, res1, conv1, nfev1 = _staged_fit(sys, Gc, omega, K, K + 1, fit)
-        nfev += nfev1
-        # BIC = N log(SSE / N) + p log N: N real residuals, B_{±(K+1)} add 2 n_p m parameters
-        nres, extra = 2 * Gc.size, 2 * sys.nstates * Gc.shape[0]
-        tiny = np.finfo(float).tiny
-        # in logs: the ratio of squares can overflow or divide by zero (exact fits)
-        bic = (2 * nres * (np.log(max(res1, tiny)) - np.log(max(res, tiny)))
-               + extra * np.log(nres))
-        # with the data harmonics K + 1 measured, B_{±(K+1)} is seen directly
-        seen = Gc.shape[1] > 2 * K + 1 or _visibility(wide, omega, K) <= _MAX_VISIBILITY
-        if bic < 0 and seen:
-            model, converged = wide, conv1
-    return model, converged, nfev
-
-
-def _staged_fit(sys, Gc, omega, K, H, fit):
-    """`fit_floquet` on the data harmonics -K..K, then on all of `Gc` (-Kd..Kd) from
-    there: the harmonics |n| <= K carry the structure, a start far from it
-    meets local minima when the small outer harmonics weigh in from the outset."""
-    Kd = (Gc.shape[1] - 1) // 2
-    nfev = 0
-    if Kd > K:
-        sys, _, _, nfev = fit_floquet(sys, Gc[:, Kd - K:Kd + K + 1], omega, K, harmonics=H,
-                                      **fit)
-    model, res, converged, more = fit_floquet(sys, Gc, omega, K, harmonics=H, **fit)
-    return model, res, converged, nfev + more
-
-
-#: largest ratio of the effect of B_{±(K+1)} on the unmeasured harmonics ±(K+1) to
-#: that on the measured ones (<= 10.4 on the random plants at K = 3, > 6e5 where undetermined)
-_MAX_VISIBILITY = 1e3
-
-
-def _visibility(model, omega, K):
-    """``‖Σ C_{n-m} R_m B_m‖`` over n = ±(K+1) divided by that over |n| <= K, for
-    the terms m = ±(K+1) alone."""
-    Bc = model.B.fourier(K + 1).copy()
-    Bc[1:-1] = 0                                          # keep B_{±(K+1)}
-    extra = LTPStateSpace(model.A(0.0), PeriodicMatrix(Bc, model.period), model.C, 0,
-                          model.period)
-    G = _harmonic_response(extra, omega, K + 1)
-    return np.linalg.norm(G[:, [0, -1]]) / max(np.linalg.norm(G[:, 1:-1]),
-                                                np.finfo(float).tiny)
 
 
 def _quality(real, Kr, K, conversion, relres, converged, ml, options):

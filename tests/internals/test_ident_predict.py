@@ -153,3 +153,53 @@ def test_reduced_prediction_study():
         assert e3 <= 2 * e2 + 1e-9, cls
         e, ok, _, _ = evaluate(plant, 2, snr_db=20.0, seed=7)
         assert e <= 0.1 or not ok, cls
+
+
+def test_more_harmonics_start_from_fewer():
+    """A periodic-B plant that K = 2 models exactly: at K = 3 the refit also passes
+    through the optimum of 2 harmonics and stays exact (from the realization alone it
+    stalls at a relative residual of 5e-6)."""
+    plant = random_ltp(201, 3, 1, periodic='B')
+    model, info = _identify(plant, 3, 10)
+    assert info.success and info.relative_residual < 1e-12
+    assert 'refit converged' in info.message
+    assert ltp.compare_ltp(model, plant, LINES[:20], signal='noise').time_nrmse < 1e-10
+
+
+def test_unconverged_refit_validated_by_holdout():
+    """A refit that creeps along a flat valley stops before converging: the held-out
+    lines decide (success, no warning); without them the stop is reported."""
+    plant = random_ltp(302, 3, 1, periodic='ABC', actuator=20)   # 4 states
+    data = lifted_data(plant, 7, LINES, DT)
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        model, info = ltp.identify_ltp(data, T, 4, 2, return_info=True)
+    assert info.success and 'validated by the held-out lines' in info.message
+    assert info.holdout_nrmse < 1e-2
+    truth = ltp.compare_ltp(model, plant, LINES[:20], signal='noise').time_nrmse
+    assert truth < 1e-2 and abs(truth - info.holdout_nrmse) < 0.5 * truth
+    with pytest.warns(UserWarning, match='did not converge'):
+        _, info = ltp.identify_ltp(data, T, 4, 2, holdout=None, return_info=True)
+    assert not info.success and 'stopped before converging' in info.message
+
+
+def test_output_noise_ignores_the_response():
+    """White noise under a periodically modulated response and a periodic offset:
+    the free DFT bins give the noise variance σ²/L of the output coefficients."""
+    from ltpcontrol._identification.lifted_response import _output_noise
+    N, P, sigma, K = 16, 20, 0.3, 2
+    L, dt = N * P, 1 / N                                  # period 1, window of P periods
+    t = np.arange(L) * dt
+    lines = [np.array([3, 7, 45]) * 2 * np.pi / (L * dt), np.array([11]) * 2 * np.pi / (L * dt)]
+    rng = np.random.default_rng(1)
+    y = sigma * rng.standard_normal((2, 2, L))
+    for e, Om in enumerate(lines):
+        for w in Om:
+            y[:, e] += 5 * np.cos(w * t) * (1 + np.cos(2 * np.pi * t)) + 2 * np.cos(4 * np.pi * t)
+    var = _output_noise(y, lines, N, K, dt)
+    assert var.shape == (4, (2 * K + 1) * 2)
+    assert 0.8 < var.mean() / (sigma ** 2 / L) < 1.25
+    # an experiment whose lines were all skipped has no pairs
+    assert _output_noise(y, [lines[0], lines[1][:0]], N, K, dt).shape == (3, (2 * K + 1) * 2)
+    # off the DFT grid the bins leak: no estimate
+    assert np.isnan(_output_noise(y, [lines[0] * 1.01, lines[1]], N, K, dt)[:3]).all()
