@@ -55,7 +55,7 @@ def test_noise_share_estimated_from_records(noisy_records):
     assert info.holdout_error < info.holdout_nrmse
     assert np.isclose(info.holdout_error ** 2,
                       max(info.holdout_nrmse ** 2 - info.holdout_noise ** 2, 0.0))
-    assert info.success and 'of which noise' in info.message
+    assert info.success and info.message.count('of which noise') == 2
     # the decision uses the model's share: a tolerance between the two passes
     tol = (info.holdout_error + info.holdout_nrmse) / 2
     _, again = _identify(noisy, validation_tol=tol)
@@ -91,6 +91,12 @@ def test_known_std_of_lifted_data():
         _, poor = ltp.identify_ltp(data, 1.0, 1, 2, std=std, return_info=True)
     assert any('holdout_error' in str(w.message) for w in caught)
     assert not poor.success and poor.holdout_error > 0.05
+    # a noise level the held-out error cannot contain is not used
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always')
+        _, wrong = ltp.identify_ltp(exact, 1.0, 3, 2, std=std, return_info=True)
+    assert any('not used' in str(w.message) for w in caught)
+    assert np.isnan(wrong.holdout_noise) and wrong.holdout_error == wrong.holdout_nrmse
 
 
 def test_std_bad_input(noisy_records):

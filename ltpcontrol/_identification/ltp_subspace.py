@@ -54,13 +54,14 @@ class LTPSubspaceInfo:
     Attributes
     ----------
     success : bool
-        The model is trustworthy: with 'refit', its relative residual is
-        at most the realization's ``fit_tol`` (default 0.05) and the
-        least-squares refit converged or, if it stopped before converging,
-        the model predicts its held-out lines (``holdout_nrmse <=
-        validation_tol``); with 'log' or 'tustin', the Floquet
-        realization succeeded with all K harmonics; with ``refine='ml'``
-        also the refinement converged.
+        The model is trustworthy: it predicts its held-out lines
+        (``holdout_error <= validation_tol``; with validation); with
+        'refit', its relative residual (less the noise's share when the
+        noise is known) is at most the realization's ``fit_tol``
+        (default 0.05) and the least-squares refit converged
+        or was validated; with 'log' or 'tustin', the Floquet realization
+        succeeded with all K harmonics; with ``refine='ml'`` also the
+        refinement converged or was validated; the model is stable.
     message : str
         Description of the outcome.
     nfev : int
@@ -290,7 +291,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         `validation_tol` (the warning names ``holdout_error`` and
         ``holdout_nrmse``).  With
         'refit': if the returned model misses the data by more than
-        the realization's ``fit_tol`` (default 0.05, relative residual) or
+        the realization's ``fit_tol`` (default 0.05, relative residual less
+        the noise's share) or
         the refit stops before converging without a validation on held-out
         lines.  With 'log' or 'tustin': if the
         realization does not find the Floquet structure or had to use
@@ -372,7 +374,12 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     is the variance of its coefficient (``σ²/L`` for white noise), carried
     through the least-squares solution of every line.  For lifted data
     give `std`; without it (and for HTFs) ``holdout_error =
-    holdout_nrmse``.  With ``refine='ml'`` the refined model is
+    holdout_nrmse``.  The held-out noise was not fitted, so
+    ``holdout_nrmse >= holdout_noise`` up to the spread of the estimate: a
+    level above 1.5 times it is not noise (a transient left in the window,
+    or too large a `std`) and is not used, with a warning.  The relative
+    residual is compared with the realization's ``fit_tol`` the same way,
+    less the noise's share over all lines.  With ``refine='ml'`` the refined model is
     kept only if it predicts the held-out lines at least as well as its
     start; otherwise the start is returned and ``info.message`` says so.
 
@@ -469,6 +476,13 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         nfev += res['nfev']
     sysc, converged, ml, Kr = res['sys'], res['converged'], res['ml'], res['Kr']
     real = res['realization']
+    if holdout_noise > _NOISE_EXCESS * holdout_nrmse:
+        # the held-out lines' noise was not fitted: E holdout² = error² + noise² >=
+        # noise²; an estimate far above it is not noise (a transient, std too large)
+        warnings.warn(f"the noise level ({holdout_noise:.3g}) exceeds the held-out NRMSE "
+                      f"({holdout_nrmse:.3g}), which contains it: it is not used; "
+                      "check transient= (time records) or std=", UserWarning, stacklevel=2)
+        holdout_noise, noise_var = np.nan, None
     # the model's share of the held-out error: the noise's share removed (in squares)
     holdout_error = holdout_nrmse if not np.isfinite(holdout_noise) else float(
         np.sqrt(max(holdout_nrmse ** 2 - holdout_noise ** 2, 0.0)))
@@ -479,11 +493,10 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     Gc = _harmonic_data(G.frdata, Kd, N, ny)
     relres = float(np.linalg.norm(_harmonic_response(sysc, G.omega, Kd) - Gc)
                    / np.linalg.norm(Gc))
-    success, message = _quality(real, Kr, K, conversion, relres, converged or validated,
-                                ml, realization_options)
-    if conversion == 'refit' and not converged and validated:
-        message = message.replace('refit converged', 'refit stopped before converging '
-                                  '(validated by the held-out lines)')
+    # the noise's share of the residual, as for the held-out lines
+    noise = _noise_nrmse(noise_var, G, np.ones(M, bool), Kd, N, ny)
+    success, message = _quality(real, Kr, K, conversion, relres, converged, ml,
+                                realization_options, validated, noise)
     produced = 2 * K + max(K, sysc.B.nharmonics or 0)
     if Kd < produced:
         message += (f"; the data hold the output harmonics |n| <= {Kd}, the model produces "
@@ -551,6 +564,11 @@ def _enough_lines(M, K, nstates, q):
     """The subspace step of order (2K+1) n_p with `q` block rows can use M lines."""
     order = (2 * K + 1) * nstates
     return 2 * M >= 2 * order + 1 and (q is None or 2 * M >= q + order)
+
+
+#: largest ratio of the noise level to the held-out NRMSE that contains it (its
+#: estimate from >= 100 entries spreads by ~10 %)
+_NOISE_EXCESS = 1.5
 
 
 def _identify_lines(G, lines, ctx, htf):
@@ -751,21 +769,32 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
     return [c[1:] for c in sorted(candidates, key=lambda c: c[0])]
 
 
-def _quality(real, Kr, K, conversion, relres, converged, ml, options):
-    """``(success, message)`` of the returned model; warn when it is doubtful."""
+def _quality(real, Kr, K, conversion, relres, converged, ml, options, validated=False,
+             noise=np.nan):
+    """``(success, message)`` of the returned model; warn when it is doubtful.  A refit
+    or refinement that stopped before converging fails unless `validated` (the model
+    predicts its held-out lines); `fit_tol` bounds the residual less the share of the
+    `noise` (relative, NaN when unknown)."""
+    checked = " (validated by the held-out lines)" if validated else ""
     if Kr < K and conversion != 'refit':
         warnings.warn(f"the lifted model of {K} harmonics has no eigenvalue ladders; "
                       f"realized with {Kr} harmonics instead: the model has {Kr} "
                       "harmonics", UserWarning, stacklevel=3)
     fit_tol = (options or {}).get('fit_tol', 0.05)
     if conversion == 'refit':
-        success = converged and relres <= fit_tol
-        message = (f"refit {'converged' if converged else 'stopped before converging'}, "
-                   f"relative residual {relres:.3g} (fit_tol {fit_tol:g})")
-        if relres > fit_tol:
+        miss, share = relres, ""
+        if np.isfinite(noise):
+            miss = float(np.sqrt(max(relres ** 2 - noise ** 2, 0.0)))
+            share = f", of which noise {noise:.3g}: model {miss:.3g}"
+        success = (converged or validated) and miss <= fit_tol
+        stop = 'converged' if converged else 'stopped before converging' + checked
+        message = (f"refit {stop}, relative residual {relres:.3g}{share} (fit_tol "
+                   f"{fit_tol:g})")
+        if miss > fit_tol:
             warnings.warn(f"the identified model misses the data: relative residual "
-                          f"{relres:.3g} > {fit_tol:g} (realization: {real.message}); "
-                          "try other nstates, nharmonics or q", UserWarning, stacklevel=3)
+                          f"{relres:.3g}{share} > {fit_tol:g} (realization: "
+                          f"{real.message}); try other nstates, nharmonics or q",
+                          UserWarning, stacklevel=3)
     else:
         success = real.success and Kr == K
         message = f"{real.message}; relative residual {relres:.3g}"
@@ -773,6 +802,6 @@ def _quality(real, Kr, K, conversion, relres, converged, ml, options):
             warnings.warn(f"{real.message}; the model is not trustworthy (try another "
                           "realization method, seed or q)", UserWarning, stacklevel=3)
     if ml is not None:
-        success = success and ml.success
-        message += f"; ML refinement: {ml.message}"
+        success = success and (ml.success or validated)
+        message += f"; ML refinement: {ml.message}" + ("" if ml.success else checked)
     return bool(success), message
