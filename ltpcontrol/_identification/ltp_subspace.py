@@ -292,9 +292,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         ``holdout_nrmse``).  With
         'refit': if the returned model misses the data by more than
         the realization's ``fit_tol`` (default 0.05, relative residual less
-        the noise's share) or
-        the refit stops before converging without a validation on held-out
-        lines.  With 'log' or 'tustin': if the
+        the noise's share) or the refit stops before converging without a
+        validation on held-out lines.  With 'log' or 'tustin': if the
         realization does not find the Floquet structure or had to use
         fewer harmonics.  Lines of time records at multiples of ``ω_p/2``
         are skipped with a warning.  If the returned model is unstable
@@ -379,9 +378,11 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     level above 1.5 times it is not noise (a transient left in the window,
     or too large a `std`) and is not used, with a warning.  The relative
     residual is compared with the realization's ``fit_tol`` the same way,
-    less the noise's share over all lines.  With ``refine='ml'`` the refined model is
-    kept only if it predicts the held-out lines at least as well as its
-    start; otherwise the start is returned and ``info.message`` says so.
+    less the noise's share over all lines.
+
+    With ``refine='ml'`` the refined model is kept only if it predicts the
+    held-out lines at least as well as its start; otherwise the start is
+    returned and ``info.message`` says so.
 
     The identified model and the true system are related by a periodic
     change of state: compare them with `ltpcontrol.compare_ltp` (HTFs and
