@@ -407,7 +407,8 @@ def _output_noise(yw, lines, N, K, dt, nbins=4):
             if not occupied.all():
                 spec = np.abs(np.fft.fft(yw[:, e], axis=-1)) ** 2 / Lw ** 2     # (ny, Lw)
                 # offsets to the nearest free bins; the same for every harmonic n
-                offsets = np.concatenate([[d, -d] for d in range(1, P + nbins * P)])
+                # (within ±nbins P: every free residue appears twice per period)
+                offsets = np.concatenate([[d, -d] for d in range(1, nbins * P + 1)])
                 for r in np.unique(idx % P):
                     d = offsets[~occupied[(r + offsets) % P]][:nbins]
                     on = idx % P == r

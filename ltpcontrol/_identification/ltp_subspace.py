@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import control as ct
-from control.exception import ControlArgument, ControlDimension
+from control.exception import ControlArgument
 
 from .._core.discretize import d2c
 from .fdsubspace import fdsubspace, FDSubspaceInfo
@@ -37,8 +37,10 @@ from .lifted_response import _lifted_records, lifted_frequency_response
 from .realization import FloquetRealization, floquet_realization
 from .refine import RefineInfo, _harmonics, refine_ltp
 from .refit import _refit
+from .holdout import (_checked_noise, _data_variance, _model_share, _noise_nrmse, _nrmse,
+                      _quality)
 from .._core.validation import (check_period, check_positive, check_positive_int,
-                                real_array, steps_per_period)
+                                steps_per_period)
 
 __all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
 
@@ -477,16 +479,10 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         nfev += res['nfev']
     sysc, converged, ml, Kr = res['sys'], res['converged'], res['ml'], res['Kr']
     real = res['realization']
-    if holdout_noise > _NOISE_EXCESS * holdout_nrmse:
-        # the held-out lines' noise was not fitted: E holdout² = error² + noise² >=
-        # noise²; an estimate far above it is not noise (a transient, std too large)
-        warnings.warn(f"the noise level ({holdout_noise:.3g}) exceeds the held-out NRMSE "
-                      f"({holdout_nrmse:.3g}), which contains it: it is not used; "
-                      "check transient= (time records) or std=", UserWarning, stacklevel=2)
-        holdout_noise, noise_var = np.nan, None
-    # the model's share of the held-out error: the noise's share removed (in squares)
-    holdout_error = holdout_nrmse if not np.isfinite(holdout_noise) else float(
-        np.sqrt(max(holdout_nrmse ** 2 - holdout_noise ** 2, 0.0)))
+    holdout_noise = _checked_noise(holdout_nrmse, holdout_noise)
+    if not np.isfinite(holdout_noise):
+        noise_var = None
+    holdout_error = _model_share(holdout_nrmse, holdout_noise)
     # a refit that stopped early is doubtful unless the held-out lines validate it
     validated = bool(held.any() and holdout_error <= validation_tol)
     if conversion == 'refit' and not converged and not validated:
@@ -551,25 +547,10 @@ def _select_lines(G, lines, K, ny):
                   inputs=G.input_labels, outputs=G.output_labels[:(2 * K + 1) * ny])
 
 
-def _nrmse(sys, G, lines, Kd, N, ny):
-    """``‖Ĝ - G‖ / ‖G‖`` on the lines `lines`, harmonics -Kd..Kd (the steady-state
-    time-domain NRMSE of the held-out records, by Parseval)."""
-    Gc = _harmonic_data(G.frdata, Kd, N, ny)[..., lines]
-    with np.errstate(all='ignore'):
-        err = np.linalg.norm(_harmonic_response(sys, G.omega[lines], Kd) - Gc)
-    err = err / max(np.linalg.norm(Gc), np.finfo(float).tiny)
-    return float(err) if np.isfinite(err) else np.inf
-
-
 def _enough_lines(M, K, nstates, q):
     """The subspace step of order (2K+1) n_p with `q` block rows can use M lines."""
     order = (2 * K + 1) * nstates
     return 2 * M >= 2 * order + 1 and (q is None or 2 * M >= q + order)
-
-
-#: largest ratio of the noise level to the held-out NRMSE that contains it (its
-#: estimate from >= 100 entries spreads by ~10 %)
-_NOISE_EXCESS = 1.5
 
 
 def _identify_lines(G, lines, ctx, htf):
@@ -680,32 +661,6 @@ def _lifted_data(data, period, Kd, progress, options, K=0, std=None):
     return _lifted_records(data, period, Kd, progress=progress, unusable='skip', **given)
 
 
-def _data_variance(std, data):
-    """``std²`` broadcast to the entries of the lifted data, ``(M, rows, inputs)``."""
-    std = real_array(std, 'std')
-    if np.any(std < 0) or not np.all(np.isfinite(std)):
-        raise ValueError("std must be finite and >= 0")
-    try:
-        var = np.broadcast_to(std ** 2, data.frdata.shape)
-    except ValueError:
-        raise ControlDimension(f"std of shape {std.shape} does not broadcast to the "
-                               f"data's shape {data.frdata.shape} (outputs, inputs, "
-                               "lines)") from None
-    return var.transpose(2, 0, 1)
-
-
-def _noise_nrmse(var, G, lines, Kd, N, ny):
-    """The held-out NRMSE of the noise alone: ``sqrt(Σ var) / ‖G‖`` over the lines
-    `lines` (the trace of the noise covariance is that of any unitary basis of the
-    harmonics); NaN when the noise is unknown there."""
-    if var is None:
-        return np.nan
-    power = float(np.sum(var[lines]))
-    Gc = _harmonic_data(G.frdata, Kd, N, ny)[..., lines]
-    return np.sqrt(power) / max(np.linalg.norm(Gc), np.finfo(float).tiny) \
-        if np.isfinite(power) else np.nan
-
-
 def _check_lifted_data(G, period, K, nstates, q):
     """Validate the lifted data; return (outputs, steps per period, data harmonics)."""
     H = 2 * K + 1
@@ -768,41 +723,3 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
     if not candidates:
         raise ValueError(f"the Floquet realization failed: {real.message}")
     return [c[1:] for c in sorted(candidates, key=lambda c: c[0])]
-
-
-def _quality(real, Kr, K, conversion, relres, converged, ml, options, validated=False,
-             noise=np.nan):
-    """``(success, message)`` of the returned model; warn when it is doubtful.  A refit
-    or refinement that stopped before converging fails unless `validated` (the model
-    predicts its held-out lines); `fit_tol` bounds the residual less the share of the
-    `noise` (relative, NaN when unknown)."""
-    checked = " (validated by the held-out lines)" if validated else ""
-    if Kr < K and conversion != 'refit':
-        warnings.warn(f"the lifted model of {K} harmonics has no eigenvalue ladders; "
-                      f"realized with {Kr} harmonics instead: the model has {Kr} "
-                      "harmonics", UserWarning, stacklevel=3)
-    fit_tol = (options or {}).get('fit_tol', 0.05)
-    if conversion == 'refit':
-        miss, share = relres, ""
-        if np.isfinite(noise):
-            miss = float(np.sqrt(max(relres ** 2 - noise ** 2, 0.0)))
-            share = f", of which noise {noise:.3g}: model {miss:.3g}"
-        success = (converged or validated) and miss <= fit_tol
-        stop = 'converged' if converged else 'stopped before converging' + checked
-        message = (f"refit {stop}, relative residual {relres:.3g}{share} (fit_tol "
-                   f"{fit_tol:g})")
-        if miss > fit_tol:
-            warnings.warn(f"the identified model misses the data: relative residual "
-                          f"{relres:.3g}{share} > {fit_tol:g} (realization: "
-                          f"{real.message}); try other nstates, nharmonics or q",
-                          UserWarning, stacklevel=3)
-    else:
-        success = real.success and Kr == K
-        message = f"{real.message}; relative residual {relres:.3g}"
-        if not real.success:
-            warnings.warn(f"{real.message}; the model is not trustworthy (try another "
-                          "realization method, seed or q)", UserWarning, stacklevel=3)
-    if ml is not None:
-        success = success and (ml.success or validated)
-        message += f"; ML refinement: {ml.message}" + ("" if ml.success else checked)
-    return bool(success), message

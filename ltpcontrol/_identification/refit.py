@@ -27,17 +27,16 @@ def _refit(sys, Gc, omega, K, harmonics, estimate_d, fit_a, labels, progress=Fal
     refit can stall in them.
     """
     fit = dict(estimate_d=estimate_d, fit_a=fit_a, progress=progress, **labels)
-    best = _refit_from(sys, Gc, omega, K, harmonics, fit)
+    model, res, converged, nfev = _refit_from(sys, Gc, omega, K, harmonics, fit)
     if k0 is not None and k0 < K:
-        nested, nfev = sys, best[3]
+        nested = sys
         for k in range(k0, K):
             nested, _, _, more = _staged_fit(nested, Gc, omega, k, k, fit)
             nfev += more
-        other = _refit_from(nested, Gc, omega, K, harmonics, fit)
-        if other[1] < best[1]:
-            best = other
-        best = best[:3] + (nfev + other[3],)
-    model, _, converged, nfev = best
+        other, res1, conv1, more = _refit_from(nested, Gc, omega, K, harmonics, fit)
+        nfev += more
+        if res1 < res:
+            model, converged = other, conv1
     return model, converged, nfev
 
 
