@@ -19,19 +19,40 @@ _FUNCS = {}        # name -> class of a data-backed callable
 
 
 def register_op(name, op):
-    """Register a module-level pointwise operation (function or class) under `name`."""
+    """Register a module-level pointwise operation (function or class) under `name`.
+
+    >>> from ltpcontrol._core.pm_ops import register_op, portable_op, _OPS
+    >>> register_op('negate', np.negative) is np.negative
+    True
+    >>> portable_op(np.negative)
+    ('negate', {})
+    >>> _ = _OPS.pop('negate')
+    """
     _OPS[name] = op
     return op
 
 
 def register_func(name, cls):
-    """Register a data-backed callable class under `name`."""
+    """Register a data-backed callable class under `name`.
+
+    >>> from ltpcontrol._core.pm_ops import register_func, func_class, _FUNCS
+    >>> class Table:
+    ...     pass
+    >>> register_func('table', Table) is Table, func_class('table') is Table
+    (True, True)
+    >>> _ = _FUNCS.pop('table')
+    """
     _FUNCS[name] = cls
     return cls
 
 
 def portable_op(op):
-    """``(name, params)`` of a registered operation, or None."""
+    """``(name, params)`` of a registered operation, or None.
+
+    >>> from ltpcontrol._core.pm_ops import portable_op, Scale
+    >>> portable_op(Scale(2.0)), portable_op(np.add), portable_op(print)
+    (('scale', {'c': 2.0}), ('add', {}), None)
+    """
     for name, known in _OPS.items():
         if op is known:
             return name, {}
@@ -41,7 +62,16 @@ def portable_op(op):
 
 
 def op_from_portable(name, params):
-    """The operation stored as ``(name, params)``."""
+    """The operation stored as ``(name, params)``.
+
+    >>> from ltpcontrol._core.pm_ops import op_from_portable
+    >>> float(op_from_portable('scale', {'c': 3.0})(2.0))
+    6.0
+    >>> op_from_portable('nope', {})
+    Traceback (most recent call last):
+    ...
+    ValueError: unknown pointwise operation 'nope' in the file
+    """
     if name not in _OPS:
         raise ValueError(f"unknown pointwise operation {name!r} in the file")
     op = _OPS[name]
@@ -49,7 +79,12 @@ def op_from_portable(name, params):
 
 
 def func_class(name):
-    """Class of a data-backed callable stored under `name`."""
+    """Class of a data-backed callable stored under `name`.
+
+    >>> from ltpcontrol._core.pm_ops import func_class
+    >>> func_class('chebyshev').__name__
+    'PiecewiseChebyshev'
+    """
     if name not in _FUNCS:
         raise ValueError(f"unknown callable form {name!r} in the file")
     return _FUNCS[name]

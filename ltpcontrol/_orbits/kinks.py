@@ -39,6 +39,26 @@ def one_sided_saltations(lp, flow, breaks, period, v0):
     `lp` is the loop as a `HybridPlant`, `flow` a variational `Flow` of it
     over one period, `breaks` the instants (modulo `period`) where the
     loop's field may jump in t, `v0` the (zero) noise input.
+
+    Examples
+    --------
+    ``ẋ = -a(t) - x`` with a = 1, then 3 from t = 0.5, meets its guard ``x = 0``
+    at t = 0.5 and jumps to ``x + 2``: the saltation ``f⁺/f⁻`` is 3 with the
+    field before the jump and 5/3 with the field after it.
+
+    >>> from ltpcontrol._orbits.hybrid import Flow
+    >>> from ltpcontrol._orbits.kinks import one_sided_saltations
+    >>> a = lambda t: 1.0 if t % 1.0 < 0.5 else 3.0
+    >>> mode = ltp.HybridMode(lambda t, x, u, p: [-a(t) - x[0]],
+    ...                       guard=lambda t, x, u, p: x[0],
+    ...                       reset=lambda t, x, u, p: [x[0] + 2.0], target='m', name='m')
+    >>> plant = ltp.HybridPlant([mode], states=1)
+    >>> flow = Flow(plant, 0.0, 1.0, [np.exp(0.5) - 1], 0, lambda t: np.zeros(0),
+    ...             plant.params, 1e-10, 1e-12, 'DOP853', 10, variational=True)
+    >>> [(index, early, late, t_event)] = one_sided_saltations(plant, flow, [0.5], 1.0,
+    ...                                                        np.zeros(0))
+    >>> index, round(float(early[0, 0]), 6), round(float(late[0, 0]), 6), round(t_event, 6)
+    (1, 3.0, 1.666667, 0.5)
     """
     breaks = np.mod(np.asarray(breaks, float), period)
     kinks = []
@@ -85,6 +105,14 @@ def side_factor_lists(factors, kinks):
     """Factor lists of every combination of sides (early/late) of the kinked events.
 
     Returns ``[(sides, factors)]``, sides a tuple of 'early'/'late' per kink.
+
+    Examples
+    --------
+    >>> from ltpcontrol._orbits.kinks import side_factor_lists
+    >>> factors = [np.eye(1), np.full((1, 1), 2.0), np.eye(1)]
+    >>> kink = (1, np.full((1, 1), 3.0), np.full((1, 1), 0.5), 0.5)
+    >>> [(sides, float(f[1][0, 0])) for sides, f in side_factor_lists(factors, [kink])]
+    [(('early',), 3.0), (('late',), 0.5)]
     """
     kinks = kinks[:MAX_KINKS]
     out = []

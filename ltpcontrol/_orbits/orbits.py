@@ -166,7 +166,19 @@ class PeriodicOrbit:
 
 
 def flow_multipliers(flow, phase_direction=None):
-    """`OrbitMultipliers` of a variational `Flow` over one period (product form)."""
+    """`OrbitMultipliers` of a variational `Flow` over one period (product form).
+
+    Examples
+    --------
+    >>> from ltpcontrol._orbits.orbits import flow_multipliers
+    >>> sys = ct.nlsys(lambda t, x, u, p: -x + np.cos(t), None, states=1, inputs=0)
+    >>> orbit = ltp.periodic_orbit(sys, 2 * np.pi, [0.0], npoints=8)
+    >>> mult = flow_multipliers(orbit._flow)
+    >>> bool(np.isclose(mult.values[0].real, np.exp(-2 * np.pi)))
+    True
+    >>> bool(np.isclose(mult.log_moduli[0], -2 * np.pi))
+    True
+    """
     return product_multipliers(
         flow.factors or [flow.phi], rtol=flow.rtol, restart=_RESTART,
         trace_integral=flow.trace_integral if flow.factored else None,
