@@ -123,6 +123,13 @@ def test_impedance_inverts_the_admittance():
     with pytest.raises(ControlDimension, match="as many voltages"):
         ltp.harmonic_admittance(ltp.ltpss(ct.ss(-np.eye(2), np.eye(2), [[1, 1]], 0),
                                           period=1.0), 2)
+    # the port's channels by name or index: the same admittance; bad ones refused
+    np.testing.assert_array_equal(ltp.harmonic_admittance(conv, 2, voltage='v', current=0)(s),
+                                  ltp.harmonic_admittance(conv, 2)(s))
+    with pytest.raises(ValueError, match="unknown voltage name 'u'"):
+        ltp.harmonic_admittance(conv, 2, voltage='u')
+    with pytest.raises(ValueError, match="current index 3 out of range"):
+        ltp.harmonic_admittance(conv, 2, current=3)
 
 
 def test_sequence_components_of_a_periodic_matrix():

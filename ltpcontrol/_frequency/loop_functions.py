@@ -29,7 +29,7 @@ from .loop import LoopHTF, as_loop
 from .._core.ltpsys import LTPStateSpace, feedback, ltpss
 from .._core.periodic_matrix import PeriodicMatrix
 from .._core.coerce import as_ltp
-from .._core.validation import check_positive_int, real_array
+from .._core.validation import index_list, real_array
 
 __all__ = ['sensitivity_htf', 'complementary_sensitivity_htf', 'siso_equivalent',
            'harmonic_admittance', 'harmonic_impedance']
@@ -235,23 +235,11 @@ def harmonic_impedance(sys, nharmonics, *, voltage=None, current=None,
 
 def _port(sys, voltage, current):
     sys = as_ltp(sys, 'sys', discrete=False)
-    ins = list(range(sys.ninputs)) if voltage is None else _channels(voltage, sys.input_labels)
-    outs = list(range(sys.noutputs)) if current is None else _channels(
-        current, sys.output_labels)
+    ins = list(range(sys.ninputs)) if voltage is None else index_list(
+        voltage, sys.input_labels, 'voltage')
+    outs = list(range(sys.noutputs)) if current is None else index_list(
+        current, sys.output_labels, 'current')
     if len(ins) != len(outs):
         raise ControlDimension(f"a two-port needs as many voltages as currents; got "
                                f"{len(ins)} voltage and {len(outs)} current channels")
     return sys[outs, ins]
-
-
-def _channels(spec, labels):
-    spec = [spec] if isinstance(spec, (str, int, np.integer)) else list(spec)
-    out = []
-    for s in spec:
-        if isinstance(s, str):
-            if s not in labels:
-                raise ValueError(f"unknown signal {s!r}; the signals are {labels}")
-            out.append(labels.index(s))
-        else:
-            out.append(int(check_positive_int(s, 'channel', minimum=0)))
-    return out
