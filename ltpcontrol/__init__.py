@@ -65,6 +65,10 @@ from .storage import save, load
 
 __version__ = "0.1.0"
 
+from ._delays.ltpdsys import LTPDelayStateSpace, ltpdss
+from ._delays.monodromy import delay_monodromy, DelayMonodromy
+from ._delays.chart import stability_chart, StabilityChart, StabilityChartError
+
 #: Alias of `sample_system`, as in python-control.
 c2d = sample_system
 
@@ -117,6 +121,9 @@ __all__ = [
     'campbell', 'CampbellDiagram',
     # files
     'save', 'load',
+    # periodic systems with delays
+    'LTPDelayStateSpace', 'ltpdss', 'delay_monodromy', 'DelayMonodromy',
+    'stability_chart', 'StabilityChart', 'StabilityChartError',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

@@ -37,6 +37,9 @@ LAYERS = {
     'identification': ['_identification'],
     # rotors and wind turbines: multi-blade coordinates, OpenFAST files, Campbell diagrams
     'rotors': ['_rotors'],
+    # periodic systems with delays (uses core and frequency): monodromy operator, exact
+    # delayed HTFs, responses with history, stability charts of any LTP family
+    'delays': ['_delays'],
     # python-control's entry points
     'interop': ['interop'],
     # portable files of systems, periodic matrices and HTFs
