@@ -67,6 +67,7 @@ __version__ = "0.1.0"
 
 from ._delays.ltpdsys import LTPDelayStateSpace, ltpdss
 from ._delays.monodromy import delay_monodromy, DelayMonodromy
+from ._delays import analysis as _delay_analysis  # noqa: F401  (registers the overrides)
 from ._delays.chart import stability_chart, StabilityChart, StabilityChartError
 
 #: Alias of `sample_system`, as in python-control.

@@ -101,7 +101,7 @@ def delayed_mathieu(delta, b, eps=0.0, kappa=0.1):
                       delays=[(2 * np.pi, [[0.0, 0.0], [b, 0.0]])])
 
 
-def mos_multipliers(stiff, delayed, T, window, M=30, rtol=1e-12):
+def mos_multipliers(stiff, delayed, T, window, M=30, rtol=1e-11, constant_outside=False):
     """Dominant multipliers of ``x'' = -stiff(t) x - damp x' + delayed(t) x(t - T)`` ... by solve_ivp.
 
     The second-order equation is ``[x, v]' = F(t)[x, v] + g(t) x(t - T)``
@@ -110,7 +110,9 @@ def mos_multipliers(stiff, delayed, T, window, M=30, rtol=1e-12):
     and the positions of the last period at M Chebyshev points of the window
     (where the delayed term reads them); one period is integrated by
     solve_ivp (DOP853) for every basis state at once, the history
-    interpolated by the Chebyshev polynomial of those points.  Returns the
+    interpolated by the Chebyshev polynomial of those points (outside the
+    window, with ``constant_outside``, the exact exponential of the constant
+    F).  Returns the
     eigenvalues of the resulting matrix by decreasing modulus.
     """
     a, b = window
@@ -119,14 +121,14 @@ def mos_multipliers(stiff, delayed, T, window, M=30, rtol=1e-12):
     nodes = a + (z + 1) / 2 * (b - a)
     size = 2 + M
 
-    def hist(t, Q):
-        # Chebyshev interpolant (of the first kind) of the history columns at t in window
-        y = 2 * (t - a) / (b - a) - 1
-        Tk = np.cos(np.outer(np.arange(M), np.arccos(np.clip(z, -1, 1))))
-        coef = (2 / M) * Tk @ Q
-        coef[0] /= 2
-        Ty = np.cos(np.arange(M) * np.arccos(np.clip(y, -1, 1)))
-        return Ty @ coef
+    # Chebyshev coefficients of the history columns (first-kind interpolation at the nodes)
+    Tk = np.cos(np.outer(np.arange(M), np.arccos(z)))
+    coef_of = (2 / M) * Tk
+    coef_of[0] /= 2
+
+    def hist(t, coef):
+        y = np.clip(2 * (t - a) / (b - a) - 1, -1, 1)
+        return np.cos(np.arange(M) * np.arccos(y)) @ coef
 
     def rhs_cut(t, s, Q):
         X = s.reshape(2, size)
@@ -136,10 +138,15 @@ def mos_multipliers(stiff, delayed, T, window, M=30, rtol=1e-12):
     S0[0, 0] = S0[1, 1] = 1.0
     Q = np.zeros((M, size))
     Q[:, 2:] = np.eye(M)
+    Q = coef_of @ Q
     segments = [(0.0, a, None), (a, b, Q), (b, T, None)]
     S, newQ = S0.ravel(), None
     for t0, t1, Qs in segments:
         if t1 <= t0:
+            continue
+        if Qs is None and constant_outside:      # free flight: exact exponential
+            from scipy.linalg import expm
+            S = (expm(stiff(0.5 * (t0 + t1)) * (t1 - t0)) @ S.reshape(2, size)).ravel()
             continue
         if Qs is None:
             sol = solve_ivp(lambda t, s: (stiff(t) @ s.reshape(2, size)).ravel(), (t0, t1), S,

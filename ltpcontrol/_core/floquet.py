@@ -35,7 +35,7 @@ from .steps import step_grid
 from .transition import expm_batch, step_transitions
 from .coerce import as_ltp
 from .validation import check_positive_int, steps_per_period
-from .registry import method_alias
+from .registry import method_alias, overridden
 
 __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
            'is_stable', 'floquet_transform']
@@ -79,6 +79,8 @@ def monodromy(sys, nsteps=None):
     >>> np.allclose(ltp.monodromy(sys), np.exp(-2.0))
     True
     """
+    if (own := overridden('monodromy', sys)) is not None:      # systems with delays
+        return own(sys, nsteps)
     _, factors = _factors(sys, nsteps)
     out = np.eye(factors.shape[1])
     for phi in factors:
@@ -117,6 +119,8 @@ def floquet_multipliers(sys, nsteps=None):
     >>> np.allclose(ltp.floquet_multipliers(sys), np.exp([-1.0, -3.0]))
     True
     """
+    if (own := overridden('floquet_multipliers', sys)) is not None:   # systems with delays
+        return own(sys, nsteps)
     logmod, arg = _log_multipliers(sys, nsteps)
     with np.errstate(under='ignore', over='ignore', invalid='ignore'):
         mu = np.exp(logmod) * np.exp(1j * arg)
@@ -165,6 +169,8 @@ def floquet_exponents(sys, nsteps=None):
     >>> np.round(ltp.floquet_exponents(sys).real, 8) + 0.0
     array([  0., -24.])
     """
+    if (own := overridden('floquet_exponents', sys)) is not None:   # systems with delays
+        return own(sys, nsteps)
     logmod, arg = _log_multipliers(sys, nsteps)
     if sys.dt:
         nper = steps_per_period(sys.period, sys.dt)
@@ -244,6 +250,8 @@ def is_stable(sys, tol=1e-10, nsteps=None, *, autonomous=False):
     >>> ltp.is_stable(ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=np.pi))
     True
     """
+    if (own := overridden('is_stable', sys)) is not None:      # systems with delays
+        return own(sys, tol, nsteps, autonomous=autonomous)
     if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, numbers.Real) \
             or not 0 <= tol < 1:
         raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")

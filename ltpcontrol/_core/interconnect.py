@@ -21,6 +21,7 @@ import control as ct
 from control.exception import ControlArgument
 
 from .ltpsys import LTPStateSpace, _loop_inverse, _period_and_dt, _to_ltp, append
+from .registry import overridden
 
 __all__ = ['interconnect']
 
@@ -76,6 +77,9 @@ def interconnect(syslist, connections=None, inplist=None, outlist=None, **kwargs
     >>> loop.nstates, loop.period
     (2, 1.0)
     """
+    if (own := overridden('interconnect', *(syslist if isinstance(syslist, (list, tuple))
+                                              else ()))) is not None:  # delay elements
+        return own(syslist, connections, inplist, outlist, **kwargs)
     if params := kwargs.pop('params', None):
         raise ControlArgument(f"interconnect: LTP blocks have no parameters, got {params!r}")
     if not isinstance(syslist, (list, tuple)):

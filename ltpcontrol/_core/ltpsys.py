@@ -26,7 +26,7 @@ from control.nlsys import NonlinearIOSystem
 from .display import html, text
 from .periodic_matrix import PeriodicMatrix, as_periodic
 from .refusals import refusal, refusal_error
-from .registry import aliased
+from .registry import aliased, overridden
 from .validation import (check_period, check_positive, commensurate, index_list, real_array,
                          steps_per_period)
 
@@ -466,6 +466,8 @@ def series(*systems, **kwargs):
     >>> ltp.series(P, ct.tf([1], [1, 2])).nstates
     2
     """
+    if (own := overridden('series', *systems)) is not None:    # delay elements
+        return own(*systems, **kwargs)
     return _chain(_series, systems, kwargs)
 
 
@@ -506,6 +508,8 @@ def parallel(*systems, **kwargs):
     >>> (P + 2).D(0.0)
     array([[2.]])
     """
+    if (own := overridden('parallel', *systems)) is not None:  # delay elements
+        return own(*systems, **kwargs)
     return _chain(_parallel, systems, kwargs)
 
 
@@ -553,6 +557,8 @@ def feedback(sys1, sys2=1, sign=-1, **kwargs):
     >>> L.A(0.0)
     array([[-2.]])
     """
+    if (own := overridden('feedback', sys1, sys2)) is not None:  # delay elements
+        return own(sys1, sys2, sign, **kwargs)
     if sign not in (-1, 1):
         raise ValueError(f"sign must be -1 or 1, got {sign!r}")
     s1, s2, period, dt = _common(sys1, sys2)

@@ -68,3 +68,44 @@ def registered():
     True
     """
     return sorted(_FUNCTIONS)
+
+
+# -- implementations of public functions for system classes of higher layers --
+_OVERRIDES = {}
+
+
+def override(name, cls):
+    """Register the decorated function as public function `name`'s implementation for `cls`.
+
+    A public function of a lower layer (``floquet_multipliers``,
+    ``forced_response``, ``series``...) begins with ``if (own :=
+    overridden(name, sys)) is not None: return own(...)``, so that a
+    system class of a higher layer (systems with delays) gets its own
+    algorithm without the lower layer importing it.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.registry import overridden
+    >>> overridden('floquet_multipliers', ltp.ltpdss([[-1.0]], [[1.0]], [[1.0]], 0,
+    ...            period=1.0, delays=[(0.5, [[0.1]])])) is not None
+    True
+    """
+    def register(func):
+        _OVERRIDES.setdefault(name, []).append((cls, func))
+        return func
+    return register
+
+
+def overridden(name, *objs):
+    """The function registered by `override` for `name` and the class of one of `objs`, or None.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.registry import overridden
+    >>> overridden('floquet_multipliers', 1.0) is None
+    True
+    """
+    for cls, func in _OVERRIDES.get(name, ()):
+        if any(isinstance(obj, cls) for obj in objs):
+            return func
+    return None

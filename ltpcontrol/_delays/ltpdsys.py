@@ -175,15 +175,15 @@ class LTPDelayStateSpace(ct.InputOutputSystem):
     # -- analysis: see ltpcontrol._delays.monodromy and friends --
     def monodromy(self, **kwargs):
         """Discretized monodromy operator; see `ltpcontrol.monodromy`."""
-        return aliased('delay_monodromy')(self, **kwargs).matrix
+        return aliased('monodromy')(self, **kwargs)
 
     def floquet_multipliers(self, **kwargs):
         """Characteristic multipliers; see `ltpcontrol.floquet_multipliers`."""
-        return aliased('delay_floquet_multipliers')(self, **kwargs)
+        return aliased('floquet_multipliers')(self, **kwargs)
 
     def floquet_exponents(self, **kwargs):
         """Characteristic exponents; see `ltpcontrol.floquet_exponents`."""
-        return aliased('delay_floquet_exponents')(self, **kwargs)
+        return aliased('floquet_exponents')(self, **kwargs)
 
     def poles(self):
         """The dominant characteristic exponents (see `floquet_exponents`)."""
@@ -191,25 +191,29 @@ class LTPDelayStateSpace(ct.InputOutputSystem):
 
     def is_stable(self, **kwargs):
         """True when every characteristic multiplier lies inside the unit circle."""
-        return aliased('delay_is_stable')(self, **kwargs)
+        return aliased('is_stable')(self, **kwargs)
 
     def htf(self, nharmonics, **kwargs):
         """Harmonic transfer function with exact ``e^{-sτ}``; see `ltpcontrol.htf`."""
-        return aliased('delay_htf')(self, nharmonics, **kwargs)
+        return aliased('htf')(self, nharmonics, **kwargs)
 
     def __call__(self, *args, **kwargs):
         raise refusal_error("evaluation sys(s) of a transfer function",
                             "ltp.htf(sys, nharmonics)(s), the harmonic transfer function")
 
     # -- block-diagram algebra --
+    # (python-control's convention: ``G2 * G1`` is G1 followed by G2)
     def __mul__(self, other):
-        return aliased('delay_series')(other, self)
+        from .connect import series
+        return series(other, self)
 
     def __rmul__(self, other):
-        return aliased('delay_series')(self, other)
+        from .connect import series
+        return series(self, other)
 
     def __add__(self, other):
-        return aliased('delay_parallel')(self, other)
+        from .connect import parallel
+        return parallel(self, other)
 
     __radd__ = __add__
 
@@ -217,10 +221,12 @@ class LTPDelayStateSpace(ct.InputOutputSystem):
         return self._negated()
 
     def __sub__(self, other):
-        return aliased('delay_parallel')(self, -other)
+        from .connect import parallel
+        return parallel(self, -other)
 
     def __rsub__(self, other):
-        return aliased('delay_parallel')(other, self._negated())
+        from .connect import parallel
+        return parallel(other, self._negated())
 
     def _negated(self):
         t = self.terms
