@@ -68,6 +68,8 @@ __version__ = "0.1.0"
 from ._delays.ltpdsys import LTPDelayStateSpace, ltpdss
 from ._delays.monodromy import delay_monodromy, DelayMonodromy
 from ._delays import analysis as _delay_analysis  # noqa: F401  (registers the overrides)
+from ._delays.htf import DelayHTF
+from ._delays.connect import Delay, delay
 from ._delays.chart import stability_chart, StabilityChart, StabilityChartError
 
 #: Alias of `sample_system`, as in python-control.
@@ -123,7 +125,8 @@ __all__ = [
     # files
     'save', 'load',
     # periodic systems with delays
-    'LTPDelayStateSpace', 'ltpdss', 'delay_monodromy', 'DelayMonodromy',
+    'LTPDelayStateSpace', 'ltpdss', 'delay_monodromy', 'DelayMonodromy', 'DelayHTF',
+    'Delay', 'delay',
     'stability_chart', 'StabilityChart', 'StabilityChartError',
 ]
 

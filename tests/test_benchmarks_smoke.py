@@ -17,6 +17,7 @@ WORKLOADS = ['P1a', 'P1b', 'P2a', 'P2b', 'P3', 'P4a', 'P4b', 'P5a', 'P5b', 'P5c'
              'P8a', 'P8b']
 WORKLOADS += ['P7-4']
 WORKLOADS += ['P10a', 'P10b', 'P10c', 'P10d']
+WORKLOADS += ['P12a', 'P12b']
 
 
 @pytest.fixture(scope='module')

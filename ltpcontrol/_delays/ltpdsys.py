@@ -68,9 +68,13 @@ class LTPDelayStateSpace(ct.InputOutputSystem):
 
     def __init__(self, terms, period, **kwargs):
         self.period = check_period(period)
-        self._terms = {k: tm.clean(dict(terms[k])) for k in 'ABCD'}
-        A = self._terms['A'][0.0]
-        n, m, p = A.shape[0], self._terms['B'][0.0].shape[1], self._terms['C'][0.0].shape[0]
+        shape = {k: next(iter(terms[k].values())).shape for k in 'ABCD'}
+        self._terms = {}
+        for k in 'ABCD':
+            X = {float(a): M for a, M in terms[k].items()}
+            X.setdefault(0.0, PeriodicMatrix.constant(np.zeros(shape[k]), self.period))
+            self._terms[k] = tm.clean(X)
+        n, m, p = shape['A'][0], shape['B'][1], shape['C'][0]
         for k, shape in zip('ABCD', ((n, n), (n, m), (p, n), (p, m))):
             for a, M in self._terms[k].items():
                 if M.shape != shape:

@@ -25,7 +25,7 @@ from .. import config
 from .harmonic_ss import build, real_ss
 from .._core.coerce import as_ltp
 from .._core.validation import check_period, check_positive_int, real_array
-from .._core.registry import aliased, method_alias
+from .._core.registry import aliased, method_alias, overridden
 
 __all__ = ['HTF', 'HTFModel', 'HTFData', 'htf']
 
@@ -556,6 +556,9 @@ def htf(sys, nharmonics, *, internal_harmonics=None, method='auto', period=None)
     >>> bool(np.isclose(H(0.5j)[3, 3], G(1.5j)))
     True
     """
+    if (own := overridden('htf', sys)) is not None:            # systems with delays
+        return own(sys, nharmonics, internal_harmonics=internal_harmonics, method=method,
+                   period=period)
     return HTFModel(sys, nharmonics, internal_harmonics=internal_harmonics, method=method,
                     period=period)
 
