@@ -39,10 +39,11 @@ class DelayHTF(HTF):
 
     Examples
     --------
-    >>> P = ltp.ltpdss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0, delays=[(0.2, [[0.3]])])
+    >>> P = ltp.ltpdss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0, delays=[(0.2, [[0.3]])],
+    ...                name='P')
     >>> H = ltp.htf(P, 1)
     >>> H
-    <DelayHTF htf: ['u[0]'] -> ['y[0]'], K=1, period=1>
+    <DelayHTF P: ['u[0]'] -> ['y[0]'], K=1, period=1>
     >>> s = 0.5j
     >>> bool(np.isclose(H(s)[1, 1], 1 / (s + 1 - 0.3 * np.exp(-0.2 * s))))
     True
