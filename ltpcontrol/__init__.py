@@ -70,6 +70,7 @@ from ._delays.monodromy import delay_monodromy, DelayMonodromy
 from ._delays import analysis as _delay_analysis  # noqa: F401  (registers the overrides)
 from ._delays.htf import DelayHTF
 from ._delays.connect import Delay, delay
+from ._delays import timeresp as _delay_timeresp  # noqa: F401  (registers the overrides)
 from ._delays.chart import stability_chart, StabilityChart, StabilityChartError
 
 #: Alias of `sample_system`, as in python-control.

@@ -26,6 +26,7 @@ from .gridmarch import grid_march
 from .march import periodic_march
 from .coerce import as_ltp
 from .validation import check_kwargs, check_positive, real_array
+from .registry import overridden
 
 __all__ = ['forced_response', 'step_response', 'initial_response', 'impulse_response']
 
@@ -103,6 +104,10 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
     >>> bool(np.isclose(resp.outputs[-1], 1 - np.exp(-5)))
     True
     """
+    if (own := overridden('forced_response', sys)) is not None:   # systems with delays
+        return own(sys, timepts, inputs, initial_state, method=method, input_hold=input_hold,
+                   rtol=rtol, compute_states=compute_states, return_states=return_states,
+                   squeeze=squeeze, transpose=transpose, **kwargs)
     check_kwargs(kwargs, 'forced_response')
     sys = as_ltp(sys, lti_hint='control.forced_response')
     if timepts is None and sys.isdtime(strict=True) and np.ndim(inputs) > 0:
@@ -217,6 +222,10 @@ def initial_response(sys, timepts=None, initial_state=0.0, output_indices=None, 
     >>> bool(np.isclose(resp.outputs[-1], 2 * np.exp(-1)))
     True
     """
+    if (own := overridden('initial_response', sys)) is not None:  # systems with delays
+        return own(sys, timepts, initial_state, output_indices, method=method,
+                   input_hold=input_hold, rtol=rtol, return_states=return_states,
+                   squeeze=squeeze, transpose=transpose, **kwargs)
     check_kwargs(kwargs, 'initial_response')
     sys = as_ltp(sys, lti_hint='control.initial_response')
     t = _time_vector(sys, timepts, is_step=False)

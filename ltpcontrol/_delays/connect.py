@@ -50,6 +50,8 @@ class Delay(ct.InputOutputSystem):
     ----------
     tau : float
         The delay.
+    gain : float
+        A scalar gain (``k * delay(tau)``), 1 by default.
 
     Examples
     --------
@@ -73,16 +75,29 @@ class Delay(ct.InputOutputSystem):
             raise ControlDimension(f"a delay has as many outputs as inputs, got "
                                    f"{self.ninputs} inputs and {self.noutputs} outputs")
         self._broadcast = self.ninputs == 1 and inputs == 1 and outputs == 1
+        self.gain = 1.0
+
+    def _scaled(self, c):
+        out = Delay(self.tau, self.dt, name=self.name,
+                    inputs=1 if self._broadcast else self.input_labels,
+                    outputs=1 if self._broadcast else self.output_labels)
+        out.gain = self.gain * float(c)
+        return out
 
     def __repr__(self):
-        return f"<Delay: {self.input_labels} -> {self.output_labels}, tau={self.tau:g}>"
+        gain = f", gain={self.gain:g}" if self.gain != 1 else ""
+        return f"<Delay: {self.input_labels} -> {self.output_labels}, tau={self.tau:g}{gain}>"
 
     __str__ = __repr__
 
     def __mul__(self, other):
+        if isinstance(other, numbers.Real) and not isinstance(other, bool):
+            return self._scaled(other)
         return series(other, self)
 
     def __rmul__(self, other):
+        if isinstance(other, numbers.Real) and not isinstance(other, bool):
+            return self._scaled(other)
         return series(self, other)
 
     def __add__(self, other):
@@ -91,7 +106,7 @@ class Delay(ct.InputOutputSystem):
     __radd__ = __add__
 
     def __neg__(self):
-        return series(self, -1.0)
+        return self._scaled(-1.0)
 
 
 def delay(tau, dt=None, *, name=None, inputs=None, outputs=None):
@@ -206,7 +221,7 @@ def _shift_register(d, period, dt, width):
     B = np.zeros((n, width))
     B[:width] = np.eye(width)
     C = np.zeros((width, n))
-    C[:, -width:] = np.eye(width)
+    C[:, -width:] = d.gain * np.eye(width)
     names = {} if d._broadcast else dict(inputs=d.input_labels, outputs=d.output_labels)
     return LTPStateSpace(A, B, C, np.zeros((width, width)), period, dt=dt, name=d.name,
                          **names)
@@ -214,7 +229,7 @@ def _shift_register(d, period, dt, width):
 
 def _delay_terms(d, period, width):
     width = (width or 1) if d._broadcast else d.ninputs
-    I = PeriodicMatrix.constant(np.eye(width), period)
+    I = PeriodicMatrix.constant(d.gain * np.eye(width), period)
     Z = lambda r, c: PeriodicMatrix.constant(np.zeros((r, c)), period)  # noqa: E731
     names = {} if d._broadcast else dict(inputs=d.input_labels, outputs=d.output_labels)
     return LTPDelayStateSpace({'A': {0.0: Z(0, 0)}, 'B': {0.0: Z(0, width)},
