@@ -34,6 +34,13 @@ __all__ = ['stability_chart', 'StabilityChart', 'StabilityChartError']
 class StabilityChartError(RuntimeError):
     """The factory of `stability_chart` raised; ``chart`` holds every finished point.
 
+    Parameters
+    ----------
+    message : str
+        What failed, and where first.
+    chart : StabilityChart
+        The chart with every finished point (failed points are NaN).
+
     Examples
     --------
     >>> def factory(x, y):

@@ -22,7 +22,7 @@ from control.iosys import _process_iosys_keywords
 from .._core.ltpsys import LTPStateSpace, _system_matrix
 from .._core.periodic_matrix import PeriodicMatrix
 from .._core.refusals import refusal_error
-from .._core.registry import aliased
+from .._core.registry import aliased, overridden
 from .._core.validation import check_period
 from . import terms as tm
 
@@ -66,7 +66,7 @@ class LTPDelayStateSpace(ct.InputOutputSystem):
     <LTPDelayStateSpace turn: ['u[0]'] -> ['y[0]'], period=1, delays=(0.5,)>
     """
 
-    def __init__(self, terms, period, **kwargs):
+    def __init__(self, terms, period, *, name=None, inputs=None, outputs=None, states=None):
         self.period = check_period(period)
         shape = {k: next(iter(terms[k].values())).shape for k in 'ABCD'}
         self._terms = {}
@@ -84,9 +84,9 @@ class LTPDelayStateSpace(ct.InputOutputSystem):
                     raise ValueError(f"{k} term of delay {a:g} has period {M.period}, "
                                      f"expected {self.period}")
         name, inputs, outputs, states, _ = _process_iosys_keywords(
-            kwargs, {'inputs': m, 'outputs': p, 'states': n})
-        super().__init__(name=name, inputs=inputs, outputs=outputs, states=states, dt=0,
-                         **kwargs)
+            dict(name=name, inputs=inputs, outputs=outputs, states=states),
+            {'inputs': m, 'outputs': p, 'states': n})
+        super().__init__(name=name, inputs=inputs, outputs=outputs, states=states, dt=0)
         for what, count, size in (('inputs', self.ninputs, m), ('outputs', self.noutputs, p),
                                   ('states', self.nstates, n)):
             if count != size:
@@ -146,13 +146,13 @@ class LTPDelayStateSpace(ct.InputOutputSystem):
                 lines.append(f"  {k} term, {what} delayed by {a:g}: {kind} {M.shape}")
         return "\n".join(lines)
 
-    def undelayed(self, **kwargs):
+    def undelayed(self, *, name=None):
         """The `LTPStateSpace` with every delay set to zero (``e^{-sτ} = 1``).
 
         Parameters
         ----------
-        **kwargs
-            Keywords of the result (``name``, ...).
+        name : str, optional
+            Name of the result (default ``'<name>$undelayed'``).
 
         Returns
         -------
@@ -171,53 +171,50 @@ class LTPDelayStateSpace(ct.InputOutputSystem):
             for _, M in tm.delayed(X):
                 total = total + M
             mats.append(total)
-        kwargs.setdefault('name', self.name + '$undelayed')
-        for key in ('inputs', 'outputs', 'states'):
-            kwargs.setdefault(key, getattr(self, key[:-1] + '_labels'))
-        return LTPStateSpace(*mats, self.period, **kwargs)
+        return LTPStateSpace(*mats, self.period, name=name or self.name + '$undelayed',
+                             inputs=self.input_labels, outputs=self.output_labels,
+                             states=self.state_labels)
 
     # -- analysis: see ltpcontrol._delays.monodromy and friends --
-    def monodromy(self, **kwargs):
+    def monodromy(self):
         """Discretized monodromy operator; see `ltpcontrol.monodromy`."""
-        return aliased('monodromy')(self, **kwargs)
+        return aliased('monodromy')(self)
 
-    def floquet_multipliers(self, **kwargs):
+    def floquet_multipliers(self):
         """Characteristic multipliers; see `ltpcontrol.floquet_multipliers`."""
-        return aliased('floquet_multipliers')(self, **kwargs)
+        return aliased('floquet_multipliers')(self)
 
-    def floquet_exponents(self, **kwargs):
+    def floquet_exponents(self):
         """Characteristic exponents; see `ltpcontrol.floquet_exponents`."""
-        return aliased('floquet_exponents')(self, **kwargs)
+        return aliased('floquet_exponents')(self)
 
     def poles(self):
         """The dominant characteristic exponents (see `floquet_exponents`)."""
         return self.floquet_exponents()
 
-    def is_stable(self, **kwargs):
+    def is_stable(self, tol=1e-10):
         """True when every characteristic multiplier lies inside the unit circle."""
-        return aliased('is_stable')(self, **kwargs)
+        return aliased('is_stable')(self, tol)
 
-    def htf(self, nharmonics, **kwargs):
+    def htf(self, nharmonics, *, internal_harmonics=None):
         """Harmonic transfer function with exact ``e^{-sτ}``; see `ltpcontrol.htf`."""
-        return aliased('htf')(self, nharmonics, **kwargs)
+        return aliased('htf')(self, nharmonics, internal_harmonics=internal_harmonics)
 
     def __call__(self, *args, **kwargs):
         raise refusal_error("evaluation sys(s) of a transfer function",
                             "ltp.htf(sys, nharmonics)(s), the harmonic transfer function")
 
     # -- block-diagram algebra --
-    # (python-control's convention: ``G2 * G1`` is G1 followed by G2)
+    # (python-control's convention: ``G2 * G1`` is G1 followed by G2; the connections
+    # are those that ltpcontrol.series and parallel use for systems with delays)
     def __mul__(self, other):
-        from .connect import series
-        return series(other, self)
+        return overridden('series', self)(other, self)
 
     def __rmul__(self, other):
-        from .connect import series
-        return series(self, other)
+        return overridden('series', self)(self, other)
 
     def __add__(self, other):
-        from .connect import parallel
-        return parallel(self, other)
+        return overridden('parallel', self)(self, other)
 
     __radd__ = __add__
 
@@ -225,12 +222,10 @@ class LTPDelayStateSpace(ct.InputOutputSystem):
         return self._negated()
 
     def __sub__(self, other):
-        from .connect import parallel
-        return parallel(self, -other)
+        return overridden('parallel', self)(self, -other)
 
     def __rsub__(self, other):
-        from .connect import parallel
-        return parallel(other, self._negated())
+        return overridden('parallel', self)(other, self._negated())
 
     def _negated(self):
         t = self.terms
@@ -240,7 +235,7 @@ class LTPDelayStateSpace(ct.InputOutputSystem):
                                   outputs=self.output_labels, states=self.state_labels)
 
 
-def ltpdss(*args, period=None, delays=(), **kwargs):
+def ltpdss(*args, period=None, delays=(), name=None, inputs=None, outputs=None, states=None):
     """ltpdss(A, B, C, D, *, period, delays=[(tau_1, A_1), ...])
 
     Create a linear time-periodic system with state delays.
@@ -291,6 +286,7 @@ def ltpdss(*args, period=None, delays=(), **kwargs):
     >>> bool(ltp.is_stable(sys))
     True
     """
+    kwargs = dict(name=name, inputs=inputs, outputs=outputs, states=states)
     if len(args) == 1 and isinstance(args[0], (LTPStateSpace, ct.StateSpace,
                                                    ct.TransferFunction)):
         sys = args[0]
@@ -309,8 +305,10 @@ def ltpdss(*args, period=None, delays=(), **kwargs):
             if sys.isdtime(strict=True):
                 raise ValueError("ltpdss: sys must be a continuous-time system")
         for key in ('inputs', 'outputs', 'states'):
-            kwargs.setdefault(key, getattr(sys, key[:-1] + '_labels'))
-        kwargs.setdefault('name', sys.name)
+            if kwargs[key] is None:
+                kwargs[key] = getattr(sys, key[:-1] + '_labels')
+        if kwargs['name'] is None:
+            kwargs['name'] = sys.name
         args = (sys.A, sys.B, sys.C, sys.D)
     if len(args) != 4:
         raise ControlArgument("ltpdss expects (A, B, C, D) and period=, or (sys); got "
