@@ -71,7 +71,7 @@ def test_delayed_mathieu_boundary_converges_and_equals_method_of_steps():
 def test_milling_critical_depth_equals_method_of_steps():
     # Insperger-Stépán's 1-DOF benchmark: up-milling, 2 teeth, 5 % radial immersion
     rpms = np.array([6000.0, 7500.0, 10000.0, 15500.0, 19000.0])
-    chart = ltp.stability_chart(milling, rpms, np.linspace(1e-5, 4e-3, 17), n_jobs=1,
+    chart = ltp.stability_chart(milling, rpms, np.linspace(1e-5, 4e-3, 13), n_jobs=1,
                                 tol=1e-9)
     crit = chart.critical()
     assert np.all(np.isfinite(crit)) and not chart.failures
@@ -116,10 +116,10 @@ def test_htf_of_periodic_state_delay_system_solves_the_harmonic_balance():
     a = ltp.PeriodicMatrix.from_function(lambda t: np.array([[-2.0 + 0.5 * np.cos(2 * np.pi * t)]]), T)
     sys = ltp.ltpdss(a, [[1.0]], [[1.0]], 0, period=T, delays=[(tau, [[0.7]])])
     H = ltp.htf(sys, 2, internal_harmonics=14)
-    t = np.arange(0, 30.0 + 1e-9, 0.01)
+    t = np.arange(0, 16.0 + 1e-9, 0.01)
     r = ltp.forced_response(sys, t, np.cos(w * t))
     Hs = H(1j * w)
-    tail = t > 25
+    tail = t > 12
     # steady state: y = Re Σ_k H_{k,0}(jw) e^{j(w + k ω_p) t}
     pred = sum((Hs[k + 2, 2] * np.exp(1j * (w + k * 2 * np.pi / T) * t[tail])).real
                for k in range(-2, 3))

@@ -352,7 +352,21 @@ class _Radius:
 
 
 def _column(factory, x, ys, opts):
-    """Radius on one column, refined boundary points, failures (never raises)."""
+    """Radius on one column, refined boundary points, failures (never raises).
+
+    The matrices are small: a multi-threaded BLAS only adds overhead (10x
+    measured on a loaded machine), so it is held to one thread when
+    threadpoolctl is installed.
+    """
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:                     # optional
+        return _column_body(factory, x, ys, opts)
+    with threadpool_limits(1):
+        return _column_body(factory, x, ys, opts)
+
+
+def _column_body(factory, x, ys, opts):
     rad = _Radius(factory, x)
     order, tol = opts['order'], opts['tol']
     r = np.full(len(ys), np.nan)
