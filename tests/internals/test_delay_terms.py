@@ -20,7 +20,7 @@ def _pm(seed, shape):
 delays = st.floats(0.01, 3.0)
 
 
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=8, deadline=None)
 @given(a=delays, b=delays, seed=st.integers(0, 10_000), t=st.floats(0.0, 5.0))
 def test_product_shifts_the_right_factor(a, b, seed, t):
     M, N = _pm(seed, (2, 3)), _pm(seed + 1, (3, 2))
@@ -30,7 +30,7 @@ def test_product_shifts_the_right_factor(a, b, seed, t):
     np.testing.assert_allclose(P(t), M(t) @ N(t - a), atol=1e-12)
 
 
-@settings(max_examples=10, deadline=None)
+@settings(max_examples=5, deadline=None)
 @given(a=delays, b=delays, c=delays, seed=st.integers(0, 10_000), t=st.floats(0.0, 5.0))
 def test_product_is_associative_and_distributes(a, b, c, seed, t):
     X = {0.0: _pm(seed, (2, 2)), a: _pm(seed + 1, (2, 2))}
