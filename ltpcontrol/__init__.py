@@ -70,6 +70,7 @@ from ._delays.monodromy import delay_monodromy, DelayMonodromy
 from ._delays import analysis as _delay_analysis  # noqa: F401  (registers the overrides)
 from ._delays.htf import DelayHTF
 from ._delays.connect import Delay, delay
+from ._delays.margins import delay_margin
 from ._delays import timeresp as _delay_timeresp  # noqa: F401  (registers the overrides)
 from ._delays.chart import stability_chart, StabilityChart, StabilityChartError
 
@@ -127,7 +128,7 @@ __all__ = [
     'save', 'load',
     # periodic systems with delays
     'LTPDelayStateSpace', 'ltpdss', 'delay_monodromy', 'DelayMonodromy', 'DelayHTF',
-    'Delay', 'delay',
+    'Delay', 'delay', 'delay_margin',
     'stability_chart', 'StabilityChart', 'StabilityChartError',
 ]
 
