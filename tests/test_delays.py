@@ -260,6 +260,16 @@ def test_chart_parallel_equals_serial():
     assert cplt.axes.shape == (1, 1)
 
 
+def test_chart_runs_on_a_dask_client():
+    distributed = pytest.importorskip('dask.distributed')
+    fam = lambda a, b: ltp.ltpdss([[-a]], [[1.0]], [[1.0]], 0, period=1.0,
+                                  delays=[(1.0, [[b]])])
+    with distributed.Client(processes=False, n_workers=1, threads_per_worker=2,
+                            dashboard_address=None):
+        chart = ltp.stability_chart(fam, [0.5, 1.5], [0.0, 2.0], backend='dask', n_jobs=2)
+    np.testing.assert_allclose(chart.critical(), [0.5, 1.5], rtol=1e-8)
+
+
 #
 # Bad input
 #
