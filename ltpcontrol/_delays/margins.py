@@ -51,7 +51,7 @@ def delay_margin(L, *, sign=-1, max_delay=None, num=40, tol=1e-6):
     margin ``π - atan(√3)``, so the delay margin is ``(2π/3)/√3``:
 
     >>> L = ltp.ltpss(ct.tf([2.0], [1.0, 1.0]), 1.0)
-    >>> dm = ltp.delay_margin(L, max_delay=3.0)
+    >>> dm = ltp.delay_margin(L, max_delay=3.0, num=6)
     >>> bool(abs(dm - 2 * np.pi / 3 / np.sqrt(3)) < 1e-5)
     True
     """
