@@ -78,6 +78,9 @@ def floquet_multipliers(sys, nsteps=None):
         np.abs(fine)
     bad = np.flatnonzero(gap > 1e-8 * max(1.0, abs(fine[0])))
     keep = max(1, int(bad[0]) if bad.size else fine.size)
+    if keep < fine.size and fine[keep - 1].imag != 0 and \
+            abs(fine[keep] - np.conj(fine[keep - 1])) <= 1e-10 * max(1.0, abs(fine[0])):
+        keep += 1                                   # keep conjugate pairs together
     return fine[:keep]
 
 
