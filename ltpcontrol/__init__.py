@@ -62,6 +62,8 @@ from ._identification.refine import refine_ltp, RefineInfo
 from ._identification.montecarlo import monte_carlo, MonteCarloResult
 from ._identification.scenarios import sample_models
 from .storage import save, load
+from ._core.tvsystem import DiscreteLTPSystem, dltpss
+from ._core.lifting_forms import unlift
 
 __version__ = "0.1.0"
 
@@ -117,6 +119,8 @@ __all__ = [
     'campbell', 'CampbellDiagram',
     # files
     'save', 'load',
+    # discrete periodic systems with time-varying dimensions, lifted forms
+    'DiscreteLTPSystem', 'dltpss', 'unlift',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

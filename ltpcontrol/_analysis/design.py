@@ -25,6 +25,10 @@ from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .riccati import _GainTable, _check_weights, care, dare
 from .._core.coerce import as_ltp
 from .._core.validation import check_method, real_array
+from .._core.subperiods import align_weights
+from .._core.tvsystem import DiscreteLTPSystem
+from .tvlyap import is_varying
+from .tvdesign import tv_dlqe, tv_dlqr
 
 __all__ = ['lqr', 'dlqr', 'lqe', 'dlqe', 'lqg']
 
@@ -129,9 +133,12 @@ def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None):
     ((1, 2), (1, 2), True)
     """
     check_method(method)
+    if isinstance(sys, DiscreteLTPSystem) or any(is_varying(W) for W in (Q, R, N)):
+        return tv_dlqr(sys, Q, R, N, integral_action=integral_action)
     sys = as_ltp(sys)
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqr: sys must be a discrete-time system (use lqr)")
+    sys, (Q, R, N) = align_weights(sys, {'Q': Q, 'R': R, 'N': N})   # sub-periods
     steps = sys.nsteps
     A, B = _with_integrators(sys, integral_action, 'dlqr')
     A, B = A.sample(steps), B.sample(steps)
@@ -237,9 +244,12 @@ def dlqe(sys, QN, RN, NN=None, *, method=None):
     ((2, 1), True)
     """
     check_method(method)
+    if isinstance(sys, DiscreteLTPSystem) or any(is_varying(W) for W in (QN, RN, NN)):
+        return tv_dlqe(sys, QN, RN, NN)
     sys = as_ltp(sys)
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqe: sys must be a discrete-time system (use lqe)")
+    sys, (QN, RN, NN) = align_weights(sys, {'QN': QN, 'RN': RN, 'NN': NN})   # sub-periods
     steps = sys.nsteps
     A, G, C = (M.sample(steps) for M in (sys.A, sys.B, sys.C))
     QN, RN = _steps(QN, sys, 'QN'), _steps(RN, sys, 'RN')

@@ -59,6 +59,9 @@ from .._core.pm_ops import register_op, register_func
 from .._core.steps import step_grid
 from .._core.transition import step_transitions
 from .._core.validation import check_period, real_array
+from .._core.subperiods import tile_steps
+from .tvlyap import is_varying
+from .tvdesign import tv_dare
 
 __all__ = ['care', 'dare']
 
@@ -396,6 +399,9 @@ def dare(A, B, Q, R, S=None):
     >>> X.shape, G.shape, bool(np.all(np.abs(L) < 1))
     ((2, 2, 2), (2, 1, 2), True)
     """
+    if any(is_varying(M) for M in (A, B, Q, R, S)):     # time-varying dimensions
+        return tv_dare(A, B, Q, R, S)
+    A, B, Q, R, S = tile_steps([A, B, Q, R, S], ['A', 'B', 'Q', 'R', 'S'])   # sub-periods
     A, B, Q, R, S = _step_arrays(A, B, Q, R, S)
     N, n, m = B.shape
     _check_weights(Q, R, 'Q', 'R')

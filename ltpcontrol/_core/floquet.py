@@ -36,6 +36,7 @@ from .transition import expm_batch, step_transitions
 from .coerce import as_ltp
 from .validation import check_positive_int, steps_per_period
 from .registry import method_alias
+from .tvsystem import DiscreteLTPSystem
 
 __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
            'is_stable', 'floquet_transform']
@@ -117,6 +118,8 @@ def floquet_multipliers(sys, nsteps=None):
     >>> np.allclose(ltp.floquet_multipliers(sys), np.exp([-1.0, -3.0]))
     True
     """
+    if isinstance(sys, DiscreteLTPSystem):          # time-varying dimensions
+        return sys.floquet_multipliers()
     logmod, arg = _log_multipliers(sys, nsteps)
     with np.errstate(under='ignore', over='ignore', invalid='ignore'):
         mu = np.exp(logmod) * np.exp(1j * arg)
