@@ -64,6 +64,8 @@ from ._identification.scenarios import sample_models
 from .storage import save, load
 from ._core.tvsystem import DiscreteLTPSystem, dltpss
 from ._core.lifting_forms import unlift
+from ._core.multirate import sample_multirate
+from ._analysis.multirate_loop import lifted_margins
 
 __version__ = "0.1.0"
 
@@ -120,7 +122,7 @@ __all__ = [
     # files
     'save', 'load',
     # discrete periodic systems with time-varying dimensions, lifted forms
-    'DiscreteLTPSystem', 'dltpss', 'unlift',
+    'DiscreteLTPSystem', 'dltpss', 'unlift', 'sample_multirate', 'lifted_margins',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise
