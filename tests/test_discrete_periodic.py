@@ -386,3 +386,20 @@ def test_unlift_cyclic_round_trip_property(dims, seed):
     back = ltp.unlift(ltp.lift(sys, method='cyclic'), N, method='cyclic', nstates=dims)
     assert back.nstates == sys.nstates
     assert all(np.array_equal(a, b) for a, b in zip(back.A, sys.A))
+
+
+def test_ltpss_components_of_sub_periods():
+    rng = np.random.default_rng(13)
+    A3 = 0.5 * rng.standard_normal((3, 2, 2))
+    B2 = rng.standard_normal((2, 2, 1))
+    sys = ltp.ltpss(A3, B2, np.ones((1, 2)), 0, period=6.0, dt=1.0)
+    assert sys.nsteps == 6
+    np.testing.assert_array_equal(sys.B.sample(6), np.tile(B2, (3, 1, 1)))
+    np.testing.assert_array_equal(sys.A.sample(6), np.tile(A3, (2, 1, 1)))
+    with pytest.raises(ControlDimension, match="B has 4 matrices but the period has 6"):
+        ltp.ltpss(A3, np.ones((4, 2, 1)), np.ones((1, 2)), 0, period=6.0, dt=1.0)
+    # the same system built with dltpss from the two sub-periods
+    tv = ltp.dltpss(A3, B2, np.ones((1, 2)), 0)
+    assert tv.nsteps == 6
+    np.testing.assert_allclose(tv.floquet_multipliers(), ltp.floquet_multipliers(sys),
+                               atol=1e-14)
