@@ -5,9 +5,10 @@ observable subspaces (a periodic staircase in the sense of Varga's
 ``psminreal``; the order may change with k):
 
 * reachable subspaces: the smallest family ``R_k`` with ``range B_k ⊂
-  R_{k+1}`` and ``A_k R_k ⊂ R_{k+1}``, found by sweeping ``R_{k+1} <-
-  orth([A_k R_k, B_k])`` around the period until no dimension grows (at
-  most ``Σ n_k`` sweeps).  With orthonormal bases ``T_k`` the restriction
+  R_{k+1}`` and ``A_k R_k ⊂ R_{k+1}``, found by sweeping around the period
+  and appending to the orthonormal basis of ``R_{k+1}`` the directions of
+  ``[A_k R_k, B_k]`` outside it (a staircase step) until no dimension grows
+  (at most ``Σ n_k`` sweeps).  With orthonormal bases ``T_k`` the restriction
   ``(T_{k+1}ᵀA_kT_k, T_{k+1}ᵀB_k, C_kT_k, D_k)`` has the same input-output
   map and is reachable;
 * observable subspaces: the smallest family ``O_k`` with ``range C_kᵀ ⊂
@@ -46,17 +47,9 @@ def periodic_minreal(sys, tol):
     >>> periodic_minreal(sys, 1e-10).nstates
     (1, 1)
     """
-    red = _reachable_part(sys, tol)
-    return _observable_part(red, tol)
-
-
-def _orth(M, tol, scale):
-    """Orthonormal basis of the range of M (singular values > tol * scale)."""
-    if M.shape[1] == 0 or M.shape[0] == 0:
-        return np.zeros((M.shape[0], 0))
-    U, s, _ = np.linalg.svd(M, full_matrices=False)
-    r = int(np.count_nonzero(s > tol * max(scale, 1e-300)))
-    return U[:, :r]
+    red = _observable_part(_reachable_part(sys, tol), tol)
+    red.name = sys.name + '$minreal'
+    return red
 
 
 def _reachable_part(sys, tol):
@@ -69,11 +62,9 @@ def _reachable_part(sys, tol):
         grown = False
         for k in range(N):
             k1 = (k + 1) % N
-            new = _orth(np.hstack([sys.A[k] @ T[k], sys.B[k]]), tol, scale[k])
-            if new.shape[1] > T[k1].shape[1]:
-                grown = True
-            if new.shape[1] >= T[k1].shape[1]:
-                T[k1] = new
+            T[k1], added = _extend(T[k1], np.hstack([sys.A[k] @ T[k], sys.B[k]]),
+                                   tol * scale[k])
+            grown = grown or added
         if not grown:
             break
     return _project(sys, T, T)
@@ -89,14 +80,34 @@ def _observable_part(sys, tol):
         grown = False
         for k in range(N - 1, -1, -1):
             k1 = (k + 1) % N
-            new = _orth(np.hstack([sys.C[k].T, sys.A[k].T @ Z[k1]]), tol, scale[k])
-            if new.shape[1] > Z[k].shape[1]:
-                grown = True
-            if new.shape[1] >= Z[k].shape[1]:
-                Z[k] = new
+            Z[k], added = _extend(Z[k], np.hstack([sys.C[k].T, sys.A[k].T @ Z[k1]]),
+                                  tol * scale[k])
+            grown = grown or added
         if not grown:
             break
     return _project(sys, Z, Z)
+
+
+def _extend(T, M, threshold):
+    """Append to the orthonormal basis T the directions of M outside its span.
+
+    Only the part of M orthogonal to T is examined (a staircase step), so
+    the directions already found are never recomputed: rounding errors
+    along unreachable (unobservable) unstable modes are not amplified from
+    one sweep to the next.
+    """
+    if M.shape[1] == 0 or T.shape[0] == T.shape[1]:
+        return T, False
+    R = M - T @ (T.T @ M)
+    R = R - T @ (T.T @ R)
+    U, sv, _ = np.linalg.svd(R, full_matrices=False)
+    r = int(np.count_nonzero(sv > threshold))
+    if r == 0:
+        return T, False
+    new = U[:, :r]
+    new = new - T @ (T.T @ new)
+    new, _ = np.linalg.qr(new)
+    return np.hstack([T, new]), True
 
 
 def _project(sys, W, V):
