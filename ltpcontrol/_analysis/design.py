@@ -101,8 +101,10 @@ def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None):
 
     Parameters
     ----------
-    sys : LTPStateSpace
-        Discrete-time plant with N = period/dt steps per period.
+    sys : LTPStateSpace or DiscreteLTPSystem
+        Discrete-time plant with N = period/dt steps per period (weights of
+        a sub-period repeat; a `DiscreteLTPSystem` with time-varying
+        dimensions takes lists of weights and returns lists).
     Q, R, N : array_like, PeriodicMatrix or callable
         Weights: a 2D array (the same at every step), an array of shape
         (N, rows, cols) (one matrix per step), or a periodic matrix sampled
@@ -217,8 +219,8 @@ def dlqe(sys, QN, RN, NN=None, *, method=None):
 
     Parameters
     ----------
-    sys : LTPStateSpace
-        Discrete-time plant.
+    sys : LTPStateSpace or DiscreteLTPSystem
+        Discrete-time plant (a `DiscreteLTPSystem` returns lists).
     QN, RN, NN : array_like, PeriodicMatrix or callable
         Noise covariances per step (2D: the same at every step; (N, ., .):
         one per step); NN (cross covariance) is zero by default.

@@ -207,7 +207,7 @@ def minreal(sys, tol=None, *, verbose=False, nsteps=None):
     """Remove the uncontrollable and unobservable periodic modes, as `control.minreal`.
 
     Discrete time: orthogonal projection on the periodic reachable, then
-    observable, subspaces (`ltpcontrol._analysis.minimal`), which removes
+    observable, subspaces (a periodic staircase), which removes
     every unreachable and every unobservable part, stable or not, and keeps
     the input-output map exactly; the minimal order may vary with the step,
     and the result is then a `DiscreteLTPSystem`.  Continuous time with

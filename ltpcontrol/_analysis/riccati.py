@@ -371,7 +371,9 @@ def dare(A, B, Q, R, S=None):
         The N matrices of one period, shapes (N, n, n), (N, n, m), (N, n, n),
         (N, m, m) and (N, n, m); a 2D array is the same matrix at every step.
         S is zero by default.  R_k + B_kᵀX_{k+1}B_k must be positive
-        definite; R_k is required to be.
+        definite; R_k is required to be.  Stacks of different lengths are
+        combined on their least common multiple; lists of matrices whose
+        shapes vary with k (time-varying dimensions) give lists.
 
     Returns
     -------

@@ -98,8 +98,10 @@ def floquet_multipliers(sys, nsteps=None):
 
     Parameters
     ----------
-    sys : LTPStateSpace
-        Continuous- or discrete-time LTP system.
+    sys : LTPStateSpace or DiscreteLTPSystem
+        Continuous- or discrete-time LTP system.  With time-varying
+        dimensions: the ``min n_k`` core multipliers of the cyclic product,
+        padded with zeros to ``n_0`` (see `DiscreteLTPSystem`).
     nsteps : int, optional
         Continuous time only; see `monodromy`.
 

@@ -52,8 +52,11 @@ def lift(sysd, *, method='frequency', real=True, nharmonics=None, name=None, sta
         those of the output (module notes).  'time': Meyer-Burrus (standard)
         lifting; the result runs once per period (``dt = period``) and maps
         the N stacked input samples of a period to the N stacked output
-        samples.  'stacked' and 'cyclic': the Grasselli-Longhi descriptor
-        and Flamm cyclic forms (`ltpcontrol._core.lifting_forms`).  A
+        samples.  'stacked': the Grasselli-Longhi descriptor form, the
+        tuple ``(A, E, B, C, D)`` of ``E z[p+1] = A z[p] + B U[p]`` with the
+        states of a period stacked; 'cyclic': Flamm's cyclic form, an LTI
+        system at the base rate whose state holds ``x[k]`` in block
+        ``k mod N`` (see `unlift` for both).  A
         `DiscreteLTPSystem` (dimensions varying with k) takes the three
         time-domain forms.
     real : bool

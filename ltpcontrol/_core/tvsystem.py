@@ -157,7 +157,7 @@ class DiscreteLTPSystem:
         """
         if not self.has_constant_dimensions:
             raise ControlDimension("the dimensions vary over the period: the system has no "
-                                   "LTPStateSpace form (pad it with `padded`)")
+                                   "LTPStateSpace form")
         from .ltpsys import LTPStateSpace
         return LTPStateSpace(np.array(self.A), np.array(self.B), np.array(self.C),
                              np.array(self.D), self.period, dt=self.dt, name=self.name)
