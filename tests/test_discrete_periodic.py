@@ -408,3 +408,45 @@ def test_ltpss_components_of_sub_periods():
     assert tv.nsteps == 6
     np.testing.assert_allclose(tv.floquet_multipliers(), ltp.floquet_multipliers(sys),
                                atol=1e-14)
+
+
+def test_tv_simulation_equals_zero_padded_system():
+    # the reference toolbox's time-response case: dims 10, 8, 6, 4, 2
+    rng = np.random.default_rng(14)
+    na = [10, 8, 6, 4, 2]
+    ma = na[1:] + na[:1]
+    A = [0.3 * rng.standard_normal((m, n)) for n, m in zip(na, ma)]
+    B = [rng.standard_normal((m, 2)) for m in ma]
+    C = [rng.standard_normal((3, n)) for n in na]
+    D = rng.standard_normal((3, 2))
+    sys = ltp.dltpss(A, B, C, D)
+    U = rng.standard_normal((11, 2))
+    x0 = rng.standard_normal(10)
+    y, x = sys.forced_response(U, x0)
+    Bp = np.zeros((5, 10, 2))
+    Cp = np.zeros((5, 3, 10))
+    for k in range(5):
+        Bp[k, :ma[k]] = B[k]
+        Cp[k, :, :na[k]] = C[k]
+    padded = ltp.ltpss(_pad(A, 10), Bp, Cp, D, period=5.0, dt=1.0)
+    res = ltp.forced_response(padded, np.arange(11.0), U.T, X0=x0)
+    assert np.abs(np.asarray(res.outputs).T - y).max() < 1e-12 * np.abs(y).max()
+
+
+def test_tv_feedback_equals_lifted_feedback_and_gram_is_stable():
+    rng = np.random.default_rng(15)
+    P = ltp.dltpss(_tv_random(15, [3, 2, 4], [2, 4, 3], 0.5),
+                   [rng.standard_normal((m, 1)) for m in [2, 4, 3]],
+                   [rng.standard_normal((1, n)) for n in [3, 2, 4]], 0)
+    Kc = ltp.dltpss([np.array([[0.3]])], [np.array([[1.0]])], [np.array([[0.5]])],
+                    [np.array([[0.2]])])
+    closed = P.feedback(Kc)
+    Kc3 = ltp.dltpss(*(list(M) * 3 for M in (Kc.A, Kc.B, Kc.C, Kc.D)))   # on P's period
+    lifted = ct.feedback(ltp.lift(P, method='time'), ltp.lift(Kc3, method='time'))
+    Lc = ltp.lift(closed, method='time')
+    for z in (0.4j, 1.5):
+        assert np.abs(Lc(z) - lifted(z)).max() < 1e-10 * max(1, np.abs(lifted(z)).max())
+    assert ltp.is_stable(closed) == bool(np.abs(np.linalg.eigvals(lifted.A)).max() < 1)
+    if ltp.is_stable(P):
+        Pc = ltp.gram(P, 'c')
+        assert [p.shape[0] for p in Pc] == [3, 2, 4]

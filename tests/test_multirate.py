@@ -154,3 +154,22 @@ def test_multirate_lq_controller_verified_on_the_continuous_plant():
     # the Kalman predictor of the same model is stable
     L, P, Ee = ltp.dlqe(M, np.eye(2), [[0.01]])
     assert np.all(np.abs(Ee) < 1)
+
+
+def test_multirate_periodic_plant_against_solve_ivp():
+    from scipy.integrate import solve_ivp
+    Ts = 0.05
+    T = 4 * Ts
+    b = lambda t: np.array([[0.0], [1.0 + 0.5 * np.cos(2 * np.pi * t / T)]])
+    plant = ltp.ltpss([[0.0, 1.0], [-2.0, -0.3]], b, [[1.0, 0.0]], 0, period=T)
+    M = ltp.sample_multirate(plant, Ts, [3], [2])
+    assert M.nsteps == 12
+    rng = np.random.default_rng(4)
+    K = 36
+    held = rng.standard_normal(K)[(np.arange(K) // 3) * 3]
+    y = np.asarray(ltp.forced_response(M, np.arange(K) * Ts, held[None, :]).outputs)
+    sol = solve_ivp(lambda t, x: plant.A(t) @ x + b(t)[:, 0] * held[min(int(t / Ts + 1e-9), K - 1)],
+                    (0, (K - 1) * Ts), np.zeros(2), t_eval=np.arange(K) * Ts, rtol=1e-11,
+                    atol=1e-13, max_step=Ts / 4)
+    at = np.arange(0, K, 2)
+    assert np.abs(y[at] - sol.y[0, at]).max() < 1e-8

@@ -34,6 +34,8 @@ from .._core.coerce import as_ltp
 from .._core.validation import real_array
 from .._core.subperiods import on_common_period, tile_steps
 from .tvlyap import is_varying, tv_dlyap
+from .._core.tvsystem import DiscreteLTPSystem
+from .tvdesign import tv_gram
 
 __all__ = ['lyap', 'dlyap', 'gram']
 
@@ -197,6 +199,8 @@ def gram(sys, type):
     >>> np.allclose(P(0.7), ct.gram(G, 'c'))
     True
     """
+    if isinstance(sys, DiscreteLTPSystem):          # time-varying dimensions: lists
+        return tv_gram(sys, type)
     sys = as_ltp(sys)
     if type not in ('c', 'o'):
         raise ValueError(f"type must be 'c' or 'o', got {type!r}")

@@ -252,6 +252,8 @@ def is_stable(sys, tol=1e-10, nsteps=None, *, autonomous=False):
     if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, numbers.Real) \
             or not 0 <= tol < 1:
         raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
+    if isinstance(sys, DiscreteLTPSystem):          # time-varying dimensions
+        return sys.is_stable(tol)
     logmod, arg = _log_multipliers(sys, nsteps)
     if autonomous:
         logmod = _without_phase_multiplier(logmod, arg)
