@@ -450,3 +450,26 @@ def test_tv_feedback_equals_lifted_feedback_and_gram_is_stable():
     if ltp.is_stable(P):
         Pc = ltp.gram(P, 'c')
         assert [p.shape[0] for p in Pc] == [3, 2, 4]
+
+
+@settings(max_examples=12, deadline=None)
+@given(st.lists(st.integers(1, 4), min_size=1, max_size=5), st.integers(1, 3),
+       st.integers(0, 10 ** 6), st.booleans())
+def test_tv_dlyap_residual_property(dims, q_steps, seed, adjoint):
+    rng = np.random.default_rng(seed)
+    N = len(dims)
+    A = [0.5 * rng.standard_normal((dims[(k + 1) % N], dims[k])) for k in range(N)]
+    L = int(np.lcm(N, q_steps))
+    size = [dims[k % N] if adjoint else dims[(k + 1) % N] for k in range(L)]
+    # Q of q_steps matrices must fit every step it is repeated at
+    if any(size[k] != size[k % q_steps] for k in range(L)):
+        return
+    Q = [_sym(rng, size[k]) for k in range(q_steps)]
+    X = ltp.dlyap(A, Q, adjoint=adjoint)
+    assert len(X) == L
+    scale = max(1.0, max(np.abs(x).max() for x in X))
+    for k in range(L):
+        a, q = A[k % N], Q[k % q_steps]
+        r = a.T @ X[(k + 1) % L] @ a + q - X[k] if adjoint else \
+            a @ X[k] @ a.T + q - X[(k + 1) % L]
+        assert np.abs(r).max() <= 1e-11 * scale
