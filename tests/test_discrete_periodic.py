@@ -473,3 +473,12 @@ def test_tv_dlyap_residual_property(dims, q_steps, seed, adjoint):
         r = a.T @ X[(k + 1) % L] @ a + q - X[k] if adjoint else \
             a @ X[k] @ a.T + q - X[(k + 1) % L]
         assert np.abs(r).max() <= 1e-11 * scale
+
+
+def test_tv_static_gain_on_either_side():
+    s = ltp.dltpss([[[0.5]]], [[[1.0]]], [[[1.0], [2.0]]], 0)
+    y, _ = s.forced_response(np.ones((3, 1)))
+    y1, _ = (np.array([[1.0, 1.0]]) * s).forced_response(np.ones((3, 1)))
+    np.testing.assert_allclose(y1[:, 0], y.sum(axis=1), atol=1e-15)
+    y2, _ = (s * np.array([[2.0]])).forced_response(np.ones((3, 1)))
+    np.testing.assert_allclose(y2, 2 * y, atol=1e-15)

@@ -71,6 +71,9 @@ class DiscreteLTPSystem:
     <DiscreteLTPSystem sys[0]: states (2, 1), inputs (1, 1), outputs (1, 1), N=2, dt=1>
     """
 
+    # make numpy defer to our reflected operators (ndarray * DiscreteLTPSystem)
+    __array_ufunc__ = None
+
     def __init__(self, A, B, C, D, dt=1.0, *, name=None):
         self.dt = check_positive(dt, 'dt')
         A = _sequence(A, 'A')
@@ -262,6 +265,10 @@ class DiscreteLTPSystem:
     def __mul__(self, other):
         """Series connection ``self * other`` (other's output drives self)."""
         return series_tv(other, self)
+
+    def __rmul__(self, other):
+        """``other * self``: a static gain (matrix) or system after `self`."""
+        return series_tv(self, other)
 
     def __add__(self, other):
         return parallel_tv(self, other)
