@@ -482,3 +482,10 @@ def test_tv_static_gain_on_either_side():
     np.testing.assert_allclose(y1[:, 0], y.sum(axis=1), atol=1e-15)
     y2, _ = (s * np.array([[2.0]])).forced_response(np.ones((3, 1)))
     np.testing.assert_allclose(y2, 2 * y, atol=1e-15)
+
+
+def test_tv_hankel_norm_equals_constant_dimension_norm():
+    rng = np.random.default_rng(16)
+    s3 = ltp.ltpss(0.4 * rng.standard_normal((3, 3, 3)), rng.standard_normal((3, 3, 2)),
+                   rng.standard_normal((3, 1, 3)), 0, period=3.0, dt=1.0)
+    assert np.isclose(ltp.norm(ltp.dltpss(s3), 'hankel'), ltp.norm(s3, 'hankel'), rtol=1e-9)

@@ -54,8 +54,7 @@ def norm(sys, p=2, tol=1e-6, print_warning=True, method=None, *,
     Parameters
     ----------
     sys : LTPStateSpace or DiscreteLTPSystem
-        Continuous- or discrete-time LTP system (a `DiscreteLTPSystem`
-        takes p = 2 or 'inf').
+        Continuous- or discrete-time LTP system (or a `DiscreteLTPSystem`).
     p : {2, 'inf', 'hankel'}
         2: the H2 norm, per-period average (Conventions page); 'inf': the
         L∞ norm (``sup_ω σ_max`` of the HTF; for a stable system the H∞

@@ -236,7 +236,9 @@ def tv_gram(sys, type):
 
 
 def tv_norm(sys, p=2, tol=1e-6):
-    """H2 or ℓ∞ norm of a stable `DiscreteLTPSystem` (module notes).
+    """H2, ℓ∞ or Hankel norm of a stable `DiscreteLTPSystem` (module notes).
+
+    The Hankel norm is ``max_k sqrt(λ_max(P_k Q_k))`` over the steps.
 
     Examples
     --------
@@ -258,4 +260,8 @@ def tv_norm(sys, p=2, tol=1e-6):
             return float(np.linalg.norm(D, 2))
         L = ct.ss(A, B, C, D, sys.period)
         return float(ct.norm(L, 'inf', tol=tol))
-    raise ControlArgument(f"p must be 2 or np.inf, got {p!r}")
+    if p == 'hankel':
+        P, Q = tv_gram(sys, 'c'), tv_gram(sys, 'o')
+        return float(np.sqrt(max(max(np.linalg.eigvals(Pk @ Qk).real.max(initial=0.0), 0.0)
+                                 for Pk, Qk in zip(P, Q))))
+    raise ControlArgument(f"p must be 2, np.inf or 'hankel', got {p!r}")
