@@ -62,6 +62,10 @@ from ._identification.refine import refine_ltp, RefineInfo
 from ._identification.montecarlo import monte_carlo, MonteCarloResult
 from ._identification.scenarios import sample_models
 from .storage import save, load
+from ._core.tvsystem import DiscreteLTPSystem, dltpss
+from ._core.lifting_forms import unlift
+from ._core.multirate import sample_multirate
+from ._analysis.multirate_loop import lifted_margins
 
 __version__ = "0.1.0"
 
@@ -130,6 +134,8 @@ __all__ = [
     'LTPDelayStateSpace', 'ltpdss', 'delay_monodromy', 'DelayMonodromy', 'DelayHTF',
     'Delay', 'delay', 'delay_margin',
     'stability_chart', 'StabilityChart', 'StabilityChartError',
+    # discrete periodic systems with time-varying dimensions, lifted forms
+    'DiscreteLTPSystem', 'dltpss', 'unlift', 'sample_multirate', 'lifted_margins',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

@@ -293,10 +293,10 @@ def test_bad_input_names_the_argument():
     sysd = ltp.ltpss(np.eye(2) * 1.5, [[1.0], [0.0]], np.eye(2), 0, period=2.0, dt=1.0)
     with pytest.raises(ValueError, match="stabilizing"):
         ltp.dlqr(sysd, np.eye(2), [[1.0]])
-    with pytest.raises(ControlDimension, match="Q has 3 matrices"):
-        ltp.dlqr(sysd, np.ones((3, 2, 2)), [[1.0]])
-    with pytest.raises(ControlDimension, match="same number of steps"):
-        ltp.dare(np.ones((3, 2, 2)), np.ones((2, 2, 1)), np.eye(2), [[1.0]])
+    with pytest.raises(ValueError, match=r"Q \(101 steps\), R \(103 steps\) have"):
+        ltp.dlqr(sysd, np.ones((101, 2, 2)), np.ones((103, 1, 1)))
+    with pytest.raises(ValueError, match=r"A \(101 steps\), B \(103 steps\)"):
+        ltp.dare(np.ones((101, 2, 2)), np.ones((103, 2, 1)), np.eye(2), [[1.0]])
     with pytest.raises(ControlArgument, match="period must be given"):
         ltp.care(np.eye(2), np.ones((2, 1)), np.eye(2), [[1.0]])
     with pytest.raises(ControlArgument, match="dlqr"):

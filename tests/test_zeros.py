@@ -78,8 +78,8 @@ def test_zeros_zhou_tac2009():
 
 def test_zeros_bad_input():
     sys = ltp.ltpss(-np.eye(2), np.ones((2, 2)), np.ones((1, 2)), 0, period=1.0)
-    with pytest.raises(ControlDimension, match="square"):
-        ltp.zeros(sys)
+    with pytest.raises(ValueError, match="structure"):
+        ltp.zeros(sys, structure='yes')
     square = ltp.ltpss(-np.eye(2), np.ones((2, 1)), np.ones((1, 2)), 0, period=1.0)
     with pytest.raises(ValueError, match="rtol"):
         ltp.zeros(square, rtol=2)

@@ -25,6 +25,10 @@ from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .riccati import _GainTable, _check_weights, care, dare
 from .._core.coerce import as_ltp
 from .._core.validation import check_method, real_array
+from .._core.subperiods import align_weights
+from .._core.tvsystem import DiscreteLTPSystem
+from .tvlyap import is_varying
+from .tvdesign import tv_dlqe, tv_dlqr
 
 __all__ = ['lqr', 'dlqr', 'lqe', 'dlqe', 'lqg']
 
@@ -97,8 +101,10 @@ def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None):
 
     Parameters
     ----------
-    sys : LTPStateSpace
-        Discrete-time plant with N = period/dt steps per period.
+    sys : LTPStateSpace or DiscreteLTPSystem
+        Discrete-time plant with N = period/dt steps per period (weights of
+        a sub-period repeat; a `DiscreteLTPSystem` with time-varying
+        dimensions takes lists of weights and returns lists).
     Q, R, N : array_like, PeriodicMatrix or callable
         Weights: a 2D array (the same at every step), an array of shape
         (N, rows, cols) (one matrix per step), or a periodic matrix sampled
@@ -129,9 +135,12 @@ def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None):
     ((1, 2), (1, 2), True)
     """
     check_method(method)
+    if isinstance(sys, DiscreteLTPSystem) or any(is_varying(W) for W in (Q, R, N)):
+        return tv_dlqr(sys, Q, R, N, integral_action=integral_action)
     sys = as_ltp(sys)
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqr: sys must be a discrete-time system (use lqr)")
+    sys, (Q, R, N) = align_weights(sys, {'Q': Q, 'R': R, 'N': N})   # sub-periods
     steps = sys.nsteps
     A, B = _with_integrators(sys, integral_action, 'dlqr')
     A, B = A.sample(steps), B.sample(steps)
@@ -210,8 +219,8 @@ def dlqe(sys, QN, RN, NN=None, *, method=None):
 
     Parameters
     ----------
-    sys : LTPStateSpace
-        Discrete-time plant.
+    sys : LTPStateSpace or DiscreteLTPSystem
+        Discrete-time plant (a `DiscreteLTPSystem` returns lists).
     QN, RN, NN : array_like, PeriodicMatrix or callable
         Noise covariances per step (2D: the same at every step; (N, ., .):
         one per step); NN (cross covariance) is zero by default.
@@ -237,9 +246,12 @@ def dlqe(sys, QN, RN, NN=None, *, method=None):
     ((2, 1), True)
     """
     check_method(method)
+    if isinstance(sys, DiscreteLTPSystem) or any(is_varying(W) for W in (QN, RN, NN)):
+        return tv_dlqe(sys, QN, RN, NN)
     sys = as_ltp(sys)
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqe: sys must be a discrete-time system (use lqe)")
+    sys, (QN, RN, NN) = align_weights(sys, {'QN': QN, 'RN': RN, 'NN': NN})   # sub-periods
     steps = sys.nsteps
     A, G, C = (M.sample(steps) for M in (sys.A, sys.B, sys.C))
     QN, RN = _steps(QN, sys, 'QN'), _steps(RN, sys, 'RN')

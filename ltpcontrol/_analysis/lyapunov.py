@@ -32,6 +32,10 @@ from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .._core.steps import step_grid, step_integrals
 from .._core.coerce import as_ltp
 from .._core.validation import real_array
+from .._core.subperiods import on_common_period, tile_steps
+from .tvlyap import is_varying, tv_dlyap
+from .._core.tvsystem import DiscreteLTPSystem
+from .tvdesign import tv_gram
 
 __all__ = ['lyap', 'dlyap', 'gram']
 
@@ -53,7 +57,9 @@ def lyap(A, Q, *, adjoint=False, period=None, nsteps=None):
     A : PeriodicMatrix, callable or array_like, shape (n, n)
         Periodic state matrix (a callable or constant array needs `period`).
     Q : PeriodicMatrix, callable or array_like, shape (n, n)
-        Symmetric periodic weight; its period must divide that of `A`.
+        Symmetric periodic weight.  A `PeriodicMatrix` A and Q of
+        commensurate periods (3 and 2) are combined on the common period (6);
+        otherwise the period of Q must divide that of `A`.
     adjoint : bool, optional
         Solve the adjoint (backward) equation.
     period : float, optional
@@ -85,6 +91,8 @@ def lyap(A, Q, *, adjoint=False, period=None, nsteps=None):
     >>> np.allclose(X(0.3), ct.lyap(A, Q))
     True
     """
+    if period is None:                  # sub-periods: A and Q on their common period
+        A, Q = on_common_period({'A': A, 'Q': Q}).values()
     A, Q = _pair(A, Q, period, 'lyap')
     _check_bool(adjoint, 'adjoint')
     grid = step_grid(A, [Q], nsteps)
@@ -106,14 +114,18 @@ def dlyap(A, Q, *, adjoint=False):
     A : array_like, shape (N, n, n) or (n, n)
         The N matrices of one period (a 2D array: N = 1, or N from `Q`).
     Q : array_like, shape (N, n, n) or (n, n)
-        Symmetric weights (a 2D array is the same at every step).
+        Symmetric weights (a 2D array is the same at every step).  `A` and
+        `Q` may repeat with different numbers of steps: the equation is then
+        solved on the least common multiple (A of 3 steps, Q of 2: N = 6).
+        Lists of matrices whose dimensions vary with k (``A[k]`` of shape
+        ``n_{k+1} x n_k``) are accepted (time-varying dimensions).
     adjoint : bool, optional
         Solve the adjoint (backward) equation.
 
     Returns
     -------
     X : ndarray, shape (N, n, n)
-        ``X[k]`` for k = 0..N−1.
+        ``X[k]`` for k = 0..N−1 (a list for time-varying dimensions).
 
     Raises
     ------
@@ -131,8 +143,12 @@ def dlyap(A, Q, *, adjoint=False):
     True
     """
     _check_bool(adjoint, 'adjoint')
+    # time-varying dimensions and sub-periods (ltpcontrol._analysis.tvlyap)
+    if is_varying(A) or is_varying(Q):
+        return tv_dlyap(A, Q, adjoint=adjoint)
     A = real_array(A, 'A', ndim=(2, 3))
     Q = real_array(Q, 'Q', ndim=(2, 3))
+    A, Q = tile_steps([A, Q], ['A', 'Q'])
     if A.shape[-1] != A.shape[-2]:
         raise ControlDimension(f"A must hold square matrices, got shape {A.shape}")
     n = A.shape[-1]
@@ -183,6 +199,8 @@ def gram(sys, type):
     >>> np.allclose(P(0.7), ct.gram(G, 'c'))
     True
     """
+    if isinstance(sys, DiscreteLTPSystem):          # time-varying dimensions: lists
+        return tv_gram(sys, type)
     sys = as_ltp(sys)
     if type not in ('c', 'o'):
         raise ValueError(f"type must be 'c' or 'o', got {type!r}")

@@ -38,6 +38,8 @@ from .._core.steps import gram_weight, step_grid, step_integrals
 from .._core.transition import step_transitions
 from .._core.coerce import as_ltp
 from .._core.validation import check_method
+from .._core.tvsystem import DiscreteLTPSystem
+from .tvdesign import tv_norm
 
 __all__ = ['norm']
 
@@ -51,8 +53,8 @@ def norm(sys, p=2, tol=1e-6, print_warning=True, method=None, *,
 
     Parameters
     ----------
-    sys : LTPStateSpace
-        Continuous- or discrete-time LTP system.
+    sys : LTPStateSpace or DiscreteLTPSystem
+        Continuous- or discrete-time LTP system (or a `DiscreteLTPSystem`).
     p : {2, 'inf', 'hankel'}
         2: the H2 norm, per-period average (Conventions page); 'inf': the
         L∞ norm (``sup_ω σ_max`` of the HTF; for a stable system the H∞
@@ -105,6 +107,8 @@ def norm(sys, p=2, tol=1e-6, print_warning=True, method=None, *,
     >>> bool(np.isclose(ltp.norm(sys, 'inf', tol=1e-9), ct.norm(G, 'inf', tol=1e-9)))
     True
     """
+    if isinstance(sys, DiscreteLTPSystem):          # time-varying dimensions
+        return tv_norm(sys, np.inf if p == 'inf' else p, tol)
     sys = as_ltp(sys)
     check_method(method)
     if isinstance(p, str) and p in ('inf', 'hankel'):

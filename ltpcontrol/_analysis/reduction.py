@@ -31,6 +31,8 @@ import control as ct
 from control.exception import ControlArgument
 
 from .._core.ltpsys import LTPStateSpace
+from .._core.tvsystem import DiscreteLTPSystem, dltpss
+from .minimal import periodic_minreal, tv_balred, tv_hsvd
 from .lyapunov import dlyap
 from .periodic_balancing import gramians, hankel_svd, truncate
 from .._core.coerce import as_ltp
@@ -78,6 +80,8 @@ def hsvd(sys, t=None, *, nsteps=None):
     >>> hsv.shape, bool(hsv[0, 0] > hsv[1, 0])
     ((2, 2), True)
     """
+    if isinstance(sys, DiscreteLTPSystem):          # time-varying dimensions
+        return tv_hsvd(sys)
     _check(sys)
     if sys.isdtime(strict=True) or (sys.is_lti and t is None):
         if t is not None:
@@ -167,6 +171,16 @@ def balred(sys, orders, method='truncate', *, return_bound=False, nsteps=None):
         raise ValueError(f"method must be 'truncate', got {method!r}")
     if not isinstance(return_bound, (bool, np.bool_)):
         raise ControlArgument(f"return_bound must be True or False, got {return_bound!r}")
+    if isinstance(sys, DiscreteLTPSystem):          # time-varying dimensions
+        r = check_positive_int(orders, 'orders')
+        if r > min(sys.nstates):
+            raise ValueError(f"orders must be at most the smallest number of states "
+                             f"{min(sys.nstates)}, got {r}")
+        if not sys.is_stable():
+            raise ValueError("sys must be stable: the gramians of an unstable system do "
+                             "not exist")
+        rsys, bound = tv_balred(sys, r)
+        return (rsys, bound) if return_bound else rsys
     _check(sys)
     r = check_positive_int(orders, 'orders')
     n = sys.nstates
@@ -192,24 +206,28 @@ def balred(sys, orders, method='truncate', *, return_bound=False, nsteps=None):
 def minreal(sys, tol=None, *, verbose=False, nsteps=None):
     """Remove the uncontrollable and unobservable periodic modes, as `control.minreal`.
 
-    Balanced truncation of the states whose Hankel singular values stay
-    below ``tol`` (relative to the largest) over the whole period, which
-    removes exactly the modes that are unreachable or unobservable; the
-    input-output map is unchanged to within ``2 Σ`` of the removed values.
-    A continuous-time system with constant matrices is passed to
-    `control.minreal`.
+    Discrete time: orthogonal projection on the periodic reachable, then
+    observable, subspaces (a periodic staircase), which removes
+    every unreachable and every unobservable part, stable or not, and keeps
+    the input-output map exactly; the minimal order may vary with the step,
+    and the result is then a `DiscreteLTPSystem`.  Continuous time with
+    periodic matrices: balanced truncation of the states whose Hankel
+    singular values stay below ``tol`` (relative to the largest) over the
+    whole period.  Constant matrices (continuous, or discrete with the same
+    matrices at every step) are passed to `control.minreal`.
 
     Parameters
     ----------
-    sys : LTPStateSpace
-        Stable system (discrete time, or continuous time with periodic
-        matrices), or a continuous-time system with constant matrices.
+    sys : LTPStateSpace or DiscreteLTPSystem
+        Discrete-time system (any stability), stable continuous-time system
+        with periodic matrices, or continuous-time system with constant
+        matrices.
     tol : float, optional
-        Relative tolerance on the Hankel singular values (default
-        ``sqrt(eps)``, about 1.5e-8, in discrete time; 1e-6 for continuous
-        periodic matrices, whose gramians are integrated to about 1e-12).
-        Constant continuous-time matrices use `control.minreal` with this
-        `tol` (default python-control's).
+        Discrete time: relative rank tolerance of the projections (default
+        ``sqrt(eps)``, about 1.5e-8).  Continuous periodic matrices:
+        relative tolerance on the Hankel singular values (default 1e-6, the
+        gramians are integrated to about 1e-12).  Constant matrices use
+        `control.minreal` with this `tol` (default python-control's).
     verbose : bool, optional
         Print the number of removed states, as `control.minreal` (whose
         default is True; here False).
@@ -218,13 +236,15 @@ def minreal(sys, tol=None, *, verbose=False, nsteps=None):
 
     Returns
     -------
-    LTPStateSpace
+    LTPStateSpace or DiscreteLTPSystem
+        A `DiscreteLTPSystem` when the minimal order varies with the step
+        (or when `sys` is one).
 
     Raises
     ------
     ValueError
-        If a system with periodic matrices is unstable (its gramians do not
-        exist).
+        If a continuous-time system with periodic matrices is unstable (its
+        gramians do not exist).
 
     Examples
     --------
@@ -244,6 +264,9 @@ def minreal(sys, tol=None, *, verbose=False, nsteps=None):
 
 
 def _minreal(sys, tol, nsteps):
+    if isinstance(sys, DiscreteLTPSystem) or (isinstance(sys, LTPStateSpace)
+                                              and sys.isdtime(strict=True)):
+        return _discrete_minreal(sys, tol, nsteps)
     periodic_ct = not sys.isdtime(strict=True) and not sys.is_lti \
         if isinstance(sys, LTPStateSpace) else False
     lti_ct = isinstance(sys, LTPStateSpace) and not sys.isdtime(strict=True) and sys.is_lti
@@ -270,6 +293,44 @@ def _minreal(sys, tol, nsteps):
     if periodic_ct:
         return _truncate_periodic(sys, keep, nsteps, '$minreal')[0]
     return _project(sys, W[:, :keep], V[:, :, :keep])
+
+
+def _discrete_minreal(sys, tol, nsteps):
+    """Discrete time: python-control's minreal for constant matrices, else the
+    periodic reachable/observable projections (`minimal.periodic_minreal`)."""
+    if nsteps is not None:
+        raise ControlArgument("nsteps applies to continuous-time systems only")
+    if tol is not None and (isinstance(tol, (bool, np.bool_))
+                            or not isinstance(tol, (int, float, np.floating))
+                            or not 0 <= tol < 1):
+        raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
+    tv = sys if isinstance(sys, DiscreteLTPSystem) else dltpss(sys)
+    same = all(all(np.array_equal(M[0], Mk) for Mk in M) for M in (tv.A, tv.B, tv.C, tv.D))
+    if same and tv.has_constant_dimensions:
+        # python-control's algorithm and default tolerance for constant matrices
+        red = ct.minreal(ct.ss(tv.A[0], tv.B[0], tv.C[0], tv.D[0], tv.dt), tol=tol,
+                         verbose=False)
+        red = DiscreteLTPSystem([red.A], [red.B], [red.C], [red.D], tv.dt,
+                                name=tv.name + '$minreal')
+        red = DiscreteLTPSystem(*(list(M) * tv.nsteps for M in (red.A, red.B, red.C, red.D)),
+                                dt=tv.dt, name=red.name)
+    else:
+        red = periodic_minreal(tv, np.sqrt(np.finfo(float).eps) if tol is None else tol)
+    return _as_input_kind(sys, red)
+
+
+def _as_input_kind(sys, red):
+    """An LTPStateSpace when `sys` was one and the orders stay constant."""
+    if isinstance(sys, DiscreteLTPSystem) or not red.has_constant_dimensions:
+        return red
+    if red.nstates == tuple(sys.nstates for _ in range(sys.nsteps)) and red.nsteps == sys.nsteps \
+            and all(np.array_equal(a, b) for a, b in zip(red.A, sys.A.sample(sys.nsteps))):
+        return sys
+    return LTPStateSpace(np.array(red.A).reshape(red.nsteps, red.nstates[0], red.nstates[0]),
+                         np.array(red.B).reshape(red.nsteps, red.nstates[0], -1),
+                         np.array(red.C).reshape(red.nsteps, -1, red.nstates[0]),
+                         np.array(red.D), sys.period, dt=sys.dt, inputs=sys.input_labels,
+                         outputs=sys.output_labels, name=sys.name + '$minreal')
 
 
 #

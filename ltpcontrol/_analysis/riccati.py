@@ -59,6 +59,9 @@ from .._core.pm_ops import register_op, register_func
 from .._core.steps import step_grid
 from .._core.transition import step_transitions
 from .._core.validation import check_period, real_array
+from .._core.subperiods import tile_steps
+from .tvlyap import is_varying
+from .tvdesign import tv_dare
 
 __all__ = ['care', 'dare']
 
@@ -368,7 +371,9 @@ def dare(A, B, Q, R, S=None):
         The N matrices of one period, shapes (N, n, n), (N, n, m), (N, n, n),
         (N, m, m) and (N, n, m); a 2D array is the same matrix at every step.
         S is zero by default.  R_k + B_kᵀX_{k+1}B_k must be positive
-        definite; R_k is required to be.
+        definite; R_k is required to be.  Stacks of different lengths are
+        combined on their least common multiple; lists of matrices whose
+        shapes vary with k (time-varying dimensions) give lists.
 
     Returns
     -------
@@ -396,6 +401,9 @@ def dare(A, B, Q, R, S=None):
     >>> X.shape, G.shape, bool(np.all(np.abs(L) < 1))
     ((2, 2, 2), (2, 1, 2), True)
     """
+    if any(is_varying(M) for M in (A, B, Q, R, S)):     # time-varying dimensions
+        return tv_dare(A, B, Q, R, S)
+    A, B, Q, R, S = tile_steps([A, B, Q, R, S], ['A', 'B', 'Q', 'R', 'S'])   # sub-periods
     A, B, Q, R, S = _step_arrays(A, B, Q, R, S)
     N, n, m = B.shape
     _check_weights(Q, R, 'Q', 'R')

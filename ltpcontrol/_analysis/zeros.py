@@ -1,4 +1,4 @@
-"""Transmission zeros of square LTP systems.
+"""Transmission zeros of LTP systems, square or not, and their structure.
 
 Continuous time: the finite generalized eigenvalues s of the harmonic
 (Toeplitz) Rosenbrock pencil truncated at K harmonics (Conventions page),
@@ -14,29 +14,53 @@ Discrete time: the finite generalized eigenvalues μ of the Rosenbrock
 pencil of the time-lifted system (`lift`, method 'time'), reported per
 step as ``ρ = μ^{1/N}`` (principal root) like the poles
 (`floquet_exponents`).
+
+Non-square systems (and ``structure=True``): the zeros are the values
+where the Rosenbrock pencil loses rank below its normal rank; the pencil is
+reduced to a regular one carrying exactly these zeros by the staircase
+algorithm of Emami-Naeini and Van Dooren (SLICOT AB08ND through slycot),
+which also returns the normal rank of the transfer matrix, the orders of
+the infinite zeros (infinite elementary divisors) and the right and left
+Kronecker indices.  Discrete time these are the zeros and structure of the
+lifted system (the convention of Grasselli and Longhi for periodic
+systems); continuous time the finite zeros of the truncated harmonic
+system are kept when two truncations agree, as for square systems, and
+the structure is that of the smaller truncation.
 """
+
+from collections import namedtuple
 
 import numpy as np
 import scipy.linalg as la
-from control.exception import ControlDimension
+import slycot
 
 from .._frequency.harmonic_ss import _toeplitz
 from .._core.lifting import lift
 from .._core.coerce import as_ltp
 from .._core.validation import check_positive_int
 from .._core.registry import method_alias
+from .._core.tvsystem import DiscreteLTPSystem, dltpss
+from .._core.lifting_forms import tv_time_lift
 
 __all__ = ['zeros']
 
+#: Zeros and their structure (``zeros(sys, structure=True)``): finite zeros,
+#: normal rank of the transfer matrix, orders of the infinite zeros (one
+#: entry per infinite elementary divisor, its degree), right and left
+#: Kronecker indices (of the lifted or truncated harmonic system).
+ZeroStructure = namedtuple('ZeroStructure', ['zeros', 'normal_rank', 'infinite_orders',
+                                             'right_kronecker', 'left_kronecker'])
+
 
 @method_alias
-def zeros(sys, nharmonics=None, *, rtol=1e-8):
-    """Transmission zeros of a square LTP system.
+def zeros(sys, nharmonics=None, *, rtol=1e-8, structure=False):
+    """Transmission (invariant) zeros of an LTP system, square or not.
 
     Parameters
     ----------
-    sys : LTPStateSpace
-        Continuous- or discrete-time system with as many inputs as outputs.
+    sys : LTPStateSpace or DiscreteLTPSystem
+        Continuous- or discrete-time system; non-square systems have the
+        zeros of their normal rank (module notes).
     nharmonics : int, optional
         Continuous time: truncation order K of the harmonic pencil (default
         ``min(40, 12 + 4 K_sys)`` with K_sys the number of harmonics above
@@ -45,6 +69,9 @@ def zeros(sys, nharmonics=None, *, rtol=1e-8):
     rtol : float, optional
         Continuous time: relative agreement required between the two
         truncations for a value to be reported.
+    structure : bool, optional
+        Also return the normal rank, the infinite zero structure and the
+        Kronecker indices.
 
     Returns
     -------
@@ -54,11 +81,9 @@ def zeros(sys, nharmonics=None, *, rtol=1e-8):
         values ``μ^{1/N}``.  Sorted by real part.  An LTI system (constant
         matrices, or the same matrices at every step) gives the zeros of
         `control.zeros`, also outside the strip.
-
-    Raises
-    ------
-    ControlDimension
-        If the system is not square.
+    ZeroStructure
+        With ``structure=True`` instead: the named tuple ``(zeros,
+        normal_rank, infinite_orders, right_kronecker, left_kronecker)``.
 
     Examples
     --------
@@ -74,15 +99,34 @@ def zeros(sys, nharmonics=None, *, rtol=1e-8):
     True
     >>> bool(np.allclose(ct.zeros(sys), z))      # python-control dispatches here
     True
+
+    Pitelkau's satellite (a 2x1 system): every zero is infinite, so no
+    finite zero is returned; the lifted system has normal rank 1 per step:
+
+    >>> w = 0.00103448
+    >>> a = np.array([[0, 0, 5.318064566757217e-02, 0], [0, 0, 0, 5.318064566757217e-02],
+    ...               [-1.352134256362805e-03, 0, 0, -7.099273035392090e-02],
+    ...               [0, -7.557182037479544e-04, 3.781555288420663e-02, 0]])
+    >>> b = lambda t: np.array([[0], [0], [0.1389735e-6 * np.sin(w * t)],
+    ...                         [-0.3701336e-7 * np.cos(w * t)]])
+    >>> sys = ltp.ltpss(a, b, [[1, 0, 0, 0], [0, 1, 0, 0]], 0, period=2 * np.pi / w)
+    >>> info = ltp.zeros(sys.sample(sys.period / 24), structure=True)
+    >>> info.zeros.size, info.normal_rank
+    (0, 24)
     """
+    if not isinstance(structure, (bool, np.bool_)):
+        raise ValueError(f"structure must be True or False, got {structure!r}")
+    if isinstance(sys, DiscreteLTPSystem):
+        return _general_discrete(sys, structure)
     sys = as_ltp(sys)
-    if sys.ninputs != sys.noutputs:
-        raise ControlDimension(f"zeros: the system must be square, got {sys.noutputs} "
-                               f"outputs and {sys.ninputs} inputs")
     if not (isinstance(rtol, (int, float, np.floating)) and 0 < rtol < 1):
         raise ValueError(f"rtol must be a number in (0, 1), got {rtol!r}")
     if nharmonics is not None:
         K = check_positive_int(nharmonics, 'nharmonics', minimum=1)
+    if sys.ninputs != sys.noutputs or structure:
+        if sys.isdtime():
+            return _general_discrete(dltpss(sys), structure)
+        return _general_continuous(sys, nharmonics, rtol, structure)
     if sys.isdtime():
         return _discrete(sys)
     if sys.is_lti:                   # the zeros of the constant matrices, unfolded
@@ -146,3 +190,69 @@ def _pencil_zeros(A, B, C, D):
 
 def _sorted(z):
     return z[np.lexsort((z.imag, z.real))]
+
+
+def _ab08(A, B, C, D):
+    """Finite zeros and structure of (A, B, C, D) by SLICOT AB08ND."""
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    scale = max(1.0, np.abs(np.block([[A, B], [C, D]])).max(initial=0.0)) if n + m + p else 1.0
+    nu, rank, dinfz, nkror, nkrol, infz, kronr, kronl, Af, Bf = slycot.ab08nd(
+        n, m, p, A / scale, B / scale, C / scale, D / scale, equil='N',
+        tol=max(n + p, n + m) * np.finfo(float).eps * 10,
+        ldwork=2 * max(1, min(p, m) + max(3 * m - 1, n),
+                       min(p, n) + max(3 * p - 1, n + p, n + m),
+                       min(m, n) + max(3 * m - 1, n + m)) + 64)
+    if nu:
+        alpha, beta = la.eig(Af[:nu, :nu], Bf[:nu, :nu], right=False, homogeneous_eigvals=True)
+        finite = np.abs(beta) > 1e-12 * np.abs(alpha)
+        z = (alpha[finite] / beta[finite]).astype(complex) * scale
+    else:
+        z = np.zeros(0, complex)
+    orders = [i + 1 for i in range(dinfz) for _ in range(int(infz[i]))]
+    return z, int(rank), orders, [int(k) for k in kronr[:nkror]], \
+        [int(k) for k in kronl[:nkrol]]
+
+
+def _general_discrete(sys, structure):
+    """Zeros of the lifted system, per step (module notes)."""
+    N = sys.nsteps
+    z, rank, orders, kr, kl = _ab08(*tv_time_lift(sys))
+    if N > 1:
+        z = z ** (1.0 / N)
+    z = _sorted(z)
+    return ZeroStructure(z, rank, orders, kr, kl) if structure else z
+
+
+def _general_continuous(sys, nharmonics, rtol, structure):
+    """Zeros of the truncated harmonic system kept when two truncations agree."""
+    if sys.is_lti:
+        mats = [M(0.0) for M in (sys.A, sys.B, sys.C, sys.D)]
+        z, rank, orders, kr, kl = _ab08(*mats)
+        z = _sorted(z)
+        return ZeroStructure(z, rank, orders, kr, kl) if structure else z
+    if nharmonics is None:
+        K = min(40, 12 + 4 * max(_bandwidth(M) for M in (sys.A, sys.B, sys.C, sys.D)))
+    else:
+        K = nharmonics
+    w = sys.omega_p
+    runs = []
+    for k in (K, K + max(8, K // 2)):
+        T = [_toeplitz(M.fourier(2 * k), k) for M in (sys.A, sys.B, sys.C, sys.D)]
+        F = T[0] - np.kron(np.diag(1j * w * np.arange(-k, k + 1)), np.eye(sys.nstates))
+        runs.append(_ab08_complex(F, T[1], T[2], T[3]))
+    z1, z2 = runs[0][0], runs[1][0]
+    z1 = z1[(z1.imag > -w / 2) & (z1.imag <= w / 2)]
+    keep = [z for z in z1 if z2.size and np.min(np.abs(z2 - z)) <= rtol * max(1.0, abs(z))]
+    z = _sorted(np.array(keep, complex))
+    if structure:
+        return ZeroStructure(z, *runs[0][1:])
+    return z
+
+
+def _ab08_complex(A, B, C, D):
+    """AB08ND on the real form of a complex system (zeros come in conjugate pairs)."""
+    def real(M):
+        return np.block([[M.real, -M.imag], [M.imag, M.real]])
+    z, rank, orders, kr, kl = _ab08(real(A), real(B), real(C), real(D))
+    # the real form doubles every zero of the complex system with its conjugate
+    return z, rank // 2, sorted(orders)[::2], sorted(kr)[::2], sorted(kl)[::2]

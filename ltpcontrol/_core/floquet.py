@@ -36,6 +36,7 @@ from .transition import expm_batch, step_transitions
 from .coerce import as_ltp
 from .validation import check_positive_int, steps_per_period
 from .registry import method_alias, overridden
+from .tvsystem import DiscreteLTPSystem
 
 __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
            'is_stable', 'floquet_transform']
@@ -99,8 +100,10 @@ def floquet_multipliers(sys, nsteps=None):
 
     Parameters
     ----------
-    sys : LTPStateSpace
-        Continuous- or discrete-time LTP system.
+    sys : LTPStateSpace or DiscreteLTPSystem
+        Continuous- or discrete-time LTP system.  With time-varying
+        dimensions: the ``min n_k`` core multipliers of the cyclic product,
+        padded with zeros to ``n_0`` (see `DiscreteLTPSystem`).
     nsteps : int, optional
         Continuous time only; see `monodromy`.
 
@@ -121,6 +124,8 @@ def floquet_multipliers(sys, nsteps=None):
     """
     if (own := overridden('floquet_multipliers', sys)) is not None:   # systems with delays
         return own(sys, nsteps)
+    if isinstance(sys, DiscreteLTPSystem):          # time-varying dimensions
+        return sys.floquet_multipliers()
     logmod, arg = _log_multipliers(sys, nsteps)
     with np.errstate(under='ignore', over='ignore', invalid='ignore'):
         mu = np.exp(logmod) * np.exp(1j * arg)
@@ -255,6 +260,8 @@ def is_stable(sys, tol=1e-10, nsteps=None, *, autonomous=False):
     if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, numbers.Real) \
             or not 0 <= tol < 1:
         raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
+    if isinstance(sys, DiscreteLTPSystem):          # time-varying dimensions
+        return sys.is_stable(tol)
     logmod, arg = _log_multipliers(sys, nsteps)
     if autonomous:
         logmod = _without_phase_multiplier(logmod, arg)

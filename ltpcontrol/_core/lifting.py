@@ -31,24 +31,34 @@ from control.exception import ControlArgument
 
 from .coerce import as_ltp
 from .validation import check_positive_int
+from .tvsystem import DiscreteLTPSystem
+from .lifting_forms import lift_form, tv_time_lift  # noqa: F401  (re-exported)
 
 __all__ = ['lift']
 
 
-def lift(sysd, *, method='frequency', real=True, nharmonics=None, name=None, start=0):
+def lift(sysd, *, method='frequency', real=True, nharmonics=None, name=None, start=0,
+         sparse=False):
     """Lift a discrete-time LTP system to an equivalent LTI system.
 
     Parameters
     ----------
     sysd : LTPStateSpace
         Discrete-time LTP system with period N steps.
-    method : {'frequency', 'time'}
+    method : {'frequency', 'time', 'stacked', 'cyclic'}
         'frequency' (default): harmonic (frequency-domain) lifting, thesis
         eqs. (4.65)-(4.76); the result runs at the sampling time of `sysd`
         and maps the modulated Fourier coefficients ``U_m`` of the input to
-        those of the output (module notes).  'time': Meyer-Burrus lifting;
-        the result runs once per period (``dt = period``) and maps the N
-        stacked input samples of a period to the N stacked output samples.
+        those of the output (module notes).  'time': Meyer-Burrus (standard)
+        lifting; the result runs once per period (``dt = period``) and maps
+        the N stacked input samples of a period to the N stacked output
+        samples.  'stacked': the Grasselli-Longhi descriptor form, the
+        tuple ``(A, E, B, C, D)`` of ``E z[p+1] = A z[p] + B U[p]`` with the
+        states of a period stacked; 'cyclic': Flamm's cyclic form, an LTI
+        system at the base rate whose state holds ``x[k]`` in block
+        ``k mod N`` (see `unlift` for both).  A
+        `DiscreteLTPSystem` (dimensions varying with k) takes the three
+        time-domain forms.
     real : bool
         Frequency lifting only.  True (default): return the real-valued
         form ``V^H (.) V`` as a `control.StateSpace`.  False: return the
@@ -64,6 +74,9 @@ def lift(sysd, *, method='frequency', real=True, nharmonics=None, name=None, sta
         Step ``k0`` in 0..N-1 at which the lifted periods begin: the result
         lifts the shifted system ``A[k0 + k], B[k0 + k], ...`` (time
         lifting: ``x_L[p] = x[pN + k0]``).  Default 0.
+    sparse : bool, optional
+        'stacked' and 'cyclic' only: return scipy.sparse matrices (long
+        periods).
 
     Returns
     -------
@@ -112,9 +125,15 @@ def lift(sysd, *, method='frequency', real=True, nharmonics=None, name=None, sta
     >>> ltp.lift(sysd, method='time', start=1).B[0, 0]     # Φ(5, 2) B[1]
     np.float64(0.0625)
     """
+    if method in ('stacked', 'cyclic') or isinstance(sysd, DiscreteLTPSystem):
+        return lift_form(sysd, method, start=start, sparse=sparse, name=name,
+                         nharmonics=nharmonics)
     sysd = as_ltp(sysd, 'sysd', discrete=True)
     if method not in ('frequency', 'time'):
-        raise ValueError(f"method must be 'frequency' or 'time', got {method!r}")
+        raise ValueError("method must be 'frequency', 'time', 'stacked' or 'cyclic', "
+                         f"got {method!r}")
+    if sparse:
+        raise ValueError("sparse applies to the 'stacked' and 'cyclic' forms only")
     if not isinstance(real, (bool, np.bool_)):
         raise ControlArgument(f"real must be True or False, got {real!r}")
     N = sysd.nsteps

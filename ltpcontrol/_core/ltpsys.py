@@ -373,7 +373,8 @@ def ltpss(*args, period=None, **kwargs):
         ``f(t)`` returning a 2D array is a smooth periodic matrix; a
         `PeriodicMatrix` may have any period that divides ``period``.  For
         discrete-time systems an array of shape ``(N, rows, cols)`` gives
-        the N matrices of one period, and continuous-time matrices are
+        the N matrices of one period (or of a sub-period: N_i matrices with
+        N_i dividing N repeat), and continuous-time matrices are
         sampled at ``t = k dt``.  ``D`` may be the scalar 0.
     period : float
         Period T > 0 in seconds.
@@ -655,6 +656,8 @@ def _system_matrix(M, period, name, nsteps, rows=None, cols=None, zero_ok=False)
     if nsteps is not None and not isinstance(M, PeriodicMatrix) and not callable(M):
         arr = real_array(M, name, ndim=(0, 1, 2, 3))
         if arr.ndim == 3:
+            if arr.shape[0] != nsteps and arr.shape[0] and nsteps % arr.shape[0] == 0:
+                arr = np.tile(arr, (nsteps // arr.shape[0], 1, 1))   # a sub-period
             if arr.shape[0] != nsteps:
                 raise ControlDimension(f"{name} has {arr.shape[0]} matrices but the period "
                                        f"has {nsteps} steps")
