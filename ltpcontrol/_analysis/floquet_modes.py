@@ -39,6 +39,8 @@ from .._core.steps import step_grid
 from .._core.transition import step_transitions
 from .._core.coerce import as_ltp
 from .._core.validation import check_positive_int, steps_per_period
+from .mode_separation import (clusters, constant_modes, constant_part, separate_clusters,
+                              warn_ambiguous)
 
 __all__ = ['floquet_modes', 'FloquetModes']
 
@@ -149,7 +151,8 @@ class FloquetModes:
         return "\n".join(lines)
 
 
-def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
+def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None, cluster_tol=1e-6,
+                  constant_rtol=None):
     """Floquet modes with frequencies, damping ratios and harmonic content.
 
     Each exponent is placed on the branch of the **principal harmonic** of
@@ -223,6 +226,18 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
     n = sys.nstates
     if n == 0:
         raise ValueError("sys has no states: it has no Floquet modes")
+    F = _frame(frame, sys)
+    if not sys.isdtime(strict=True):
+        rtol = _constant_rtol(constant_rtol, sys)
+        A0 = constant_part(sys.A, rtol)
+        if A0 is not None:
+            # time-invariant (to the data's precision): the eigenvectors of A
+            K = _harmonic_count(sys, nharmonics, A0)
+            times = np.arange(2 * K + 1) * sys.period / (2 * K + 1)
+            strip, logmod, arg, on_samples, left = constant_modes(A0, sys.period, times)
+            return _assemble(sys, F, strip, logmod, arg, times, on_samples, left, K,
+                             float(np.trace(A0).real), float(np.sum(strip.real)), 1,
+                             cluster_tol)
     if sys.isdtime(strict=True):
         if nharmonics is not None:
             raise ControlArgument("nharmonics applies to continuous-time systems; a "
@@ -232,7 +247,6 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
         grid, factors, sample_idx, K = _discrete_grid(sys)
     else:
         grid, factors, sample_idx, K = _continuous_grid(sys, nharmonics, nsteps)
-    F = _frame(frame, sys)
     logmod, arg = product_eigenvalues(factors)
     dtime = bool(sys.dt)
     nper = len(factors)
@@ -278,6 +292,16 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
     # periodic shapes at uniform instants, in the user's frame
     times = grid[sample_idx]
     on_samples = right[:, sample_idx, :]                   # (mode, S, state)
+    trace_mean, sum_re = _liouville(sys, factors, logmod, dtime, nper)
+    return _assemble(sys, F, strip, logmod, arg, times, on_samples, left, K, trace_mean,
+                     sum_re, nper, cluster_tol)
+
+
+def _assemble(sys, F, strip, logmod, arg, times, on_samples, left, K, trace_mean, sum_re,
+              nper, cluster_tol):
+    """Harmonic content, separation of repeated multipliers, branches: the modes."""
+    n = len(strip)
+    dtime = bool(sys.dt)
     shapes = np.einsum('trn,mtn->rmt', F(times), on_samples) if F is not None \
         else np.transpose(on_samples, (2, 0, 1))
     # shapes: (r, mode, S); harmonic content by the DFT over the S samples
@@ -285,6 +309,18 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
     coeffs = np.fft.fft(shapes, axis=-1) / S
     harmonics = np.arange(S) - S // 2                      # -K..K (discrete: -⌊N/2⌋..)
     coeffs = coeffs[..., harmonics % S]
+    # repeated (or nearly repeated) multipliers: split their eigenspaces by harmonic content
+    groups = clusters(logmod + 1j * arg, cluster_tol)
+    if groups:
+        ambiguous = separate_clusters(strip, on_samples, left, coeffs, harmonics, groups)
+        warn_ambiguous(ambiguous, strip, stacklevel=4)
+        if dtime:
+            with np.errstate(divide='ignore'):
+                logmod, arg = nper * np.log(np.abs(strip)), nper * np.angle(strip)
+        else:
+            logmod, arg = strip.real * sys.period, strip.imag * sys.period
+        shapes = np.einsum('trn,mtn->rmt', F(times), on_samples) if F is not None \
+            else np.transpose(on_samples, (2, 0, 1))
     energy = np.sum(np.abs(coeffs) ** 2, axis=0)           # (mode, H)
     with np.errstate(invalid='ignore', divide='ignore'):
         share = energy / energy.sum(axis=1, keepdims=True)
@@ -303,7 +339,7 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
         exps = strip * np.exp(2j * np.pi * hstar / nper)
         with np.errstate(divide='ignore'):
             s = np.log(exps) / sys.dt
-        shift = np.exp(-2j * np.pi * np.outer(hstar, np.arange(nper))[:, sample_idx] / nper)
+        shift = np.exp(-2j * np.pi * np.outer(hstar, np.arange(len(times))) / nper)
     else:
         exps = strip + 1j * hstar * sys.omega_p
         s = exps
@@ -313,10 +349,9 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
         mu = np.exp(logmod) * np.exp(1j * arg)
         wn = np.abs(s)
         zeta = np.where(wn > 0, -s.real / np.where(wn > 0, wn, 1.0), -np.sign(s.real))
-    v = right[:, 0, :].T
+    v = on_samples[:, 0, :].T
     cond = np.linalg.norm(v, axis=0) * np.linalg.norm(left, axis=0) / np.abs(
         np.einsum('im,im->m', np.conj(left), v))
-    trace_mean, sum_re = _liouville(sys, factors, logmod, dtime, nper)
     liouville = abs(sum_re - trace_mean) / max(1.0, np.sum(np.abs(
         logmod[np.isfinite(logmod)])) / (nper if dtime else sys.period))
     order = np.lexsort((-np.sign(s.imag), np.round(wn, 12)))
@@ -328,6 +363,32 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
         times=times, shapes=shapes[:, order], condition=cond[order],
         trace_mean=float(trace_mean), liouville_error=float(liouville),
         truncation=truncation, period=sys.period, dt=float(sys.dt or 0.0))
+
+
+def _constant_rtol(constant_rtol, sys):
+    """Tolerance on the variation of A below which A is taken as constant."""
+    if constant_rtol is not None:
+        rtol = float(constant_rtol)
+        if not (np.isfinite(rtol) and rtol >= 0):
+            raise ValueError(f"constant_rtol must be a non-negative number, got "
+                             f"{constant_rtol!r}")
+        return rtol
+    # a model read from printed data carries its relative precision
+    precision = getattr(sys, 'precision', None)
+    if isinstance(precision, float) and np.isfinite(precision) and precision > 0:
+        return max(1e-12, 20 * precision)
+    return 1e-12
+
+
+def _harmonic_count(sys, nharmonics, A0):
+    """Harmonics -K..K of the content of a time-invariant system's modes."""
+    if nharmonics is not None:
+        return check_positive_int(nharmonics, 'nharmonics')
+    ev = np.linalg.eigvals(A0)
+    radius = float(np.abs(ev).max(initial=0.0))
+    K = int(np.clip(np.ceil(1.5 * radius / sys.omega_p) + 4, 8, _KMAX))
+    # the eigenvalues' own branches must be resolved
+    return max(K, int(np.abs(np.round(ev.imag / sys.omega_p)).max(initial=0)) + 4)
 
 
 def _principal(share, harmonics, lam, sys, dtime, nper):

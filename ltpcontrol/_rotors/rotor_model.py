@@ -62,6 +62,10 @@ class RotorStateSpace(LTPStateSpace):
         of freedom, 1 for a first-order state (0 when unknown).
     wind_speed : float or None
         Wind speed of the operating point (m/s).
+    precision : float or None
+        Relative precision of the data the model was read from (half a unit
+        of the last printed digit); `floquet_modes` takes a model whose
+        matrices vary by less than 20 times it as time-invariant.
 
     Examples
     --------
@@ -75,7 +79,7 @@ class RotorStateSpace(LTPStateSpace):
     _KEYS = ('rotor_speed', 'azimuth0', 'azimuths', 'samples', 'interpolation', 'nblades',
              'frame', 'state_descriptions', 'input_descriptions', 'output_descriptions',
              'rotating_states', 'rotating_inputs', 'rotating_outputs', 'derivative_order',
-             'wind_speed')
+             'wind_speed', 'precision')
 
     def __init__(self, A, B, C, D, period, *, rotor=None, **kwargs):
         super().__init__(A, B, C, D, period, **kwargs)
@@ -91,7 +95,7 @@ class RotorStateSpace(LTPStateSpace):
                         output_descriptions=list(self.output_labels),
                         rotating_states=np.zeros(n, bool), rotating_inputs=np.zeros(m, bool),
                         rotating_outputs=np.zeros(p, bool),
-                        derivative_order=np.zeros(n, int), wind_speed=None)
+                        derivative_order=np.zeros(n, int), wind_speed=None, precision=None)
         defaults.update(rotor)
         for key, value in defaults.items():
             setattr(self, key, value)
@@ -188,6 +192,12 @@ def sampled_matrix(samples, azimuths, azimuth0, period, interpolation, name):
     samples = np.asarray(samples, float)
     if interpolation is None:
         def refuse(t):
+            if len(azimuths) == 1:
+                raise ValueError(f"{name}(t) is not available: a linearization at a single "
+                                 "azimuth of a turning rotor defines no periodic model (a "
+                                 "constant one would assume rotating-frame matrices "
+                                 "independent of the azimuth); use mbc and "
+                                 "average(method='samples'), exact for an isotropic rotor")
             raise ValueError(f"{name}(t) is not available: the model's {len(azimuths)} "
                              "azimuth samples are not uniform and complete, so no periodic "
                              "model can be formed (use average(method='samples'))")
