@@ -104,6 +104,9 @@ class FloquetModes:
         time): a measure of the aliasing of the harmonic content.
     period, dt : float
         Period and sampling time of the system.
+    frame : str or None
+        Coordinates of the system's states when it says ('rotating' or
+        'multiblade' for rotor models), None otherwise.
 
     Examples
     --------
@@ -135,13 +138,15 @@ class FloquetModes:
     truncation: float
     period: float
     dt: float
+    frame: str = None
 
     def __len__(self):
         return len(self.exponents)
 
     def __repr__(self):
         return (f"<FloquetModes: {len(self)} modes, period={self.period:g}"
-                + (f", dt={self.dt:g}" if self.dt else "") + ">")
+                + (f", dt={self.dt:g}" if self.dt else "")
+                + (f", {self.frame} frame" if self.frame else "") + ">")
 
     def __str__(self):
         lines = [repr(self), "  freq [rad/s]   damping    h*   multiplier"]
@@ -194,6 +199,21 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None, cluster_tol=
     nsteps : int, optional
         Continuous time: uniform steps per period of the Floquet grid; see
         `monodromy`.
+    cluster_tol : float, optional
+        Multipliers closer than this (relative, on ``log μ``) form a
+        cluster whose eigenspace is split by harmonic content: the
+        combinations of its periodic vectors that are stationary for the
+        mean harmonic index (the generalized eigenvectors of ``H y = η E
+        y`` with the energy E and the harmonic-weighted energy H of their
+        Fourier coefficients).  Shapes of distinct single harmonics — an
+        isotropic rotor's collective, backward and forward whirl modes,
+        which share one multiplier — are recovered exactly.  Default 1e-6.
+    constant_rtol : float, optional
+        Continuous time: a system whose A(t) varies by at most this times
+        its largest entry is solved as time-invariant (``eig`` of the
+        mean, each mode one harmonic: participation exactly 1).  Default
+        1e-12, or 20 times the ``precision`` of a model read from printed
+        data (`read_lin`).
 
     Returns
     -------
@@ -205,7 +225,9 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None, cluster_tol=
         When the outermost harmonics still carry more than 1e-6 of a mode's
         content (increase `nharmonics`), or when a periodic vector cannot
         be computed (repeated multipliers): that mode's shape is then
-        returned as NaN.
+        returned as NaN; or when modes of one cluster of repeated
+        multipliers cannot be separated by their harmonic content (their
+        mean harmonics differ by less than 1/2).
 
     Examples
     --------
@@ -226,6 +248,9 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None, cluster_tol=
     n = sys.nstates
     if n == 0:
         raise ValueError("sys has no states: it has no Floquet modes")
+    if not (isinstance(cluster_tol, (int, float, np.number)) and not isinstance(cluster_tol, bool)
+            and np.isfinite(cluster_tol) and cluster_tol >= 0):
+        raise ValueError(f"cluster_tol must be a non-negative number, got {cluster_tol!r}")
     F = _frame(frame, sys)
     if not sys.isdtime(strict=True):
         rtol = _constant_rtol(constant_rtol, sys)
@@ -362,7 +387,14 @@ def _assemble(sys, F, strip, logmod, arg, times, on_samples, left, K, trace_mean
         participation=share[order], vectors=v[:, order], left_vectors=left[:, order],
         times=times, shapes=shapes[:, order], condition=cond[order],
         trace_mean=float(trace_mean), liouville_error=float(liouville),
-        truncation=truncation, period=sys.period, dt=float(sys.dt or 0.0))
+        truncation=truncation, period=sys.period, dt=float(sys.dt or 0.0),
+        frame=_frame_name(sys))
+
+
+def _frame_name(sys):
+    """The coordinates a (rotor) model declares, or None."""
+    frame = getattr(sys, 'frame', None)
+    return frame if isinstance(frame, str) else None
 
 
 def _constant_rtol(constant_rtol, sys):
