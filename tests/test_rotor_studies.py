@@ -331,7 +331,7 @@ def test_campbell_of_a_folder_tree_exported_and_reloaded(tmp_path):
     for k, Om in enumerate(cd.values):
         truth = np.linalg.eigvals(mbc_turbine(Om))
         assert max(np.abs(truth - lam).min() for lam in cd.exponents[k]) < 1e-7
-    upper = cd._tracks(None)
+    upper = [k for k in range(16) if np.mean(cd.damped_frequency[:, k] >= 0) >= 0.5]
     assert {cd.labels[j] for j in upper} == {
         '1st tower FA', '1st tower SS', '1st flap BW', '1st flap collective', '1st flap FW',
         '1st edge BW', '1st edge collective', '1st edge FW'}
