@@ -125,15 +125,20 @@ def test_constant_path_detects_time_invariance_to_data_precision(tmp_path):
 def test_isotropic_turbine_flap_tracks_keep_their_shape():
     desc = turbine_descriptions()
 
+    cache = {}
+
     def model(Omega):
+        if Omega in cache:
+            return cache[Omega]
         rot = ltp.ltpss(lambda t: turbine_A(t, Omega), np.zeros((16, 0)),
                         np.zeros((0, 16)), 0, period=2 * np.pi / Omega)
         rotor = dict(rotor_speed=Omega, state_descriptions=desc,
                      rotating_states=np.array(['blade' in d for d in desc]),
                      derivative_order=np.full(16, 2))
         rot = ltp.RotorStateSpace(rot.A, rot.B, rot.C, rot.D, rot.period, rotor=rotor)
-        return ltp.mbc(rot, 3)[0]
-    speeds = np.linspace(0.3, 1.6, 8)
+        cache[Omega] = ltp.mbc(rot, 3)[0]
+        return cache[Omega]
+    speeds = np.linspace(0.3, 1.6, 6)
     cd = ltp.campbell(model, speeds, n_jobs=1, branch='principal')
     labels = [ltp.mode_labels(cd.modes[k], model(speeds[k])) for k in range(len(speeds))]
     flap = [j for j in range(16) if 'flap' in labels[0][cd.indices[0, j]]]
@@ -398,3 +403,61 @@ def test_campbell_accepts_averaged_models():
     # each crossing once (not for both tracks of a complex pair)
     pairs = [(n, round(v, 9)) for _, n, v, _ in cd.crossings]
     assert len(pairs) == len(set(pairs))
+
+
+def test_aerodyn_states_blade_by_blade_grouped(tmp_path):
+    # first-order AeroDyn states written blade by blade after the structure:
+    # uncoupled lags of rate 5 1/s become -5 (collective) and -5 ± jΩ (cyclic)
+    Omega, desc = 0.9, turbine_descriptions()
+    ad = [f'AD UA x{j} blade {b}, node 2, rad' for b in (1, 2, 3) for j in (1, 2)]
+    for k in range(6):
+        psi = 2 * np.pi * k / 6
+        A = np.zeros((22, 22))
+        A[:16, :16] = turbine_A(psi / Omega, Omega)
+        A[16:, 16:] = np.diag([-5.0, -7.0] * 3)
+        write_lin(tmp_path / f'ad.{k + 1}.lin', A, Omega, psi, 8.0, desc + ad,
+                  ['blade' in d for d in desc + ad], [2] * 16 + [1] * 6, digits=16)
+    lin = ltp.read_lin(tmp_path)
+    nr, _ = ltp.mbc(lin, 3)
+    assert [nr.state_labels[i].rsplit('_', 1)[1] for i in (16, 18, 20)] == ['0', 'c1', 's1']
+    ev = np.linalg.eigvals(nr.average(method='samples').A)
+    for lam in (-5, -5 + 0.9j, -5 - 0.9j, -7, -7 + 0.9j, -7 - 0.9j):
+        assert np.abs(ev - lam).min() < 1e-10
+
+
+def test_tower_azimuths_dropped_and_operating_point_speeds():
+    files = sorted(DATA.glob('Main_Rotating.*.lin'))
+    lin = ltp.read_lin(files)
+    # MBC3 takes Ω from the generator azimuth's derivative at the operating point, Ω̇
+    # from its rate's
+    assert np.allclose(lin.sample_speeds, 0.9425)
+    assert np.allclose(lin.sample_accelerations, [-7.308e-06, 6.543e-06, 7.905e-06])
+    # azimuths (deg) 0.5, 110.1, 230.0: the first only is 55 degrees away from the
+    # tower passages at 60, 180 and 300
+    kept = ltp.read_lin(files, drop_near_tower=55.0)
+    assert np.allclose(np.degrees(kept.azimuths), np.degrees(lin.azimuths[[0]]))
+    with pytest.raises(ValueError, match="every file"):
+        ltp.read_lin(files[1:], drop_near_tower=55.0)
+
+
+def test_campbell_frame_follows_the_rotor_speed():
+    # rotating-frame models of uncoupled blades: measured in the multi-blade frame of
+    # each rotor speed, the exponents are the whirl ones ω ± Ω
+    desc = [f'ED 1st edgewise bending-mode DOF of blade {b}, m' for b in (1, 2, 3)]
+    desc += [d.replace('ED ', 'ED First time derivative of ') + '/s' for d in desc]
+
+    def rotating(Omega):
+        A = ltp.PeriodicMatrix.constant(np.kron(AB, np.eye(3)), 2 * np.pi / Omega)
+        return ltp.RotorStateSpace(A, np.zeros((6, 0)), np.zeros((0, 6)), np.zeros((0, 0)),
+                                   2 * np.pi / Omega, rotor=dict(
+                                       rotor_speed=Omega, state_descriptions=desc,
+                                       rotating_states=np.ones(6, bool),
+                                       derivative_order=np.full(6, 2)))
+    cd = ltp.campbell(rotating, [0.5, 0.8], frame='multiblade', n_jobs=1,
+                      branch='principal')
+    wd = np.sqrt(4 - 0.01)
+    for k, Om in enumerate([0.5, 0.8]):
+        assert np.allclose(np.sort(np.abs(cd.damped_frequency[k])),
+                           np.sort(np.repeat([wd - Om, wd, wd + Om], 2)), atol=1e-10)
+    with pytest.raises(ValueError, match="frame must be 'multiblade'"):
+        ltp.campbell(rotating, [0.5, 0.8], frame='rotating', n_jobs=1)

@@ -218,6 +218,7 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
                      'rotating_outputs')
     psi0 = float(azimuth0 if azimuth0 is not None else
                  (sys.azimuth0 if rotor else 0.0))
+    rotor_given = rotor_speed
     if rotor_speed is None:
         rotor_speed = sys.rotor_speed if rotor else 2 * np.pi / T
     speed = _speed(rotor_speed, T)
@@ -249,9 +250,11 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
             P[np.ix_(g, g)], Pinv[np.ix_(g, g)] = T0, w[:, None] * T0.T
         return P, Pinv
 
-    def transformed(t, mats, which=(0, 1, 2, 3)):
+    def transformed(t, mats, which=(0, 1, 2, 3), at_speed=None):
         """The transformed matrices `which` (0: A, 1: B, 2: C, 3: D) at time t."""
         omega, domega, psi = speed(t, psi0)
+        if at_speed is not None:
+            omega, domega = at_speed
         P, Pinv, dP = state_transform(omega, domega, psi)
         (Pu, Puinv), (Py, Pyinv) = signal_transform(m, in_groups, psi), \
             signal_transform(p, out_groups, psi)
@@ -297,8 +300,14 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
         times = np.mod((np.asarray(sys.azimuths) - psi0) / omega, T) if omega else \
             np.zeros(len(sys.azimuths))
         samples = [[], [], [], []]
+        # the samples' own Ω and Ω̇ (operating point), as MBC3 takes them
+        own = getattr(sys, 'sample_speeds', None)
+        acc = getattr(sys, 'sample_accelerations', None)
+        use_own = rotor_given is None and own is not None and acc is not None and \
+            len(own) == len(times) and sys.rotor_speed > 0
         for s, t in enumerate(times):
-            out = transformed(t, [M[s] for M in sys.samples])
+            out = transformed(t, [M[s] for M in sys.samples],
+                              at_speed=(own[s], acc[s]) if use_own else None)
             for j in range(4):
                 samples[j].append(out[j])
         samples = tuple(np.array(M).reshape((len(times),) + sys.samples[j].shape[1:])

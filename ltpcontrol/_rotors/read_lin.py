@@ -74,7 +74,7 @@ def _natural(path):
 
 
 def read_lin(files, *, interpolation='auto', overflow='raise', atol_azimuth=1e-3,
-             remove_states=None, name=None):
+             remove_states=None, drop_near_tower=None, nblades=3, name=None):
     """Read OpenFAST ``.lin`` files (one per azimuth) into a rotor model.
 
     Parameters
@@ -102,6 +102,15 @@ def read_lin(files, *, interpolation='auto', overflow='raise', atol_azimuth=1e-3
         Regular expression: the states whose descriptions match it are
         removed (rows and columns of A, rows of B, columns of C), as
         MBC3's ``removeStatesPattern``.
+    drop_near_tower : float, optional
+        Half-width (degrees) of the azimuth ranges around the tower passage
+        of a blade (blade b at 180°: ``ψ = 180° - 360°(b-1)/nblades``)
+        whose files are left out, as MBC3's ``removeTwrAzimuth`` (4° around
+        60°, 180°, 300° for three blades).  The remaining azimuths are
+        not uniform: the model keeps samples only (``average(method=
+        'samples')``).
+    nblades : int
+        Number of blades, for `drop_near_tower`.
     name : str, optional
         Name of the model.
 
@@ -143,6 +152,8 @@ def read_lin(files, *, interpolation='auto', overflow='raise', atol_azimuth=1e-3
             raise ControlArgument(f"overflow must be 'raise' or a number, got {overflow!r}") \
                 from None
     parsed = [_parse(f, overflow) for f in files]
+    if drop_near_tower is not None:
+        files, parsed = _drop_near_tower(files, parsed, drop_near_tower, nblades)
     first = parsed[0]
     for f, d in zip(files[1:], parsed[1:]):
         for key in ('nstates', 'ninputs', 'noutputs'):
@@ -208,6 +219,8 @@ def read_lin(files, *, interpolation='auto', overflow='raise', atol_azimuth=1e-3
                 for M, nm in zip(samples, 'ABCD')]
     rotor = dict(
         precision=min(d['precision'] for d in parsed),
+        sample_speeds=np.array([d['speed_op'][0] for d in parsed]),
+        sample_accelerations=np.array([d['speed_op'][1] for d in parsed]),
         rotor_speed=omega, azimuth0=float(psi[0]), azimuths=psi, samples=samples,
         interpolation=interp, frame='rotating',
         state_descriptions=[r[4] for r in tables['states']],
@@ -243,6 +256,7 @@ def _parse(path, overflow):
         out[key] = int(value) if key.startswith('n') else _number(value, path, key, overflow)
     for key, title in _TABLES.items():
         out[key] = _table(lines, title, out['n' + key], path)
+    out['speed_op'] = _operating_speed(lines, out, path, overflow)
     mats = {}
     i = 0
     while i < len(lines):
@@ -347,3 +361,59 @@ def _remove_states(samples, tables, pattern):
     samples = (A[:, keep][:, :, keep], B[:, keep], C[:, :, keep], D)
     tables = dict(tables, states=[r for r, k in zip(tables['states'], keep) if k])
     return samples, tables
+
+
+def _operating_speed(lines, out, path, overflow):
+    """Ω and Ω̇ of the operating point, as MBC3 takes them.
+
+    The time derivatives at the operating point of the generator azimuth
+    (``DOF_GeAz``) and of its rate, plus those of the drivetrain torsion
+    (``DOF_DrTr``); the header's rotor speed and Ω̇ = 0 when the file has no
+    such states (or no table of state derivatives).
+    """
+    omega, domega = out['rotor_speed'], 0.0
+    n = out['nstates']
+    title = 'Order of continuous state derivatives:'
+    if n == 0 or not any(ln.strip() == title for ln in lines):
+        return omega, domega
+    try:
+        rows = _table(lines, title, n, path)
+        xdop = [_number(r[1].split()[0], path, 'an operating point', overflow)
+                if r[1].split() else 0.0 for r in rows]
+    except ValueError:
+        return omega, domega
+    desc = [r[4] for r in out['states']]
+    n2 = sum(1 for r in out['states'] if r[3] == 2)
+    half = n2 // 2
+    found = False
+    for i in range(half):
+        if 'DOF_GeAz' in desc[i]:
+            omega, domega, found = xdop[i], xdop[i + half], True
+            break
+    for i in range(half):
+        if 'DOF_DrTr' in desc[i]:
+            omega, domega = omega + xdop[i], domega + xdop[i + half]
+            break
+    return float(omega), float(domega)
+
+
+def _drop_near_tower(files, parsed, width, nblades):
+    """The files whose azimuth is farther than `width` degrees from a tower passage."""
+    try:
+        width = float(width)
+    except (TypeError, ValueError):
+        raise ControlArgument(f"drop_near_tower must be a number of degrees, got "
+                              f"{width!r}") from None
+    if not 0 <= width < 180:
+        raise ValueError(f"drop_near_tower must be in [0, 180) degrees, got {width}")
+    N = int(nblades)
+    passages = np.mod(180.0 - 360.0 * np.arange(N) / N, 360.0)
+    keep = []
+    for f, d in zip(files, parsed):
+        psi = np.mod(np.degrees(d['azimuth']), 360.0)
+        gap = np.abs(np.mod(psi - passages + 180.0, 360.0) - 180.0)
+        keep.append(bool(np.all(gap >= width)))
+    if not any(keep):
+        raise ValueError(f"drop_near_tower={width}: every file is within {width} degrees of "
+                         "a tower passage")
+    return ([f for f, k in zip(files, keep) if k], [d for d, k in zip(parsed, keep) if k])

@@ -62,6 +62,10 @@ class RotorStateSpace(LTPStateSpace):
         of freedom, 1 for a first-order state (0 when unknown).
     wind_speed : float or None
         Wind speed of the operating point (m/s).
+    sample_speeds, sample_accelerations : ndarray or None
+        Ω and Ω̇ at each sample, from the operating point of the generator
+        azimuth and drivetrain states as MBC3 takes them (`mbc` transforms
+        the samples with them).
     precision : float or None
         Relative precision of the data the model was read from (half a unit
         of the last printed digit); `floquet_modes` takes a model whose
@@ -79,7 +83,7 @@ class RotorStateSpace(LTPStateSpace):
     _KEYS = ('rotor_speed', 'azimuth0', 'azimuths', 'samples', 'interpolation', 'nblades',
              'frame', 'state_descriptions', 'input_descriptions', 'output_descriptions',
              'rotating_states', 'rotating_inputs', 'rotating_outputs', 'derivative_order',
-             'wind_speed', 'precision')
+             'wind_speed', 'precision', 'sample_speeds', 'sample_accelerations')
 
     def __init__(self, A, B, C, D, period, *, rotor=None, **kwargs):
         super().__init__(A, B, C, D, period, **kwargs)
@@ -95,7 +99,8 @@ class RotorStateSpace(LTPStateSpace):
                         output_descriptions=list(self.output_labels),
                         rotating_states=np.zeros(n, bool), rotating_inputs=np.zeros(m, bool),
                         rotating_outputs=np.zeros(p, bool),
-                        derivative_order=np.zeros(n, int), wind_speed=None, precision=None)
+                        derivative_order=np.zeros(n, int), wind_speed=None, precision=None,
+                        sample_speeds=None, sample_accelerations=None)
         defaults.update(rotor)
         for key, value in defaults.items():
             setattr(self, key, value)
