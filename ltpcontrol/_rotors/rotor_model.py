@@ -78,6 +78,8 @@ class RotorStateSpace(LTPStateSpace):
     ...                           np.zeros((0, 0)), 2 * np.pi, rotor={'rotor_speed': 1.0})
     >>> rot.rotor_speed, rot.frame
     (1.0, 'rotating')
+    >>> rot
+    <RotorStateSpace sys[...]: 1 states, rotating frame, rotor speed 1 rad/s, period=6.28319>
     """
 
     _KEYS = ('rotor_speed', 'azimuth0', 'azimuths', 'samples', 'interpolation', 'nblades',
@@ -104,6 +106,13 @@ class RotorStateSpace(LTPStateSpace):
         defaults.update(rotor)
         for key, value in defaults.items():
             setattr(self, key, value)
+
+    def _repr_info_(self, html=False):
+        speed = f", rotor speed {self.rotor_speed:.4g} rad/s"
+        samples = f", {len(self.azimuths)} azimuths" if self.azimuths is not None else ""
+        text = (f"<RotorStateSpace {self.name}: {self.nstates} states, {self.frame} frame"
+                f"{speed}{samples}, period={self.period:g}>")
+        return text if not html else text.replace('<', '&lt;').replace('>', '&gt;')
 
     def rotor_data(self):
         """The rotor data as a dict (for building a derived model).
