@@ -158,7 +158,7 @@ class CampbellDiagram:
         return cols
 
     def to_dataframe(self, tracks=None):
-        """The diagram as a `pandas.DataFrame` (see `table`; needs pandas).
+        """The diagram as a pandas ``DataFrame`` (see ``table``; needs pandas).
 
         Examples
         --------
@@ -176,7 +176,7 @@ class CampbellDiagram:
         return pd.DataFrame(self.table(tracks))
 
     def to_csv(self, path, tracks=None):
-        """Write the diagram's `table` to a CSV file (no pandas needed).
+        """Write the diagram's ``table`` to a CSV file (no pandas needed).
 
         Examples
         --------
