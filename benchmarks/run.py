@@ -60,6 +60,7 @@ def main(argv=None):
     import p10_grids
     import p11_orbits
     import p12_chatter
+    import p13_campbell
 
     if args.wall:
         _common.use_wall_clock()
@@ -71,6 +72,7 @@ def main(argv=None):
     suites['P10'] = p10_grids
     suites['P11'] = p11_orbits
     suites['P12'] = p12_chatter
+    suites['P13'] = p13_campbell
     only = [s.strip().upper() for s in args.only.split(',')] if args.only else list(suites)
     unknown = set(only) - set(suites)
     if unknown:

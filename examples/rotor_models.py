@@ -51,3 +51,74 @@ def flap_A(psi, mu, gamma=12.0, p=1.0):
     c = gamma / 8 * (1 + 4 / 3 * mu * np.sin(psi))
     k = p ** 2 + gamma / 8 * (4 / 3 * mu * np.cos(psi) + mu ** 2 * np.sin(2 * psi))
     return np.array([[0.0, 1.0], [-k, -c]])
+
+
+# A 16-state isotropic wind turbine: tower fore-aft and side-side, flap and edge of three
+# blades (rotating frame).  Fore-aft couples with the collective flap, side-side with the
+# cyclic edge (Coleman's in-plane coupling); tower ~0.32 Hz, flap ~0.7 Hz, edge ~1.1 Hz.
+TURBINE = dict(M_tower=3.0, k_tower=12.0, c_tower=0.02, I_flap=1.0, S_flap=0.3,
+               k_flap=19.4, c_flap=0.3, I_edge=1.0, S_edge=0.3, k_edge=49.0, c_edge=0.07,
+               e=0.1)
+
+TURBINE_DOFS = (
+    ['ED 1st tower fore-aft bending mode DOF (internal DOF index = DOF_TFA1), m',
+     'ED 1st tower side-to-side bending mode DOF (internal DOF index = DOF_TSS1), m']
+    + [f'ED 1st flapwise bending-mode DOF of blade {b} (internal DOF index = DOF_BF({b},1)), m'
+       for b in (1, 2, 3)]
+    + [f'ED 1st edgewise bending-mode DOF of blade {b} (internal DOF index = DOF_BE({b},1)), m'
+       for b in (1, 2, 3)])
+
+
+def turbine_descriptions():
+    """Descriptions of the 16 states in OpenFAST's order (displacements, then rates)."""
+    rates = [d.replace('ED ', 'ED First time derivative of ', 1).replace(', m', ', m/s')
+             for d in TURBINE_DOFS]
+    return list(TURBINE_DOFS) + rates
+
+
+def turbine_A(t, Omega, data=TURBINE):
+    """Rotating-frame state matrix of the isotropic turbine at time t (ψ_1 = Ωt)."""
+    psi = Omega * t + 2 * np.pi * np.arange(3) / 3
+    d = data
+    M, C, K = (np.zeros((8, 8)) for _ in range(3))
+    M[0, 0] = M[1, 1] = d['M_tower']
+    M[0, 2:5] = M[2:5, 0] = d['S_flap']
+    M[1, 5:] = M[5:, 1] = -d['S_edge'] * np.sin(psi)
+    M[2:5, 2:5] = d['I_flap'] * np.eye(3)
+    M[5:, 5:] = d['I_edge'] * np.eye(3)
+    C[0, 0] = C[1, 1] = d['c_tower']
+    C[1, 5:] = -2 * Omega * d['S_edge'] * np.cos(psi)
+    C[2:5, 2:5] = d['c_flap'] * np.eye(3)
+    C[5:, 5:] = d['c_edge'] * np.eye(3)
+    K[0, 0] = K[1, 1] = d['k_tower']
+    K[1, 5:] = Omega ** 2 * d['S_edge'] * np.sin(psi)
+    K[2:5, 2:5] = (d['k_flap'] + d['I_flap'] * Omega ** 2) * np.eye(3)
+    K[5:, 5:] = (d['k_edge'] + d['e'] * d['S_edge'] * Omega ** 2) * np.eye(3)
+    return np.block([[np.zeros((8, 8)), np.eye(8)],
+                     [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+
+
+def write_lin(path, A, rotor_speed, azimuth, wind_speed, descriptions, rotating, orders,
+              digits=10):
+    """Write a state matrix as an OpenFAST ``.lin`` file (no inputs or outputs)."""
+    n = A.shape[0]
+    lines = ['', 'Linearized model: synthetic turbine', '', 'Simulation information:',
+             f'   Rotor Speed:                         {rotor_speed:.4f} rad/s',
+             f'   Azimuth:                             {azimuth:.4f} rad',
+             f'   Wind Speed:                          {wind_speed:.4f} m/s',
+             f'   Number of continuous states:        {n}',
+             '   Number of discrete states:           0',
+             '   Number of constraint states:         0',
+             '   Number of inputs:                    0',
+             '   Number of outputs:                   0',
+             '   Jacobians included in this file?    No', '']
+    for title in ('Order of continuous states:', 'Order of continuous state derivatives:'):
+        lines += [title, '   Row/Column Operating Point   Rotating Frame? Derivative Order '
+                  'Description', '   ---------- ---------------   --------------- '
+                  '---------------- -----------']
+        lines += [f'   {i + 1:8d}    0.000000000E+00   {"T" if rotating[i] else "F"}   '
+                  f'{orders[i]}   {descriptions[i]}' for i in range(n)]
+        lines.append('')
+    lines += ['', 'Linearized state matrices:', '', f'A: {n} x {n}']
+    lines += ['  ' + ' '.join(f'{v: .{digits - 1}E}' for v in row) for row in A]
+    path.write_text('\n'.join(lines) + '\n')

@@ -45,6 +45,8 @@ from ._rotors.rotor_model import RotorStateSpace
 from ._rotors.mbc import mbc, coleman_matrix
 from ._rotors.read_lin import read_lin
 from ._rotors.campbell import campbell, CampbellDiagram
+from ._rotors.campbell_lin import campbell_lin
+from ._rotors.mode_labels import mode_labels
 from ._analysis.zeros import zeros
 from ._frequency.harmonic_ss import harmonic_ss
 from ._frequency.nyquist import nyquist_htf, HarmonicNyquistResponse
@@ -128,6 +130,7 @@ __all__ = [
     # rotors and wind turbines
     'floquet_modes', 'FloquetModes', 'RotorStateSpace', 'mbc', 'coleman_matrix', 'read_lin',
     'campbell', 'CampbellDiagram',
+    'campbell_lin', 'mode_labels',
     # files
     'save', 'load',
     # periodic systems with delays

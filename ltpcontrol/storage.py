@@ -15,7 +15,8 @@ Object kinds: `PeriodicMatrix` in the Fourier, switching (sampled with
 gains of `care` and `lqr`, Floquet transforms) and their pointwise
 combinations by the library's operations; `LTPStateSpace` (continuous and
 discrete time, identified models included); `HTFData`; `HTFModel` (stored
-as its system and options and rebuilt on load).  A matrix defined by an
+as its system and options and rebuilt on load); `CampbellDiagram` (its
+tracks, labels and crossings, without the modes of every value).  A matrix defined by an
 arbitrary Python function cannot be stored: sample it first.
 """
 
@@ -29,6 +30,7 @@ from ._core import pm_ops
 from ._core.ltpsys import LTPStateSpace
 from ._core.periodic_matrix import PeriodicMatrix
 from ._frequency.htf import HTFData, HTFModel
+from ._rotors.campbell import CampbellDiagram
 
 __all__ = ['save', 'load', 'FORMAT_VERSION']
 
@@ -43,8 +45,9 @@ def save(path, obj):
     ----------
     path : str or os.PathLike
         File name (``.npz`` is appended by NumPy when missing).
-    obj : LTPStateSpace, PeriodicMatrix, HTFData or HTFModel
-        Object to store.
+    obj : LTPStateSpace, PeriodicMatrix, HTFData, HTFModel or CampbellDiagram
+        Object to store (a Campbell diagram without the Floquet modes of
+        its values).
 
     Raises
     ------
@@ -87,7 +90,7 @@ def load(path):
 
     Returns
     -------
-    LTPStateSpace, PeriodicMatrix, HTFData or HTFModel
+    LTPStateSpace, PeriodicMatrix, HTFData, HTFModel or CampbellDiagram
 
     Raises
     ------
@@ -166,8 +169,22 @@ def _encode(obj, arrays):
         return {'kind': 'HTFModel', 'nharmonics': obj.nharmonics,
                 'internal_harmonics': internal, 'method': method,
                 'sys': _encode(sys, arrays)}
+    if type(obj) is CampbellDiagram:
+        # the tracks and their data; the Floquet modes of every value are not stored
+        node = {'kind': 'CampbellDiagram', 'labels': [str(x) for x in obj.labels],
+                'xlabel': obj.xlabel, 'frame': obj.frame,
+                'crossings': [[int(t), int(n), float(v), float(f)]
+                              for t, n, v, f in obj.crossings]}
+        for key in _CAMPBELL_ARRAYS:
+            value = getattr(obj, key)
+            node[key] = None if value is None else _array(value, arrays)
+        return node
     raise TypeError(f"save: cannot store a {type(obj).__name__}; supported are "
-                    "LTPStateSpace, PeriodicMatrix, HTFData and HTFModel")
+                    "LTPStateSpace, PeriodicMatrix, HTFData, HTFModel and CampbellDiagram")
+
+
+_CAMPBELL_ARRAYS = ('values', 'exponents', 'frequency', 'damped_frequency', 'damping',
+                    'principal_harmonic', 'mac', 'rotor_speed', 'indices', 'wind_speed')
 
 
 def _encode_matrix(P, arrays):
@@ -235,6 +252,16 @@ def _decode(node, members):
     if kind == 'HTFModel':
         return HTFModel(_decode(node['sys'], members), int(node['nharmonics']),
                         internal_harmonics=node['internal_harmonics'], method=node['method'])
+    if kind == 'CampbellDiagram':
+        arrays = {key: None if node[key] is None else _get(node[key], members)
+                  for key in _CAMPBELL_ARRAYS}
+        K, n = arrays['frequency'].shape
+        if arrays['values'].shape != (K,) or arrays['exponents'].shape != (K, n):
+            raise ValueError("a Campbell diagram's arrays do not match")
+        return CampbellDiagram(**arrays, modes=(), labels=tuple(node['labels']),
+                               xlabel=node['xlabel'], frame=node['frame'],
+                               crossings=[(int(t), int(n_), float(v), float(f))
+                                          for t, n_, v, f in node['crossings']])
     raise ValueError(f"unknown object kind {kind!r}")
 
 

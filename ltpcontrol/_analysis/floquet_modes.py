@@ -39,6 +39,8 @@ from .._core.steps import step_grid
 from .._core.transition import step_transitions
 from .._core.coerce import as_ltp
 from .._core.validation import check_positive_int, steps_per_period
+from .mode_separation import (clusters, constant_modes, constant_part, separate_clusters,
+                              warn_ambiguous)
 
 __all__ = ['floquet_modes', 'FloquetModes']
 
@@ -102,6 +104,9 @@ class FloquetModes:
         time): a measure of the aliasing of the harmonic content.
     period, dt : float
         Period and sampling time of the system.
+    frame : str or None
+        Coordinates of the system's states when it says ('rotating' or
+        'multiblade' for rotor models), None otherwise.
 
     Examples
     --------
@@ -133,13 +138,15 @@ class FloquetModes:
     truncation: float
     period: float
     dt: float
+    frame: str = None
 
     def __len__(self):
         return len(self.exponents)
 
     def __repr__(self):
         return (f"<FloquetModes: {len(self)} modes, period={self.period:g}"
-                + (f", dt={self.dt:g}" if self.dt else "") + ">")
+                + (f", dt={self.dt:g}" if self.dt else "")
+                + (f", {self.frame} frame" if self.frame else "") + ">")
 
     def __str__(self):
         lines = [repr(self), "  freq [rad/s]   damping    h*   multiplier"]
@@ -149,7 +156,8 @@ class FloquetModes:
         return "\n".join(lines)
 
 
-def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
+def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None, cluster_tol=1e-6,
+                  constant_rtol=None):
     """Floquet modes with frequencies, damping ratios and harmonic content.
 
     Each exponent is placed on the branch of the **principal harmonic** of
@@ -191,6 +199,21 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
     nsteps : int, optional
         Continuous time: uniform steps per period of the Floquet grid; see
         `monodromy`.
+    cluster_tol : float, optional
+        Multipliers closer than this (relative, on ``log μ``) form a
+        cluster whose eigenspace is split by harmonic content: the
+        combinations of its periodic vectors that are stationary for the
+        mean harmonic index (the generalized eigenvectors of ``H y = η E
+        y`` with the energy E and the harmonic-weighted energy H of their
+        Fourier coefficients).  Shapes of distinct single harmonics — an
+        isotropic rotor's collective, backward and forward whirl modes,
+        which share one multiplier — are recovered exactly.  Default 1e-6.
+    constant_rtol : float, optional
+        Continuous time: a system whose A(t) varies by at most this times
+        its largest entry is solved as time-invariant (``eig`` of the
+        mean, each mode one harmonic: participation exactly 1).  Default
+        1e-12, or 20 times the ``precision`` of a model read from printed
+        data (`read_lin`).
 
     Returns
     -------
@@ -202,7 +225,9 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
         When the outermost harmonics still carry more than 1e-6 of a mode's
         content (increase `nharmonics`), or when a periodic vector cannot
         be computed (repeated multipliers): that mode's shape is then
-        returned as NaN.
+        returned as NaN; or when modes of one cluster of repeated
+        multipliers cannot be separated by their harmonic content (their
+        mean harmonics differ by less than 1/2).
 
     Examples
     --------
@@ -223,6 +248,21 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
     n = sys.nstates
     if n == 0:
         raise ValueError("sys has no states: it has no Floquet modes")
+    if not (isinstance(cluster_tol, (int, float, np.number)) and not isinstance(cluster_tol, bool)
+            and np.isfinite(cluster_tol) and cluster_tol >= 0):
+        raise ValueError(f"cluster_tol must be a non-negative number, got {cluster_tol!r}")
+    F = _frame(frame, sys)
+    if not sys.isdtime(strict=True):
+        rtol = _constant_rtol(constant_rtol, sys)
+        A0 = constant_part(sys.A, rtol)
+        if A0 is not None:
+            # time-invariant (to the data's precision): the eigenvectors of A
+            K = _harmonic_count(sys, nharmonics, A0)
+            times = np.arange(2 * K + 1) * sys.period / (2 * K + 1)
+            strip, logmod, arg, on_samples, left = constant_modes(A0, sys.period, times)
+            return _assemble(sys, F, strip, logmod, arg, times, on_samples, left, K,
+                             float(np.trace(A0).real), float(np.sum(strip.real)), 1,
+                             cluster_tol)
     if sys.isdtime(strict=True):
         if nharmonics is not None:
             raise ControlArgument("nharmonics applies to continuous-time systems; a "
@@ -232,7 +272,6 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
         grid, factors, sample_idx, K = _discrete_grid(sys)
     else:
         grid, factors, sample_idx, K = _continuous_grid(sys, nharmonics, nsteps)
-    F = _frame(frame, sys)
     logmod, arg = product_eigenvalues(factors)
     dtime = bool(sys.dt)
     nper = len(factors)
@@ -278,6 +317,16 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
     # periodic shapes at uniform instants, in the user's frame
     times = grid[sample_idx]
     on_samples = right[:, sample_idx, :]                   # (mode, S, state)
+    trace_mean, sum_re = _liouville(sys, factors, logmod, dtime, nper)
+    return _assemble(sys, F, strip, logmod, arg, times, on_samples, left, K, trace_mean,
+                     sum_re, nper, cluster_tol)
+
+
+def _assemble(sys, F, strip, logmod, arg, times, on_samples, left, K, trace_mean, sum_re,
+              nper, cluster_tol):
+    """Harmonic content, separation of repeated multipliers, branches: the modes."""
+    n = len(strip)
+    dtime = bool(sys.dt)
     shapes = np.einsum('trn,mtn->rmt', F(times), on_samples) if F is not None \
         else np.transpose(on_samples, (2, 0, 1))
     # shapes: (r, mode, S); harmonic content by the DFT over the S samples
@@ -285,6 +334,18 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
     coeffs = np.fft.fft(shapes, axis=-1) / S
     harmonics = np.arange(S) - S // 2                      # -K..K (discrete: -⌊N/2⌋..)
     coeffs = coeffs[..., harmonics % S]
+    # repeated (or nearly repeated) multipliers: split their eigenspaces by harmonic content
+    groups = clusters(logmod + 1j * arg, cluster_tol)
+    if groups:
+        ambiguous = separate_clusters(strip, on_samples, left, coeffs, harmonics, groups)
+        warn_ambiguous(ambiguous, strip, stacklevel=4)
+        if dtime:
+            with np.errstate(divide='ignore'):
+                logmod, arg = nper * np.log(np.abs(strip)), nper * np.angle(strip)
+        else:
+            logmod, arg = strip.real * sys.period, strip.imag * sys.period
+        shapes = np.einsum('trn,mtn->rmt', F(times), on_samples) if F is not None \
+            else np.transpose(on_samples, (2, 0, 1))
     energy = np.sum(np.abs(coeffs) ** 2, axis=0)           # (mode, H)
     with np.errstate(invalid='ignore', divide='ignore'):
         share = energy / energy.sum(axis=1, keepdims=True)
@@ -303,7 +364,7 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
         exps = strip * np.exp(2j * np.pi * hstar / nper)
         with np.errstate(divide='ignore'):
             s = np.log(exps) / sys.dt
-        shift = np.exp(-2j * np.pi * np.outer(hstar, np.arange(nper))[:, sample_idx] / nper)
+        shift = np.exp(-2j * np.pi * np.outer(hstar, np.arange(len(times))) / nper)
     else:
         exps = strip + 1j * hstar * sys.omega_p
         s = exps
@@ -313,10 +374,9 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
         mu = np.exp(logmod) * np.exp(1j * arg)
         wn = np.abs(s)
         zeta = np.where(wn > 0, -s.real / np.where(wn > 0, wn, 1.0), -np.sign(s.real))
-    v = right[:, 0, :].T
+    v = on_samples[:, 0, :].T
     cond = np.linalg.norm(v, axis=0) * np.linalg.norm(left, axis=0) / np.abs(
         np.einsum('im,im->m', np.conj(left), v))
-    trace_mean, sum_re = _liouville(sys, factors, logmod, dtime, nper)
     liouville = abs(sum_re - trace_mean) / max(1.0, np.sum(np.abs(
         logmod[np.isfinite(logmod)])) / (nper if dtime else sys.period))
     order = np.lexsort((-np.sign(s.imag), np.round(wn, 12)))
@@ -327,7 +387,40 @@ def floquet_modes(sys, *, frame=None, nharmonics=None, nsteps=None):
         participation=share[order], vectors=v[:, order], left_vectors=left[:, order],
         times=times, shapes=shapes[:, order], condition=cond[order],
         trace_mean=float(trace_mean), liouville_error=float(liouville),
-        truncation=truncation, period=sys.period, dt=float(sys.dt or 0.0))
+        truncation=truncation, period=sys.period, dt=float(sys.dt or 0.0),
+        frame=_frame_name(sys))
+
+
+def _frame_name(sys):
+    """The coordinates a (rotor) model declares, or None."""
+    frame = getattr(sys, 'frame', None)
+    return frame if isinstance(frame, str) else None
+
+
+def _constant_rtol(constant_rtol, sys):
+    """Tolerance on the variation of A below which A is taken as constant."""
+    if constant_rtol is not None:
+        rtol = float(constant_rtol)
+        if not (np.isfinite(rtol) and rtol >= 0):
+            raise ValueError(f"constant_rtol must be a non-negative number, got "
+                             f"{constant_rtol!r}")
+        return rtol
+    # a model read from printed data carries its relative precision
+    precision = getattr(sys, 'precision', None)
+    if isinstance(precision, float) and np.isfinite(precision) and precision > 0:
+        return max(1e-12, 20 * precision)
+    return 1e-12
+
+
+def _harmonic_count(sys, nharmonics, A0):
+    """Harmonics -K..K of the content of a time-invariant system's modes."""
+    if nharmonics is not None:
+        return check_positive_int(nharmonics, 'nharmonics')
+    ev = np.linalg.eigvals(A0)
+    radius = float(np.abs(ev).max(initial=0.0))
+    K = int(np.clip(np.ceil(1.5 * radius / sys.omega_p) + 4, 8, _KMAX))
+    # the eigenvalues' own branches must be resolved
+    return max(K, int(np.abs(np.round(ev.imag / sys.omega_p)).max(initial=0)) + 4)
 
 
 def _principal(share, harmonics, lam, sys, dtime, nper):

@@ -16,7 +16,7 @@ interpolation between sweep values.
 """
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import control as ct
@@ -25,7 +25,11 @@ from scipy.optimize import linear_sum_assignment
 
 from .._analysis.floquet_modes import floquet_modes
 from .._core.coerce import as_ltp
+from .._core.ltpsys import LTPStateSpace
+from .._core.periodic_matrix import PeriodicMatrix
 from .._core.validation import real_array
+from .mbc import mbc
+from .rotor_model import RotorStateSpace
 
 __all__ = ['campbell', 'CampbellDiagram']
 
@@ -60,7 +64,19 @@ class CampbellDiagram:
         ``(track, n, value, frequency)`` where track ``track`` crosses the
         nP line ``n Ω``.
     modes : tuple of FloquetModes
-        The modes at each value (in their own order).
+        The modes at each value (in their own order; empty for a diagram
+        read back by `load`).
+    indices : ndarray of int, shape (K, n)
+        The index of each track's mode in ``modes[k]``.
+    labels : tuple of str
+        A name for each track (e.g. ``'1st tower FA'``, ``'1st flap BW'``
+        from `campbell_lin`), or empty.
+    wind_speed : ndarray or None
+        Wind speed (m/s) at each value, when known.
+    xlabel : str
+        Name of the sweep value.
+    frame : str or None
+        Coordinates of the modes ('rotating', 'multiblade' or None).
 
     Examples
     --------
@@ -84,10 +100,115 @@ class CampbellDiagram:
     rotor_speed: np.ndarray
     crossings: list
     modes: tuple
+    labels: tuple = ()
+    indices: np.ndarray = None
+    wind_speed: np.ndarray = None
+    xlabel: str = 'sweep value'
+    frame: str = None
 
     def __repr__(self):
+        frame = f", {self.frame} frame" if self.frame else ""
         return (f"<CampbellDiagram: {self.frequency.shape[1]} tracks over "
-                f"{len(self.values)} values>")
+                f"{len(self.values)} values{frame}>")
+
+    def table(self, tracks=None):
+        """The diagram as columns of a long table: one row per value and track.
+
+        Columns: ``track``, ``label``, ``value``, ``rotor_speed_rpm``,
+        ``wind_speed`` (NaN when unknown), ``frequency_hz``,
+        ``damped_frequency_hz``, ``damping_ratio``, ``damping_percent``,
+        ``log_decrement`` (``2πζ/√(1-ζ²)``), ``principal_harmonic``.
+
+        Parameters
+        ----------
+        tracks : sequence of int, optional
+            Default: one track of each complex pair (those with
+            non-negative damped frequency at most values).
+
+        Returns
+        -------
+        dict of ndarray
+
+        Examples
+        --------
+        >>> A = lambda p: np.array([[0.0, 1.0], [-(4 + p), -0.2]])
+        >>> cd = ltp.campbell(lambda p: ltp.ltpss(A(p), np.zeros((2, 0)), np.zeros((0, 2)),
+        ...                                       0, period=1.0), [1.0, 2.0], n_jobs=1)
+        >>> t = cd.table()
+        >>> t['frequency_hz'].round(4), t['damping_percent'].round(3)
+        (array([0.3559, 0.3898]), array([4.472, 4.082]))
+        """
+        tracks = self._tracks(tracks)
+        K = len(self.values)
+        cols = {'track': np.repeat(np.asarray(tracks, int), K)}
+        labels = [self.labels[k] if k < len(self.labels) else '' for k in tracks]
+        cols['label'] = np.repeat(np.asarray(labels, dtype=object), K)
+        cols['value'] = np.tile(self.values, len(tracks))
+        cols['rotor_speed_rpm'] = np.tile(self.rotor_speed * 30 / np.pi, len(tracks))
+        wind = self.wind_speed if self.wind_speed is not None else np.full(K, np.nan)
+        cols['wind_speed'] = np.tile(np.asarray(wind, float), len(tracks))
+        cols['frequency_hz'] = self.frequency[:, tracks].T.ravel() / (2 * np.pi)
+        cols['damped_frequency_hz'] = self.damped_frequency[:, tracks].T.ravel() / (2 * np.pi)
+        zeta = self.damping[:, tracks].T.ravel()
+        cols['damping_ratio'] = zeta
+        cols['damping_percent'] = 100 * zeta
+        with np.errstate(invalid='ignore', divide='ignore'):
+            cols['log_decrement'] = 2 * np.pi * zeta / np.sqrt(1 - zeta ** 2)
+        cols['principal_harmonic'] = self.principal_harmonic[:, tracks].T.ravel()
+        return cols
+
+    def to_dataframe(self, tracks=None):
+        """The diagram as a pandas ``DataFrame`` (see ``table``; needs pandas).
+
+        Examples
+        --------
+        >>> A = lambda p: np.array([[0.0, 1.0], [-(4 + p), -0.2]])
+        >>> cd = ltp.campbell(lambda p: ltp.ltpss(A(p), np.zeros((2, 0)), np.zeros((0, 2)),
+        ...                                       0, period=1.0), [1.0, 2.0], n_jobs=1)
+        >>> cd.to_dataframe().shape
+        (2, 11)
+        """
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError("to_dataframe needs pandas (pip install pandas); to_csv and "
+                              "table work without it") from None
+        return pd.DataFrame(self.table(tracks))
+
+    def to_csv(self, path, tracks=None):
+        """Write the diagram's ``table`` to a CSV file (no pandas needed).
+
+        Examples
+        --------
+        >>> import csv, os, tempfile
+        >>> A = lambda p: np.array([[0.0, 1.0], [-(4 + p), -0.2]])
+        >>> cd = ltp.campbell(lambda p: ltp.ltpss(A(p), np.zeros((2, 0)), np.zeros((0, 2)),
+        ...                                       0, period=1.0), [1.0, 2.0], n_jobs=1)
+        >>> path = os.path.join(tempfile.mkdtemp(), 'campbell.csv')
+        >>> cd.to_csv(path)
+        >>> with open(path) as fh:
+        ...     rows = list(csv.DictReader(fh))
+        >>> len(rows), bool(float(rows[1]['frequency_hz']) == cd.frequency[1, 0] / (2 * np.pi))
+        (2, True)
+        """
+        import csv
+        cols = self.table(tracks)
+        names = list(cols)
+        with open(path, 'w', newline='') as fh:
+            writer = csv.writer(fh)
+            writer.writerow(names)
+            for i in range(len(cols['track'])):
+                writer.writerow([repr(float(cols[c][i])) if isinstance(cols[c][i], float)
+                                 else cols[c][i] for c in names])
+
+    def _tracks(self, tracks):
+        if tracks is None:
+            return [k for k in range(self.frequency.shape[1])
+                    if np.mean(self.damped_frequency[:, k] >= 0) >= 0.5]
+        tracks = [int(k) for k in tracks]
+        if any(not 0 <= k < self.frequency.shape[1] for k in tracks):
+            raise ValueError(f"tracks must be in 0..{self.frequency.shape[1] - 1}")
+        return tracks
 
     def track_crossings(self, i, j):
         """Values where tracks i and j have equal frequencies (linear interpolation).
@@ -110,8 +231,9 @@ class CampbellDiagram:
         d = self.frequency[:, i] - self.frequency[:, j]
         return _zeros(self.values, d)
 
-    def plot(self, ax=None, *, per_rev=(1, 2, 3), tracks=None, title=None):
-        """Campbell diagram: frequency and damping ratio against the sweep value.
+    def plot(self, ax=None, *, per_rev=(1, 2, 3), tracks=None, title=None, x='value',
+             frequency_unit='rad/s', damping='ratio', legend=None):
+        """Campbell diagram: frequency and damping against the sweep value.
 
         Parameters
         ----------
@@ -125,6 +247,15 @@ class CampbellDiagram:
             frequency at most values, one per complex pair).
         title : str, optional
             Figure title.
+        x : {'value', 'rpm', 'rotor_speed', 'wind_speed'}
+            Abscissa: the sweep value, the rotor speed in rpm or rad/s, or
+            the wind speed in m/s.
+        frequency_unit : {'rad/s', 'Hz'}
+        damping : {'ratio', 'percent', 'logdec'}
+            Damping ratio, in percent, or logarithmic decrement.
+        legend : bool, optional
+            Legend of the track labels (default: when the tracks have
+            labels).
 
         Returns
         -------
@@ -137,11 +268,39 @@ class CampbellDiagram:
         >>> A = lambda p: np.array([[0.0, 1.0], [-(4 + p), -0.2]])
         >>> cd = ltp.campbell(lambda p: ltp.ltpss(A(p), np.zeros((2, 0)), np.zeros((0, 2)),
         ...                                       0, period=1.0), [0.0, 1.0, 2.0], n_jobs=1)
-        >>> cplt = cd.plot()
-        >>> cplt.axes.shape
-        (2, 1)
+        >>> cplt = cd.plot(frequency_unit='Hz', damping='percent')
+        >>> cplt.axes.shape, cplt.axes[0, 0].get_ylabel()
+        ((2, 1), 'frequency [Hz]')
         """
         import matplotlib.pyplot as plt
+        if x == 'value':
+            xs, xlabel = self.values, self.xlabel
+        elif x == 'rpm':
+            xs, xlabel = self.rotor_speed * 30 / np.pi, 'rotor speed [rpm]'
+        elif x == 'rotor_speed':
+            xs, xlabel = self.rotor_speed, 'rotor speed [rad/s]'
+        elif x == 'wind_speed':
+            if self.wind_speed is None:
+                raise ValueError("x='wind_speed': the diagram has no wind speeds")
+            xs, xlabel = np.asarray(self.wind_speed, float), 'wind speed [m/s]'
+        else:
+            raise ValueError(f"x must be 'value', 'rpm', 'rotor_speed' or 'wind_speed', "
+                             f"got {x!r}")
+        if frequency_unit not in ('rad/s', 'Hz'):
+            raise ValueError(f"frequency_unit must be 'rad/s' or 'Hz', got {frequency_unit!r}")
+        fscale = 1 / (2 * np.pi) if frequency_unit == 'Hz' else 1.0
+        zeta = self.damping
+        if damping == 'ratio':
+            dvals, dlabel = zeta, 'damping ratio'
+        elif damping == 'percent':
+            dvals, dlabel = 100 * zeta, 'damping ratio [%]'
+        elif damping == 'logdec':
+            with np.errstate(invalid='ignore', divide='ignore'):
+                dvals = 2 * np.pi * zeta / np.sqrt(1 - zeta ** 2)
+            dlabel = 'logarithmic decrement'
+        else:
+            raise ValueError(f"damping must be 'ratio', 'percent' or 'logdec', got "
+                             f"{damping!r}")
         if ax is None:
             fig, ax = plt.subplots(2, 1, sharex=True, squeeze=False)
             ax = ax[:, 0]
@@ -150,26 +309,29 @@ class CampbellDiagram:
             if ax.size != 2:
                 raise ControlArgument("ax must hold two axes (frequency, damping)")
             fig = ax[0].figure
-        if tracks is None:
-            tracks = [k for k in range(self.frequency.shape[1])
-                      if np.mean(self.damped_frequency[:, k] >= 0) >= 0.5]
+        tracks = self._tracks(tracks)
         lines = np.empty((2, 1), dtype=object)
         freq_lines, damp_lines = [], []
         for k in tracks:
-            freq_lines += ax[0].plot(self.values, self.frequency[:, k], label=f'track {k}')
-            damp_lines += ax[1].plot(self.values, self.damping[:, k],
-                                     color=freq_lines[-1].get_color())
+            label = self.labels[k] if k < len(self.labels) and self.labels[k] else \
+                f'track {k}'
+            freq_lines += ax[0].plot(xs, fscale * self.frequency[:, k], label=label)
+            damp_lines += ax[1].plot(xs, dvals[:, k], color=freq_lines[-1].get_color())
         for n in per_rev:
-            freq_lines += ax[0].plot(self.values, n * self.rotor_speed, 'k--', lw=0.7)
-            ax[0].annotate(f'{n}P', (self.values[-1], n * self.rotor_speed[-1]),
+            freq_lines += ax[0].plot(xs, fscale * n * self.rotor_speed, 'k--', lw=0.7)
+            ax[0].annotate(f'{n}P', (xs[-1], fscale * n * self.rotor_speed[-1]),
                            fontsize='small')
         for _, n, value, freq in self.crossings:
             if n in per_rev:
-                ax[0].plot(value, freq, 'ko', ms=3)
+                at = np.interp(value, self.values, xs) if self.values[-1] > self.values[0] \
+                    else np.interp(value, self.values[::-1], xs[::-1])
+                ax[0].plot(at, fscale * freq, 'ko', ms=3)
         ax[1].axhline(0, color='k', lw=0.5)
-        ax[0].set_ylabel('frequency [rad/s]')
-        ax[1].set_ylabel('damping ratio')
-        ax[1].set_xlabel('sweep value')
+        ax[0].set_ylabel(f'frequency [{frequency_unit}]')
+        ax[1].set_ylabel(dlabel)
+        ax[1].set_xlabel(xlabel)
+        if legend or (legend is None and any(self.labels)):
+            ax[0].legend(fontsize='x-small', ncol=2)
         lines[0, 0], lines[1, 0] = freq_lines, damp_lines
         if title:
             fig.suptitle(title)
@@ -255,14 +417,17 @@ def campbell(factory, values, *, rotor_speed=None, per_rev=(1, 2, 3), branch='co
             raise ValueError(f"rotor_speed must have one value per sweep value "
                              f"({len(values)}), got {len(speeds)}")
     jobs = _jobs(n_jobs, len(values))
+    if isinstance(frame, str) and frame != 'multiblade':
+        raise ValueError(f"frame must be 'multiblade', a matrix, a PeriodicMatrix or a "
+                         f"callable, got {frame!r}")
     kwargs = dict(frame=frame, nharmonics=nharmonics)
     if jobs == 1 and backend is None:
-        modes = [_modes_at(factory, v, kwargs) for v in values]
+        modes = [_modes_at(factory, v, w, kwargs) for v, w in zip(values, speeds)]
     else:
         import joblib
         with joblib.parallel_config(backend=backend or 'loky', n_jobs=jobs):
-            modes = joblib.Parallel()(joblib.delayed(_modes_at)(factory, v, kwargs)
-                                      for v in values)
+            modes = joblib.Parallel()(joblib.delayed(_modes_at)(factory, v, w, kwargs)
+                                      for v, w in zip(values, speeds))
     sizes = {len(m) for m in modes}
     if len(sizes) != 1:
         raise ValueError(f"the models of the sweep have different numbers of states {sizes}")
@@ -271,6 +436,7 @@ def campbell(factory, values, *, rotor_speed=None, per_rev=(1, 2, 3), branch='co
     perm = np.zeros((K, n), int)
     perm[0] = np.arange(n)
     mac = np.zeros((K - 1, n))
+    modes = list(modes)
     for k in range(1, K):
         prev, cur = modes[k - 1], modes[k]
         cost, macs = _cost(prev, cur)
@@ -278,6 +444,8 @@ def campbell(factory, values, *, rotor_speed=None, per_rev=(1, 2, 3), branch='co
         rows, cols = linear_sum_assignment(cost[perm[k - 1]])
         perm[k, rows] = cols
         mac[k - 1, rows] = macs[perm[k - 1][rows], cols]
+        # modes of a repeated exponent: the basis that follows the previous shapes
+        modes[k] = _follow(prev, cur, perm[k - 1][rows], cols)
     pick = lambda attr: np.array([getattr(m, attr)[p] for m, p in zip(modes, perm)])
     exps, hstar = pick('exponents'), pick('principal_harmonic')
     if branch not in ('continuous', 'principal'):
@@ -294,7 +462,9 @@ def campbell(factory, values, *, rotor_speed=None, per_rev=(1, 2, 3), branch='co
         damping = np.where(freq > 0, -exps.real / np.where(freq > 0, freq, 1.0),
                            -np.sign(exps.real))
     crossings = []
-    for track in range(n):
+    # one track of each complex pair: those turning forward at most values
+    upper = [k for k in range(n) if np.mean(exps[:, k].imag >= 0) >= 0.5]
+    for track in upper:
         for nrev in per_rev:
             for value in _zeros(values, freq[:, track] - nrev * speeds):
                 crossings.append((track, int(nrev), float(value),
@@ -304,12 +474,34 @@ def campbell(factory, values, *, rotor_speed=None, per_rev=(1, 2, 3), branch='co
     return CampbellDiagram(values=values, exponents=exps, frequency=freq,
                            damped_frequency=exps.imag, damping=damping,
                            principal_harmonic=hstar, mac=mac,
-                           rotor_speed=speeds, crossings=crossings, modes=tuple(modes))
+                           rotor_speed=speeds, crossings=crossings, modes=tuple(modes),
+                           indices=perm)
 
 
-def _modes_at(factory, value, kwargs):
-    sys = as_ltp(factory(value), 'factory(value)')
+def _modes_at(factory, value, speed, kwargs):
+    sys = factory(value)
+    if isinstance(sys, ct.StateSpace) and not isinstance(sys, LTPStateSpace):
+        # an LTI model (e.g. an azimuth average) viewed over one revolution
+        if sys.isdtime(strict=True):
+            raise ControlArgument("factory(value) returned a discrete-time LTI model: "
+                                  "return an LTPStateSpace")
+        sys = as_ltp(sys, 'factory(value)',
+                     period=2 * np.pi / speed if speed > 0 else 2 * np.pi)
+    sys = as_ltp(sys, 'factory(value)')
+    kwargs = dict(kwargs)
+    if isinstance(kwargs['frame'], str):
+        kwargs['frame'] = _multiblade_frame(sys)
     return floquet_modes(sys, **kwargs)
+
+
+def _multiblade_frame(sys):
+    """``T(t)⁻¹`` of the multi-blade transform of a rotating-frame rotor model."""
+    if not isinstance(sys, RotorStateSpace) or sys.frame != 'rotating':
+        raise ValueError("frame='multiblade' needs rotor models in the rotating frame "
+                         "(read_lin, or a RotorStateSpace with rotating-frame flags)")
+    _, P = mbc(sys, nblades=sys.nblades or 3)
+    return PeriodicMatrix.from_function(lambda t: np.linalg.inv(P(t)), P.period, P.shape,
+                                        check=False)
 
 
 def _jobs(n_jobs, nvalues):
@@ -321,6 +513,56 @@ def _jobs(n_jobs, nvalues):
     return int(min(n_jobs, cores, nvalues))
 
 
+def _repeated(modes, tol=1e-6):
+    """Groups (size > 1) of modes with equal exponents (relative `tol`)."""
+    lam = modes.exponents
+    scale = max(np.abs(lam).max(initial=0.0), 1e-300)
+    out, done = [], np.zeros(len(lam), bool)
+    for i in range(len(lam)):
+        if done[i]:
+            continue
+        g = np.flatnonzero((np.abs(lam - lam[i]) <= tol * scale) & ~done)
+        done[g] = True
+        if len(g) > 1:
+            out.append(g)
+    return out
+
+
+def _follow(prev, cur, src, dst):
+    """`cur` with the basis of each repeated exponent rotated to follow `prev`'s shapes."""
+    groups = _repeated(cur)
+    if not groups:
+        return cur
+    keep = min(prev.shapes.shape[-1], cur.shapes.shape[-1]) // 2
+    U, V = _harmonics(prev.shapes, keep), _harmonics(cur.shapes, keep)
+    vectors, left, shapes = cur.vectors.copy(), cur.left_vectors.copy(), cur.shapes.copy()
+    match = dict(zip(dst, src))
+    for g in groups:
+        targets = [match[j] for j in g if j in match]
+        if len(targets) != len(g) or not np.all(np.isfinite(V[g])):
+            continue
+        # R: the combinations of the group's shapes nearest the previous ones
+        R = np.linalg.lstsq(V[g].T, U[targets].T, rcond=None)[0]
+        norms = np.linalg.norm(cur.vectors[:, g] @ R, axis=0)
+        if np.any(norms == 0) or np.linalg.cond(R) > 1e8:
+            continue
+        R = R / norms
+        vectors[:, g] = cur.vectors[:, g] @ R
+        left[:, g] = cur.left_vectors[:, g] @ np.linalg.inv(R).conj().T
+        shapes[:, g] = np.einsum('rit,ij->rjt', cur.shapes[:, g], R)
+    return replace(cur, vectors=vectors, left_vectors=left, shapes=shapes)
+
+
+def _subspace_mac(X, Y, groups):
+    """MAC of the rows of X with the span of each group of rows of Y (mode, coords)."""
+    out = {}
+    for g in groups:
+        Q, _ = np.linalg.qr(Y[g].T)
+        proj = np.sum(np.abs(np.conj(Q).T @ X.T) ** 2, axis=0)
+        out[tuple(g)] = proj / np.maximum(np.sum(np.abs(X) ** 2, axis=1), 1e-300)
+    return out
+
+
 def _cost(prev, cur):
     """Assignment cost and MAC between the modes of two neighbouring values."""
     # MAC over the period = MAC of the Fourier coefficients (Parseval), on the
@@ -330,6 +572,12 @@ def _cost(prev, cur):
     cross = np.abs(np.conj(U) @ V.T) ** 2
     norms = np.outer(np.sum(np.abs(U) ** 2, axis=1), np.sum(np.abs(V) ** 2, axis=1))
     macs = np.divide(cross, norms, out=np.zeros_like(cross), where=norms > 0)
+    # a repeated exponent has a subspace of shapes: MAC with the subspace
+    if np.all(np.isfinite(U)) and np.all(np.isfinite(V)):
+        for g, m in _subspace_mac(U, V, _repeated(cur)).items():
+            macs[:, list(g)] = np.maximum(macs[:, list(g)], m[:, None])
+        for g, m in _subspace_mac(V, U, _repeated(prev)).items():
+            macs[list(g), :] = np.maximum(macs[list(g), :], m[None, :])
     lam_u, lam_v = prev.exponents, cur.exponents
     scale = max(np.abs(lam_u).max(), np.abs(lam_v).max(), 1e-300)
     dist = np.abs(lam_u[:, None] - lam_v[None, :]) / scale

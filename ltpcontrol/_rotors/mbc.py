@@ -30,6 +30,7 @@ from control.exception import ControlArgument, ControlDimension
 from .._core.periodic_matrix import PeriodicMatrix
 from .._core.coerce import as_ltp
 from .._core.validation import check_positive_int
+from .blade_groups import blade_key, check_groups, infer_blade_groups
 from .rotor_model import RotorStateSpace, sampled_matrix
 
 __all__ = ['mbc', 'coleman_matrix']
@@ -97,9 +98,15 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
         coordinates (``inverse=True``); its time axis is the rotor's (blade-1
         azimuth ``ψ(t) = ψ_0 + ∫Ω``).  A `RotorStateSpace` supplies its rotor
         speed, azimuth and samples.
-    rotating : sequence of sequences, optional
+    rotating : sequence of sequences or int, optional
         Groups of blade states: each group lists the N states (indices or
-        labels) of one blade degree of freedom, blade 1 first.  For a
+        labels) of one blade degree of freedom, blade 1 first.  Default
+        (a `RotorStateSpace`): inferred from the descriptions and
+        rotating-frame flags, for ElastoDyn, BeamDyn, AeroDyn and ServoDyn
+        states in any module order.  An integer is taken as `nblades`
+        (``mbc(lin, 3)``).  Groups given for a model with descriptions are
+        checked against them (blades 1..N in order, each rate the
+        derivative of its displacement).  For a
         second-order degree of freedom, the group of displacements.  In
         multi-blade coordinates, group member j is coordinate j (collective,
         cosine, sine, ..., differential).
@@ -139,7 +146,10 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
     ------
     ValueError
         If a group does not have `nblades` members, a state is in two
-        groups, or the rotor speed is not commensurate with the period.
+        groups, the rotor speed is not commensurate with the period, the
+        groups contradict the descriptions (blade order, rates), the model
+        has no rotating states, or it is in multi-blade coordinates already
+        (``inverse=False``).
 
     Examples
     --------
@@ -159,10 +169,20 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
     True
     """
     sys = as_ltp(sys)
+    if isinstance(rotating, numbers.Integral) and not isinstance(rotating, bool):
+        # mbc(sys, 3): the blade count in second place (MBC3's habit)
+        nblades, rotating = rotating, None
     N = check_positive_int(nblades, 'nblades', minimum=2)
     n, m, p = sys.nstates, sys.ninputs, sys.noutputs
     T = sys.period
     rotor = isinstance(sys, RotorStateSpace)
+    if rotor and sys.frame == 'multiblade' and not inverse:
+        raise ValueError(f"{sys.name} is already in multi-blade coordinates (frame "
+                         "'multiblade'): transform it back with inverse=True, or pass the "
+                         "rotating-frame model")
+    if rotor and sys.frame == 'rotating' and inverse and sys.nblades is not None:
+        raise ValueError(f"{sys.name} is in the rotating frame already: inverse=True "
+                         "transforms a multi-blade model back")
     if rotating is None:
         if not rotor:
             raise ControlArgument("rotating is needed unless sys is a RotorStateSpace with "
@@ -184,8 +204,21 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
         raise ValueError("rotating and rates must name every state at most once")
     in_groups = _groups(rotating_inputs or [], N, sys.input_labels, 'rotating_inputs')
     out_groups = _groups(rotating_outputs or [], N, sys.output_labels, 'rotating_outputs')
+    if not groups and not in_groups and not out_groups:
+        raise ValueError(f"{sys.name} has no rotating states, inputs or outputs (none is "
+                         "flagged in the rotating frame, or rotating is empty): there is "
+                         "nothing to transform to multi-blade coordinates")
+    if rotor:
+        # the groups must agree with the descriptions: blades 1..N in order, rates of
+        # their own displacements
+        check_groups(groups, rate_groups, sys.state_descriptions, 'rotating')
+        check_groups(in_groups, [None] * len(in_groups), sys.input_descriptions,
+                     'rotating_inputs')
+        check_groups(out_groups, [None] * len(out_groups), sys.output_descriptions,
+                     'rotating_outputs')
     psi0 = float(azimuth0 if azimuth0 is not None else
                  (sys.azimuth0 if rotor else 0.0))
+    rotor_given = rotor_speed
     if rotor_speed is None:
         rotor_speed = sys.rotor_speed if rotor else 2 * np.pi / T
     speed = _speed(rotor_speed, T)
@@ -217,9 +250,11 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
             P[np.ix_(g, g)], Pinv[np.ix_(g, g)] = T0, w[:, None] * T0.T
         return P, Pinv
 
-    def transformed(t, mats, which=(0, 1, 2, 3)):
+    def transformed(t, mats, which=(0, 1, 2, 3), at_speed=None):
         """The transformed matrices `which` (0: A, 1: B, 2: C, 3: D) at time t."""
         omega, domega, psi = speed(t, psi0)
+        if at_speed is not None:
+            omega, domega = at_speed
         P, Pinv, dP = state_transform(omega, domega, psi)
         (Pu, Puinv), (Py, Pyinv) = signal_transform(m, in_groups, psi), \
             signal_transform(p, out_groups, psi)
@@ -265,8 +300,14 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
         times = np.mod((np.asarray(sys.azimuths) - psi0) / omega, T) if omega else \
             np.zeros(len(sys.azimuths))
         samples = [[], [], [], []]
+        # the samples' own Ω and Ω̇ (operating point), as MBC3 takes them
+        own = getattr(sys, 'sample_speeds', None)
+        acc = getattr(sys, 'sample_accelerations', None)
+        use_own = rotor_given is None and own is not None and acc is not None and \
+            len(own) == len(times) and sys.rotor_speed > 0
         for s, t in enumerate(times):
-            out = transformed(t, [M[s] for M in sys.samples])
+            out = transformed(t, [M[s] for M in sys.samples],
+                              at_speed=(own[s], acc[s]) if use_own else None)
             for j in range(4):
                 samples[j].append(out[j])
         samples = tuple(np.array(M).reshape((len(times),) + sys.samples[j].shape[1:])
@@ -349,84 +390,68 @@ def _check_revolutions(mean, T):
 
 
 def _infer_groups(sys, N):
-    """Blade groups from a rotor model's flags, in OpenFAST's state order."""
+    """Blade groups from a rotor model's flags and descriptions (any module order)."""
     flags, order = np.asarray(sys.rotating_states, bool), np.asarray(sys.derivative_order)
-    n2 = int(np.count_nonzero(order == 2))
+    desc = sys.state_descriptions
     if np.any(flags & (order == 0)):
-        raise ValueError("the derivative order of rotating states is unknown: give rotating "
-                         "(and rates) explicitly")
+        raise ValueError("the derivative order of rotating states is unknown (e.g. "
+                         f"{desc[int(np.flatnonzero(flags & (order == 0))[0])]!r}): give "
+                         "rotating (and rates) explicitly")
+    groups, rates, left = infer_blade_groups(desc, flags, order, N, 'states')
+    if left:
+        # descriptions without a common pattern: OpenFAST's order of the states
+        try:
+            groups, rates = _positional_groups(flags, order, desc, N)
+        except ValueError as exc:
+            raise ValueError(f"{len(left)} rotating states form no group of nblades = {N} "
+                             f"blades by their descriptions ({[desc[i] for i in left][:6]}) "
+                             f"nor by their order ({exc}); give rotating (and rates) "
+                             "explicitly") from None
+    ins = _signal_groups(sys.rotating_inputs, sys.input_descriptions, N, 'inputs')
+    outs = _signal_groups(sys.rotating_outputs, sys.output_descriptions, N, 'outputs')
+    return groups, rates, ins, outs
+
+
+def _positional_groups(flags, order, desc, N):
+    """Consecutive blade groups in OpenFAST's state order (displacements, rates, first order)."""
+    n2 = int(np.count_nonzero(order == 2))
     if n2 % 2 or not np.all(order[:n2] == 2):
-        raise ValueError("the second-order states must come first, displacements then rates "
-                         "(OpenFAST's order): give rotating and rates explicitly")
+        raise ValueError("the second-order states do not come first, displacements then "
+                         "rates")
     half = n2 // 2
     if np.any(flags[:half] != flags[half:n2]):
         raise ValueError("the rotating-frame flags of the displacements and of their rates "
-                         "differ: give rotating and rates explicitly")
+                         "differ")
 
-    def consecutive(indices, what, descriptions):
+    def consecutive(indices, what):
         if len(indices) % N:
             raise ValueError(f"{len(indices)} rotating {what} cannot be split into groups of "
                              f"nblades = {N}: wrong blade count")
-        groups = [list(indices[i:i + N]) for i in range(0, len(indices), N)]
+        groups = [[int(i) for i in indices[k:k + N]] for k in range(0, len(indices), N)]
         for g in groups:
-            blades = [_blade_number(descriptions[i]) for i in g]
+            blades = [blade_key(desc[i], loose=False)[1] for i in g]
             if all(b is not None for b in blades) and blades != list(range(1, N + 1)):
-                raise ValueError(f"rotating {what} {g} describe blades {blades}, not 1..{N}: "
-                                 "wrong blade count or order")
+                raise ValueError(f"rotating {what} {[desc[i] for i in g]} describe blades "
+                                 f"{blades}, not 1..{N}: wrong blade count or order")
         return groups
 
-    desc = sys.state_descriptions
-    disp = consecutive(np.flatnonzero(flags[:half]), 'displacements', desc)
-    first = consecutive(n2 + np.flatnonzero(flags[n2:]), 'first-order states', desc)
-    rates = [[i + half for i in g] for g in disp] + [None] * len(first)
-    ins = _signal_groups(np.flatnonzero(sys.rotating_inputs), sys.input_descriptions, N,
-                         'inputs')
-    outs = _signal_groups(np.flatnonzero(sys.rotating_outputs), sys.output_descriptions, N,
-                          'outputs')
-    return disp + first, rates, ins, outs
+    disp = consecutive(np.flatnonzero(flags[:half]), 'displacements')
+    first = consecutive(n2 + np.flatnonzero(flags[n2:]), 'first-order states')
+    return disp + first, [[i + half for i in g] for g in disp] + [None] * len(first)
 
 
-def _signal_groups(indices, descriptions, N, what):
-    """Blade groups of rotating inputs or outputs, matched by their names.
+def _signal_groups(flags, descriptions, N, what):
+    """Blade groups of rotating inputs or outputs, matched by their descriptions.
 
-    Items whose descriptions differ only in the blade number ('Blade 2 pitch',
-    'TipDxb2') form a group of N; flagged items that form no complete group
-    stay in the rotating frame, with a warning.
+    Flagged items that form no complete group stay in the rotating frame,
+    with a warning naming them.
     """
-    keyed = {}
-    for i in indices:
-        key, blade = _blade_key(descriptions[i])
-        keyed.setdefault(key, []).append((blade, int(i)))
-    groups, left = [], []
-    for key, items in keyed.items():
-        blades = sorted(b for b, _ in items)
-        if key is not None and blades == list(range(1, N + 1)):
-            groups.append([i for _, i in sorted(items)])
-        else:
-            left += [i for _, i in items]
+    groups, _, left = infer_blade_groups(descriptions, flags, None, N, what)
     if left:
-        warnings.warn(f"{len(left)} rotating {what} form no group of {N} blades (e.g. "
-                      f"{descriptions[left[0]]!r}); they are left in the rotating frame",
-                      UserWarning, stacklevel=4)
+        warnings.warn(f"{len(left)} rotating {what} form no group of {N} blades "
+                      f"({[descriptions[i] for i in left][:4]}); they are left in the "
+                      "rotating frame", UserWarning, stacklevel=4)
     return groups
-
-
-def _blade_key(text):
-    """(description without its blade number, blade number), or (None, None)."""
-    m = re.search(r'blade\s*(\d+)', text, re.I)
-    if m:
-        return text[:m.start()] + 'blade #' + text[m.end():], int(m.group(1))
-    name, _, rest = text.partition(',')
-    m = re.match(r'^(.*?\D)(\d)(\D*)$', name.strip())
-    if m:
-        return m.group(1) + '#' + m.group(3) + ',' + rest, int(m.group(2))
-    return None, None
-
-
-def _blade_number(text):
-    """The blade a description names ('blade 2', 'Blade2', 'B2...'), or None."""
-    m = re.search(r'blade\s*(\d+)', text, re.I)
-    return int(m.group(1)) if m else None
 
 
 def _groups(spec, N, labels, what):

@@ -11,12 +11,15 @@ the periodic model is the trigonometric interpolant of the samples in
 or a zero-order hold.
 """
 
+import glob
 import os
+import pathlib
 import re
 
 import numpy as np
 from control.exception import ControlArgument
 
+from .blade_groups import derivative_orders
 from .rotor_model import RotorStateSpace, sampled_matrix
 
 __all__ = ['read_lin']
@@ -31,14 +34,54 @@ _ROW = re.compile(r'^\s*(\d+)\s+(.*?)\s+([TF])\s+(?:(\d+)\s+)?(.*?)\s*$')
 _MATRIX = re.compile(r'^\s*([A-Za-z]\w*):\s*(\d+)\s*x\s*(\d+)\s*$')
 
 
+def lin_files(files):
+    """The ``.lin`` files named by a path, a folder, a glob pattern or a sequence.
+
+    Examples
+    --------
+    >>> import pathlib
+    >>> from ltpcontrol._rotors.read_lin import lin_files
+    >>> data = pathlib.Path(ltp.__file__).parents[1] / 'tests' / 'data'
+    >>> [p.name for p in lin_files(str(data / 'ws03.0.*.lin'))]
+    ['ws03.0.1.lin', 'ws03.0.13.lin', 'ws03.0.34.lin']
+    """
+    if isinstance(files, (str, os.PathLike)):
+        path = pathlib.Path(files)
+        if path.is_dir():
+            found = sorted(path.glob('*.lin'), key=_natural)
+            if not found:
+                raise ValueError(f"the folder {path} holds no .lin file")
+            return found
+        if any(c in str(files) for c in '*?['):
+            found = sorted((pathlib.Path(f) for f in glob.glob(str(files))), key=_natural)
+            if not found:
+                raise ValueError(f"no file matches {str(files)!r}")
+            return found
+        return [path]
+    try:
+        out = [pathlib.Path(f) for f in files]
+    except TypeError:
+        raise ControlArgument("files must be a path, a folder, a glob pattern or a sequence "
+                              f"of paths, got {type(files).__name__}") from None
+    if not out:
+        raise ValueError("files must name at least one .lin file")
+    return out
+
+
+def _natural(path):
+    """Sort key: numbers in the name by value (Main.2.lin before Main.10.lin)."""
+    return [int(t) if t.isdigit() else t for t in re.split(r'(\d+)', str(path))]
+
+
 def read_lin(files, *, interpolation='auto', overflow='raise', atol_azimuth=1e-3,
-             name=None):
+             remove_states=None, drop_near_tower=None, nblades=3, name=None):
     """Read OpenFAST ``.lin`` files (one per azimuth) into a rotor model.
 
     Parameters
     ----------
     files : str, path or sequence of them
-        The linearization files of one operating point, in any order.
+        The linearization files of one operating point, in any order: a
+        file, a folder (all its ``*.lin``), a glob pattern, or a sequence.
     interpolation : {'auto', 'fourier', 'hold', 'samples'}
         How the periodic matrices are formed from uniform azimuth samples:
         'fourier' (trigonometric interpolation), 'hold' (each sample held
@@ -55,6 +98,19 @@ def read_lin(files, *, interpolation='auto', overflow='raise', atol_azimuth=1e-3
     atol_azimuth : float
         Tolerance (rad) on the uniform spacing of the azimuths (OpenFAST
         prints them with 4 decimals).
+    remove_states : str, optional
+        Regular expression: the states whose descriptions match it are
+        removed (rows and columns of A, rows of B, columns of C), as
+        MBC3's ``removeStatesPattern``.
+    drop_near_tower : float, optional
+        Half-width (degrees) of the azimuth ranges around the tower passage
+        of a blade (blade b at 180°: ``ψ = 180° - 360°(b-1)/nblades``)
+        whose files are left out, as MBC3's ``removeTwrAzimuth`` (4° around
+        60°, 180°, 300° for three blades).  The remaining azimuths are
+        not uniform: the model keeps samples only (``average(method=
+        'samples')``).
+    nblades : int
+        Number of blades, for `drop_near_tower`.
     name : str, optional
         Name of the model.
 
@@ -85,11 +141,7 @@ def read_lin(files, *, interpolation='auto', overflow='raise', atol_azimuth=1e-3
     >>> lin.derivative_order[:3], lin.rotating_states[6:9]
     (array([2, 2, 2]), array([ True,  True,  True]))
     """
-    if isinstance(files, (str, os.PathLike)):
-        files = [files]
-    files = list(files)
-    if not files:
-        raise ValueError("files must name at least one .lin file")
+    files = lin_files(files)
     if interpolation not in ('auto', 'fourier', 'hold', 'samples'):
         raise ValueError("interpolation must be 'auto', 'fourier', 'hold' or 'samples', got "
                          f"{interpolation!r}")
@@ -100,6 +152,8 @@ def read_lin(files, *, interpolation='auto', overflow='raise', atol_azimuth=1e-3
             raise ControlArgument(f"overflow must be 'raise' or a number, got {overflow!r}") \
                 from None
     parsed = [_parse(f, overflow) for f in files]
+    if drop_near_tower is not None:
+        files, parsed = _drop_near_tower(files, parsed, drop_near_tower, nblades)
     first = parsed[0]
     for f, d in zip(files[1:], parsed[1:]):
         for key in ('nstates', 'ninputs', 'noutputs'):
@@ -127,8 +181,14 @@ def read_lin(files, *, interpolation='auto', overflow='raise', atol_azimuth=1e-3
                          "linearizations")
     uniform = bool(np.all(np.abs(gaps - 2 * np.pi / S) <= atol_azimuth))
     standstill = omega == 0
+    single = S == 1 and not standstill
+    if single and interpolation in ('fourier', 'hold'):
+        raise ValueError(f"one azimuth at rotor speed {omega:.4g} rad/s defines no periodic "
+                         "model: a constant model would assume the rotating-frame matrices "
+                         "do not depend on the azimuth; use mbc and average(method='samples') "
+                         "(exact for an isotropic rotor), or linearize at more azimuths")
     if interpolation == 'auto':
-        interp = 'fourier' if uniform and not standstill else None
+        interp = 'fourier' if uniform and not standstill and not single else None
     elif interpolation == 'samples':
         interp = None
     else:
@@ -141,6 +201,9 @@ def read_lin(files, *, interpolation='auto', overflow='raise', atol_azimuth=1e-3
             raise ValueError("the rotor is at standstill (rotor speed 0): no periodic model")
         interp = interpolation
     samples = tuple(np.array([d[key] for d in parsed]) for key in 'ABCD')
+    tables = {key: first[key] for key in ('states', 'inputs', 'outputs')}
+    if remove_states is not None:
+        samples, tables = _remove_states(samples, tables, remove_states)
     # time axis: ψ(t) = ψ_0 + Ω t; a rotor at standstill is time-invariant
     if standstill:
         period = 2 * np.pi
@@ -154,8 +217,10 @@ def read_lin(files, *, interpolation='auto', overflow='raise', atol_azimuth=1e-3
         period = 2 * np.pi / omega
         mats = [sampled_matrix(M, psi, psi[0], period, interp, nm)
                 for M, nm in zip(samples, 'ABCD')]
-    tables = {key: first[key] for key in ('states', 'inputs', 'outputs')}
     rotor = dict(
+        precision=min(d['precision'] for d in parsed),
+        sample_speeds=np.array([d['speed_op'][0] for d in parsed]),
+        sample_accelerations=np.array([d['speed_op'][1] for d in parsed]),
         rotor_speed=omega, azimuth0=float(psi[0]), azimuths=psi, samples=samples,
         interpolation=interp, frame='rotating',
         state_descriptions=[r[4] for r in tables['states']],
@@ -164,7 +229,7 @@ def read_lin(files, *, interpolation='auto', overflow='raise', atol_azimuth=1e-3
         rotating_states=np.array([r[2] for r in tables['states']], bool),
         rotating_inputs=np.array([r[2] for r in tables['inputs']], bool),
         rotating_outputs=np.array([r[2] for r in tables['outputs']], bool),
-        derivative_order=np.array([r[3] for r in tables['states']], int),
+        derivative_order=_orders(tables['states']),
         wind_speed=None if np.isnan(first['wind_speed']) else first['wind_speed'])
     label = name or os.path.basename(str(files[0])).split('.')[0]
     return RotorStateSpace(*mats, period, rotor=rotor, name=label)
@@ -191,6 +256,7 @@ def _parse(path, overflow):
         out[key] = int(value) if key.startswith('n') else _number(value, path, key, overflow)
     for key, title in _TABLES.items():
         out[key] = _table(lines, title, out['n' + key], path)
+    out['speed_op'] = _operating_speed(lines, out, path, overflow)
     mats = {}
     i = 0
     while i < len(lines):
@@ -209,6 +275,10 @@ def _parse(path, overflow):
     if 'A' not in mats and n > 0:
         raise ValueError(f"{path} has no state matrix A")
     shapes = {'A': (n, n), 'B': (n, nu), 'C': (ny, n), 'D': (ny, nu)}
+    # relative precision of the printed entries (half a unit of the last digit)
+    digits = [len(re.sub(r'\D', '', t.split('E')[0].split('e')[0]).lstrip('0') or '0')
+              for t in text_digits(lines, 40)]
+    out['precision'] = 0.5 * 10.0 ** (1 - max(1, min(digits))) if digits else np.nan
     for key, shape in shapes.items():
         M = mats.get(key, np.zeros(shape))
         if M.shape != shape:
@@ -248,3 +318,102 @@ def _number(text, path, where, overflow):
         return float(text)
     except ValueError:
         raise ValueError(f"{path}: cannot read {where} = {text!r} as a number") from None
+
+
+def _orders(rows):
+    """Derivative orders of the states; inferred from the descriptions in old files."""
+    order = np.array([r[3] for r in rows], int)
+    if len(order) and np.all(order == 0):
+        # files of OpenFAST before v2.2 have no 'Derivative Order' column
+        order = derivative_orders([r[4] for r in rows])
+    return order
+
+
+def text_digits(lines, count):
+    """Up to `count` mantissa strings of nonzero entries of the matrix A."""
+    out = []
+    for i, ln in enumerate(lines):
+        if re.match(r'^\s*A:\s*\d+\s*x\s*\d+', ln):
+            for row in lines[i + 1:]:
+                for tok in row.split():
+                    try:
+                        if float(tok) != 0:
+                            out.append(tok)
+                    except ValueError:
+                        return out
+                    if len(out) >= count:
+                        return out
+            break
+    return out
+
+
+def _remove_states(samples, tables, pattern):
+    """Samples and tables without the states whose descriptions match `pattern`."""
+    try:
+        regex = re.compile(pattern)
+    except (re.error, TypeError):
+        raise ControlArgument(f"remove_states must be a regular expression, got "
+                              f"{pattern!r}") from None
+    keep = np.array([not regex.search(r[4]) for r in tables['states']])
+    if not np.any(~keep):
+        raise ValueError(f"remove_states {pattern!r} matches no state description")
+    A, B, C, D = samples
+    samples = (A[:, keep][:, :, keep], B[:, keep], C[:, :, keep], D)
+    tables = dict(tables, states=[r for r, k in zip(tables['states'], keep) if k])
+    return samples, tables
+
+
+def _operating_speed(lines, out, path, overflow):
+    """Ω and Ω̇ of the operating point, as MBC3 takes them.
+
+    The time derivatives at the operating point of the generator azimuth
+    (``DOF_GeAz``) and of its rate, plus those of the drivetrain torsion
+    (``DOF_DrTr``); the header's rotor speed and Ω̇ = 0 when the file has no
+    such states (or no table of state derivatives).
+    """
+    omega, domega = out['rotor_speed'], 0.0
+    n = out['nstates']
+    title = 'Order of continuous state derivatives:'
+    if n == 0 or not any(ln.strip() == title for ln in lines):
+        return omega, domega
+    try:
+        rows = _table(lines, title, n, path)
+        xdop = [_number(r[1].split()[0], path, 'an operating point', overflow)
+                if r[1].split() else 0.0 for r in rows]
+    except ValueError:
+        return omega, domega
+    desc = [r[4] for r in out['states']]
+    n2 = sum(1 for r in out['states'] if r[3] == 2)
+    half = n2 // 2
+    found = False
+    for i in range(half):
+        if 'DOF_GeAz' in desc[i]:
+            omega, domega, found = xdop[i], xdop[i + half], True
+            break
+    for i in range(half):
+        if 'DOF_DrTr' in desc[i]:
+            omega, domega = omega + xdop[i], domega + xdop[i + half]
+            break
+    return float(omega), float(domega)
+
+
+def _drop_near_tower(files, parsed, width, nblades):
+    """The files whose azimuth is farther than `width` degrees from a tower passage."""
+    try:
+        width = float(width)
+    except (TypeError, ValueError):
+        raise ControlArgument(f"drop_near_tower must be a number of degrees, got "
+                              f"{width!r}") from None
+    if not 0 <= width < 180:
+        raise ValueError(f"drop_near_tower must be in [0, 180) degrees, got {width}")
+    N = int(nblades)
+    passages = np.mod(180.0 - 360.0 * np.arange(N) / N, 360.0)
+    keep = []
+    for f, d in zip(files, parsed):
+        psi = np.mod(np.degrees(d['azimuth']), 360.0)
+        gap = np.abs(np.mod(psi - passages + 180.0, 360.0) - 180.0)
+        keep.append(bool(np.all(gap >= width)))
+    if not any(keep):
+        raise ValueError(f"drop_near_tower={width}: every file is within {width} degrees of "
+                         "a tower passage")
+    return ([f for f, k in zip(files, keep) if k], [d for d, k in zip(parsed, keep) if k])

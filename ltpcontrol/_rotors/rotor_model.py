@@ -62,6 +62,14 @@ class RotorStateSpace(LTPStateSpace):
         of freedom, 1 for a first-order state (0 when unknown).
     wind_speed : float or None
         Wind speed of the operating point (m/s).
+    sample_speeds, sample_accelerations : ndarray or None
+        Ω and Ω̇ at each sample, from the operating point of the generator
+        azimuth and drivetrain states as MBC3 takes them (`mbc` transforms
+        the samples with them).
+    precision : float or None
+        Relative precision of the data the model was read from (half a unit
+        of the last printed digit); `floquet_modes` takes a model whose
+        matrices vary by less than 20 times it as time-invariant.
 
     Examples
     --------
@@ -70,12 +78,14 @@ class RotorStateSpace(LTPStateSpace):
     ...                           np.zeros((0, 0)), 2 * np.pi, rotor={'rotor_speed': 1.0})
     >>> rot.rotor_speed, rot.frame
     (1.0, 'rotating')
+    >>> rot
+    <RotorStateSpace sys[...]: 1 states, rotating frame, rotor speed 1 rad/s, period=6.28319>
     """
 
     _KEYS = ('rotor_speed', 'azimuth0', 'azimuths', 'samples', 'interpolation', 'nblades',
              'frame', 'state_descriptions', 'input_descriptions', 'output_descriptions',
              'rotating_states', 'rotating_inputs', 'rotating_outputs', 'derivative_order',
-             'wind_speed')
+             'wind_speed', 'precision', 'sample_speeds', 'sample_accelerations')
 
     def __init__(self, A, B, C, D, period, *, rotor=None, **kwargs):
         super().__init__(A, B, C, D, period, **kwargs)
@@ -91,10 +101,18 @@ class RotorStateSpace(LTPStateSpace):
                         output_descriptions=list(self.output_labels),
                         rotating_states=np.zeros(n, bool), rotating_inputs=np.zeros(m, bool),
                         rotating_outputs=np.zeros(p, bool),
-                        derivative_order=np.zeros(n, int), wind_speed=None)
+                        derivative_order=np.zeros(n, int), wind_speed=None, precision=None,
+                        sample_speeds=None, sample_accelerations=None)
         defaults.update(rotor)
         for key, value in defaults.items():
             setattr(self, key, value)
+
+    def _repr_info_(self, html=False):
+        speed = f", rotor speed {self.rotor_speed:.4g} rad/s"
+        samples = f", {len(self.azimuths)} azimuths" if self.azimuths is not None else ""
+        text = (f"<RotorStateSpace {self.name}: {self.nstates} states, {self.frame} frame"
+                f"{speed}{samples}, period={self.period:g}>")
+        return text if not html else text.replace('<', '&lt;').replace('>', '&gt;')
 
     def rotor_data(self):
         """The rotor data as a dict (for building a derived model).
@@ -188,6 +206,12 @@ def sampled_matrix(samples, azimuths, azimuth0, period, interpolation, name):
     samples = np.asarray(samples, float)
     if interpolation is None:
         def refuse(t):
+            if len(azimuths) == 1:
+                raise ValueError(f"{name}(t) is not available: a linearization at a single "
+                                 "azimuth of a turning rotor defines no periodic model (a "
+                                 "constant one would assume rotating-frame matrices "
+                                 "independent of the azimuth); use mbc and "
+                                 "average(method='samples'), exact for an isotropic rotor")
             raise ValueError(f"{name}(t) is not available: the model's {len(azimuths)} "
                              "azimuth samples are not uniform and complete, so no periodic "
                              "model can be formed (use average(method='samples'))")

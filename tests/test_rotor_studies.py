@@ -1,0 +1,463 @@
+"""Rotor studies: repeated multipliers, blade groups, Campbell diagrams from files.
+
+Independent truths: eigenvalues of multi-blade models by numpy (the
+closed form ``√(k - c²/4) ± Ω`` for uncoupled blades), a multi-blade
+transform written out here for three blades, openfast_toolbox's expected
+frequencies, damping ratios and `IdentifyModes` labels on its own files
+(tests/data/README.md), and files written here in OpenFAST's format.
+"""
+
+import csv
+import pathlib
+
+import numpy as np
+import pytest
+
+import ltpcontrol as ltp
+from examples.rotor_models import turbine_A, turbine_descriptions, write_lin
+
+DATA = pathlib.Path(__file__).parent / 'data'
+AB = np.array([[0.0, 1.0], [-4.0, -0.2]])            # one blade's lag: 1.9975 rad/s
+
+
+def uncoupled_blades():
+    return ltp.ltpss(np.kron(AB, np.eye(3)), np.zeros((6, 0)), np.zeros((0, 6)), 0,
+                     period=2 * np.pi)
+
+
+def coleman3(psi):
+    """Multi-blade transform of three blades, written out."""
+    b = psi + 2 * np.pi * np.arange(3) / 3
+    return np.column_stack([np.ones(3), np.cos(b), np.sin(b)])
+
+
+def mbc_turbine(Omega, t=0.0):
+    """Multi-blade model of the 16-state turbine, transformed here by hand."""
+    psi = Omega * t
+    T0, T1, T2 = coleman3(psi), np.zeros((3, 3)), np.zeros((3, 3))
+    b = psi + 2 * np.pi * np.arange(3) / 3
+    T1[:, 1:] = np.column_stack([-np.sin(b), np.cos(b)])
+    T2[:, 1:] = np.column_stack([-np.cos(b), -np.sin(b)])
+    P, dP = np.eye(16), np.zeros((16, 16))
+    for q, r in ((slice(2, 5), slice(10, 13)), (slice(5, 8), slice(13, 16))):
+        P[q, q] = P[r, r] = T0
+        P[r, q] = Omega * T1
+        dP[q, q] = dP[r, r] = Omega * T1
+        dP[r, q] = Omega ** 2 * T2
+    return np.linalg.solve(P, turbine_A(t, Omega) @ P - dP)
+
+
+#
+# Trustworthy modes
+#
+
+def test_guide_isotropic_rotor_modes_are_separated():
+    rot = uncoupled_blades()
+    nr, T = ltp.mbc(rot, [[0, 1, 2]], 3, rates=[[3, 4, 5]])
+    wd = np.sqrt(4 - 0.01)                            # closed form, Ω = 1
+    truth = np.sort(np.repeat([wd - 1, wd, wd + 1], 2))
+    Tinv = ltp.PeriodicMatrix.from_function(lambda t: np.linalg.inv(T(t)), T.period, (6, 6))
+    framed = ltp.floquet_modes(rot, frame=Tinv)
+    assert np.allclose(np.sort(np.abs(framed.damped_frequency)), truth, atol=1e-10)
+    assert np.allclose(framed.damping, 0.1 / 2 / np.abs(framed.exponents) * 2, atol=1e-10)
+    # the multi-blade model: one harmonic per mode, participation exactly 1
+    modes = ltp.floquet_modes(nr)
+    assert np.allclose(np.sort(np.abs(modes.damped_frequency)), truth, atol=1e-10)
+    assert np.all(np.abs(modes.participation.max(axis=1) - 1) < 1e-12)
+    assert modes.frame == 'multiblade' and 'multiblade' in repr(modes)
+    # right and left vectors stay bi-orthonormal eigenvectors of A
+    A = nr.A(0.0)
+    V, W = modes.vectors, modes.left_vectors
+    assert np.abs(A @ V - V * modes.exponents).max() < 1e-12
+    assert np.allclose(W.conj().T @ V, np.eye(6), atol=1e-12)
+
+
+def test_periodic_rotor_repeated_multipliers_split_by_harmonic_content():
+    # rotating frame of the 16-state turbine: the cyclic flap modes share a multiplier
+    # with each other; measured in multi-blade coordinates they are the eigenvalues of
+    # the hand-made multi-blade model
+    Omega = 3.0
+    rot = ltp.ltpss(lambda t: turbine_A(t, Omega), np.zeros((16, 0)), np.zeros((0, 16)), 0,
+                    period=2 * np.pi / Omega)
+    _, P = ltp.mbc(rot, [[2, 3, 4], [5, 6, 7]], 3, rates=[[10, 11, 12], [13, 14, 15]])
+    Pinv = ltp.PeriodicMatrix.from_function(lambda t: np.linalg.inv(P(t)), P.period,
+                                            (16, 16))
+    modes = ltp.floquet_modes(rot, frame=Pinv)
+    truth = np.linalg.eigvals(mbc_turbine(Omega))
+    gap = [np.abs(truth - lam).min() for lam in modes.exponents]
+    assert max(gap) < 1e-8 * np.abs(truth).max()
+    assert np.all(modes.participation.max(axis=1) > 1 - 1e-8)
+
+
+def test_identical_blades_need_no_separation():
+    # two identical blades in their own coordinates share an exponent with the same
+    # (single) harmonic: any basis is right, no warning, participation 1
+    A = np.kron(AB, np.eye(2))
+    sys = ltp.ltpss(A, np.zeros((4, 0)), np.zeros((0, 4)), 0, period=2 * np.pi)
+    with _no_warning():
+        modes = ltp.floquet_modes(sys)
+    assert np.allclose(modes.participation.max(axis=1), 1)
+    assert np.allclose(np.abs(modes.damped_frequency), np.sqrt(4 - 0.01))
+
+
+def test_constant_path_detects_time_invariance_to_data_precision(tmp_path):
+    # an isotropic rotor written with 10 digits: the multi-blade model varies at the
+    # printed precision only, and is solved as time-invariant
+    Omega, desc = 1.2, turbine_descriptions()
+    rotating = ['blade' in d for d in desc]
+    files = []
+    for k in range(12):
+        psi = 2 * np.pi * k / 12
+        f = tmp_path / f'iso.{k + 1}.lin'
+        write_lin(f, turbine_A(psi / Omega, Omega), Omega, psi, 8.0, desc, rotating,
+                  [2] * 16)
+        files.append(f)
+    lin = ltp.read_lin(files)
+    assert 1e-11 < lin.precision < 1e-9
+    nr, _ = ltp.mbc(lin, 3)
+    assert not nr.A.is_constant                       # rounding: not exactly constant
+    modes = ltp.floquet_modes(nr)
+    assert np.all(modes.participation.max(axis=1) == pytest.approx(1, abs=1e-12))
+    truth = np.linalg.eigvals(mbc_turbine(Omega))
+    assert max(np.abs(truth - lam).min() for lam in modes.exponents) < 1e-7
+
+
+def test_isotropic_turbine_flap_tracks_keep_their_shape():
+    desc = turbine_descriptions()
+
+    cache = {}
+
+    def model(Omega):
+        if Omega in cache:
+            return cache[Omega]
+        rot = ltp.ltpss(lambda t: turbine_A(t, Omega), np.zeros((16, 0)),
+                        np.zeros((0, 16)), 0, period=2 * np.pi / Omega)
+        rotor = dict(rotor_speed=Omega, state_descriptions=desc,
+                     rotating_states=np.array(['blade' in d for d in desc]),
+                     derivative_order=np.full(16, 2))
+        rot = ltp.RotorStateSpace(rot.A, rot.B, rot.C, rot.D, rot.period, rotor=rotor)
+        cache[Omega] = ltp.mbc(rot, 3)[0]
+        return cache[Omega]
+    speeds = np.linspace(0.3, 1.6, 6)
+    cd = ltp.campbell(model, speeds, n_jobs=1, branch='principal')
+    labels = [ltp.mode_labels(cd.modes[k], model(speeds[k])) for k in range(len(speeds))]
+    flap = [j for j in range(16) if 'flap' in labels[0][cd.indices[0, j]]]
+    assert len(flap) == 6
+    assert cd.mac[:, flap].min() >= 0.99
+    # each track keeps its name, and its frequency is the hand-made model's
+    for j in range(16):
+        assert len({labels[k][cd.indices[k, j]] for k in range(len(speeds))}) == 1
+    for k, Om in enumerate(speeds):
+        truth = np.linalg.eigvals(mbc_turbine(Om))
+        assert max(np.abs(truth - lam).min() for lam in cd.exponents[k]) < 1e-9
+    names = {labels[0][cd.indices[0, j]] for j in flap}
+    assert names == {'1st flap BW', '1st flap collective', '1st flap FW'}
+
+
+#
+# Blade groups and misuse
+#
+
+def test_toolbox_files_grouped_and_averaged_like_the_toolbox():
+    expected = {   # openfast_toolbox linearization/tests/test_campbell_data.py
+        'BAR_URC_EDBD.1.lin': ([0.18549539, 0.18727956, 1.12675789, 1.25491926, 9.03091505,
+                                9.05584944, 9.31045707, 9.36779001, 11.30081115,
+                                13.78922866],
+                               [0.40656628, 0.40815288, 0.64834856, 0.75063003, 6.02032061,
+                                8.60631293, 6.29886588, 8.37207306, 9.96489352, 9.70093435]),
+        'StandstillSemi_ForID_EDHD.1.lin': (
+            [0.00852735, 0.00865675, 0.01333642, 0.03147209, 0.03544405, 0.03550137,
+             0.04915103, 0.07296769, 0.07801498, 0.08493981],
+            [0.16886295, 3.43729876, 25.10525282, 56.73819059, 2.56872571, 2.45772964,
+             0.18473601, 23.22413272, 11.67420729, 24.10895804]),
+    }
+    for name, (freq, damp) in expected.items():
+        with _no_warning():
+            lin = ltp.read_lin(DATA / name)
+            nr, _ = ltp.mbc(lin, 3)
+        ev = np.linalg.eigvals(nr.average(method='samples').A)
+        ev = ev[ev.imag > 0]
+        ev = ev[np.argsort(np.abs(ev))][:10]
+        assert np.allclose(np.abs(ev) / (2 * np.pi), freq, atol=5e-5)
+        assert np.allclose(-100 * ev.real / np.abs(ev), damp, atol=5e-5)
+    # the file format without derivative orders (toolbox: 0.427, 0.449, 0.667 Hz and
+    # log decrements 1.9497, 2.1162, 5.0113 %)
+    with pytest.warns(UserWarning, match="RootFxc1"):
+        nr, _ = ltp.mbc(ltp.read_lin(DATA / 'Standstill_old.1.lin'), 3)
+    ev = np.linalg.eigvals(nr.average(method='samples').A)
+    ev = ev[ev.imag > 0]
+    ev = ev[np.argsort(np.abs(ev))][:3]
+    assert np.allclose(np.abs(ev) / (2 * np.pi), [0.427, 0.449, 0.667], atol=5e-4)
+    assert np.allclose(-ev.real / np.abs(ev) * 100 * 2 * np.pi, [1.9497, 2.1162, 5.0113],
+                       atol=5e-4)
+
+
+class _no_warning:
+    def __enter__(self):
+        import warnings
+        self._c = warnings.catch_warnings()
+        self._c.__enter__()
+        warnings.simplefilter('error')
+
+    def __exit__(self, *exc):
+        return self._c.__exit__(*exc)
+
+
+def test_beamdyn_blades_grouped_in_openfast_order():
+    lin = ltp.read_lin(DATA / 'BAR_URC_EDBD.1.lin')
+    nr, _ = ltp.mbc(lin, 3)
+    # BeamDyn writes blade by blade (displacements, rates): the first group is node 2's
+    # X translation of blades 1, 2, 3 and its rates
+    desc = lin.state_descriptions
+    assert [desc[i][:4] for i in (8, 20, 32)] == ['BD_1', 'BD_2', 'BD_3']
+    assert nr.state_labels[8] == 'x[8]_0' and nr.state_labels[20] == 'x[8]_c1'
+    assert nr.state_labels[32] == 'x[8]_s1'
+
+
+def test_any_module_order_gives_the_same_multiblade_model(tmp_path):
+    # the turbine written with blade-major (AeroDyn-like) order of its blade states
+    Omega, desc = 1.0, turbine_descriptions()
+    perm = [0, 1, 8, 9, 2, 10, 5, 13, 3, 11, 6, 14, 4, 12, 7, 15]
+    for k in range(6):
+        psi = 2 * np.pi * k / 6
+        A = turbine_A(psi / Omega, Omega)
+        write_lin(tmp_path / f'a.{k + 1}.lin', A, Omega, psi, 8.0, desc,
+                  ['blade' in d for d in desc], [2] * 16, digits=16)
+        write_lin(tmp_path / f'b.{k + 1}.lin', A[np.ix_(perm, perm)], Omega, psi, 8.0,
+                  [desc[i] for i in perm], ['blade' in desc[i] for i in perm], [2] * 16,
+                  digits=16)
+    a = ltp.mbc(ltp.read_lin(str(tmp_path / 'a.*.lin')), 3)[0]
+    b = ltp.mbc(ltp.read_lin(str(tmp_path / 'b.*.lin')), 3)[0]
+    ea = np.linalg.eigvals(a.average(method='samples').A)
+    eb = np.linalg.eigvals(b.average(method='samples').A)
+    truth = np.linalg.eigvals(mbc_turbine(Omega))
+    assert max(np.abs(ea - lam).min() for lam in eb) < 1e-10
+    assert max(np.abs(truth - lam).min() for lam in ea) < 1e-9
+
+
+def test_misuse_is_refused_naming_the_states(tmp_path):
+    files = sorted(DATA.glob('ws03.0.*.lin'))
+    lin = ltp.read_lin(files)
+    # blades given in reverse order
+    with pytest.raises(ValueError, match=r"blade 3 .* names blades \[3, 2, 1\]"):
+        ltp.mbc(lin, [[8, 7, 6]], 3, rates=[[23, 22, 21]])
+    # rates of another degree of freedom
+    with pytest.raises(ValueError, match="is not the rate of 'ED 1st flapwise"):
+        ltp.mbc(lin, [[6, 7, 8]], 3, rates=[[24, 25, 26]])
+    # a model in multi-blade coordinates already
+    nr, _ = ltp.mbc(lin, 3)
+    with pytest.raises(ValueError, match="already in multi-blade coordinates"):
+        ltp.mbc(nr, 3)
+    # no rotating states
+    tower = ltp.read_lin(files, remove_states='blade')
+    with pytest.raises(ValueError, match="no rotating states"):
+        ltp.mbc(tower, 3)
+    # a wrong blade count
+    with pytest.raises(ValueError, match="describe 3 blades"):
+        ltp.mbc(lin, 4)
+    # a single azimuth of a turning rotor is no periodic model
+    one = ltp.read_lin(files[0])
+    with pytest.raises(ValueError, match="single azimuth"):
+        ltp.floquet_modes(one)
+    with pytest.raises(ValueError, match="defines no periodic model"):
+        ltp.read_lin(files[0], interpolation='fourier')
+    # ... but averaging in multi-blade coordinates works, as MBC3's
+    nr1, _ = ltp.mbc(one, 3)
+    assert nr1.average(method='samples').A.shape == (30, 30)
+
+
+def test_read_lin_sources_and_mbc_blade_count_in_second_place():
+    files = sorted(DATA.glob('ws03.0.*.lin'))
+    by_list = ltp.read_lin(files)
+    by_glob = ltp.read_lin(str(DATA / 'ws03.0.*.lin'))
+    assert np.array_equal(by_list.samples[0], by_glob.samples[0])
+    with pytest.raises(ValueError, match="no file matches"):
+        ltp.read_lin(str(DATA / 'nothing*.lin'))
+    a, _ = ltp.mbc(by_list, 3)
+    b, _ = ltp.mbc(by_list, nblades=3)
+    assert np.array_equal(a.samples[0], b.samples[0])
+    drop = ltp.read_lin(files, remove_states='Nacelle yaw')
+    assert drop.nstates == 28 and not any('yaw' in d for d in drop.state_descriptions)
+
+
+#
+# Campbell diagrams from files
+#
+
+def test_mode_labels_equal_identify_modes_of_the_toolbox():
+    # openfast_toolbox linearization/tests/test_modesID.py: mode numbers (1-based,
+    # by frequency) of its IdentifyModes
+    cases = {
+        'Standstill_ForID_ED.1.lin': {1: '1st tower SS', 2: '1st tower FA', 4: '1st flap',
+                                      7: '1st edge', 9: '2nd flap', 13: '2nd tower FA',
+                                      14: '2nd tower SS'},
+        # (its modes 47, 50, 51 are named here by participation factors: HydroDyn
+        # states 99 %, 1st tower FA 61 %, 1st tower SS 74 %; the toolbox says 1st flap
+        # regressive, progressive and 1st edge collective, and marks that range of its
+        # identification as doubtful)
+        'StandstillSemi_ForID_EDHD.1.lin': {1: 'platform sway', 2: 'platform surge',
+                                            3: 'platform yaw', 7: 'platform heave',
+                                            58: '2nd flap', 59: '2nd flap',
+                                            60: '2nd flap collective'},
+    }
+    for name, truth in cases.items():
+        with _no_warning():
+            lin = ltp.read_lin(DATA / name)
+            nr, _ = ltp.mbc(lin, 3)
+        av = nr.average(method='samples')
+        modes = ltp.floquet_modes(ltp.ltpss(av.A, av.B, av.C, av.D, period=2 * np.pi))
+        labels = [lab for lab, f in zip(ltp.mode_labels(modes, nr), modes.damped_frequency)
+                  if f > 0]
+        for number, label in truth.items():
+            assert labels[number - 1].startswith(label), (name, number, labels[number - 1])
+
+
+def write_study(root, speeds, winds, nazimuths=36):
+    """A folder per operating point of the 16-state turbine, one file per azimuth."""
+    desc = turbine_descriptions()
+    for Omega, wind in zip(speeds, winds):
+        folder = root / f'ws{wind:04.1f}'
+        folder.mkdir()
+        for k in range(nazimuths):
+            psi = 2 * np.pi * k / nazimuths
+            write_lin(folder / f'Main.{k + 1}.lin', turbine_A(psi / Omega, Omega), Omega,
+                      psi, wind, desc, ['blade' in d for d in desc], [2] * 16)
+
+
+def test_campbell_of_a_folder_tree_exported_and_reloaded(tmp_path):
+    speeds = np.array([1.2, 0.6, 0.8, 1.0, 1.3, 1.25])       # rpm 5.7 .. 12.4
+    winds = np.array([11.0, 4.0, 6.0, 8.0, 14.0, 12.5])
+    write_study(tmp_path, speeds, winds)
+    cd = ltp.campbell_lin(tmp_path, x='rotor_speed')
+    order = np.argsort(speeds)
+    assert np.allclose(cd.values, speeds[order]) and np.allclose(cd.wind_speed, winds[order])
+    assert cd.frame == 'multiblade'
+    # frequencies: the hand-made multi-blade model's eigenvalues
+    for k, Om in enumerate(cd.values):
+        truth = np.linalg.eigvals(mbc_turbine(Om))
+        assert max(np.abs(truth - lam).min() for lam in cd.exponents[k]) < 1e-7
+    upper = [k for k in range(16) if np.mean(cd.damped_frequency[:, k] >= 0) >= 0.5]
+    assert {cd.labels[j] for j in upper} == {
+        '1st tower FA', '1st tower SS', '1st flap BW', '1st flap collective', '1st flap FW',
+        '1st edge BW', '1st edge collective', '1st edge FW'}
+    assert cd.mac[:, upper].min() > 0.99
+    # the forward whirl of the edge crosses no nP line twice: crossings once per pair
+    assert len(cd.crossings) == len(set((t, n) for t, n, _, _ in cd.crossings)) or \
+        all(t in upper for t, _, _, _ in cd.crossings)
+    # table: CSV without pandas, reloaded
+    path = tmp_path / 'campbell.csv'
+    cd.to_csv(path)
+    with open(path) as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == len(upper) * len(cd.values)
+    for row in rows:
+        j, value = int(row['track']), float(row['value'])
+        k = int(np.flatnonzero(cd.values == value)[0])
+        assert float(row['frequency_hz']) == cd.frequency[k, j] / (2 * np.pi)
+        assert row['label'] == cd.labels[j]
+        assert float(row['rotor_speed_rpm']) == pytest.approx(cd.values[k] * 30 / np.pi)
+    pd = pytest.importorskip('pandas')
+    df = cd.to_dataframe()
+    back = pd.read_csv(path)
+    assert np.array_equal(back['frequency_hz'].to_numpy(), df['frequency_hz'].to_numpy())
+    # ltp.save / ltp.load
+    ltp.save(tmp_path / 'cd.npz', cd)
+    loaded = ltp.load(tmp_path / 'cd.npz')
+    assert np.array_equal(loaded.exponents, cd.exponents) and loaded.labels == cd.labels
+    assert loaded.crossings == cd.crossings and loaded.modes == ()
+    # plots in Hz against rpm and wind speed, damping in % and log decrement
+    import matplotlib
+    matplotlib.use('Agg')
+    cplt = cd.plot(x='rpm', frequency_unit='Hz', damping='percent')
+    assert cplt.axes[1, 0].get_xlabel() == 'rotor speed [rpm]'
+    xs = cplt.lines[0, 0][0].get_xdata()
+    assert np.allclose(xs, cd.values * 30 / np.pi)
+    cplt = cd.plot(x='wind_speed', damping='logdec')
+    assert cplt.axes[1, 0].get_ylabel() == 'logarithmic decrement'
+    matplotlib.pyplot.close('all')
+
+
+def test_campbell_of_files_by_floquet_equals_averaging(tmp_path):
+    write_study(tmp_path, [0.7, 1.1], [5.0, 9.0])
+    avg = ltp.campbell_lin(tmp_path)
+    flo = ltp.campbell_lin(tmp_path, method='floquet')
+    assert avg.xlabel == 'wind speed [m/s]'
+    for k in range(2):
+        assert max(np.abs(avg.exponents[k] - lam).min() for lam in flo.exponents[k]) < 1e-7
+    with pytest.raises(ValueError, match="same rotor_speed"):
+        ltp.campbell_lin([sorted((tmp_path / 'ws05.0').glob('*.lin'))] * 2,
+                         x='rotor_speed')
+
+
+def test_campbell_accepts_averaged_models():
+    rot = uncoupled_blades()
+
+    def averaged(Omega):
+        sys = ltp.ltpss(rot.A(0.0), np.zeros((6, 1)), np.zeros((1, 6)), 0,
+                        period=2 * np.pi / Omega)
+        return ltp.mbc(sys, [[0, 1, 2]], 3, rates=[[3, 4, 5]])[0].average()
+    cd = ltp.campbell(averaged, [0.5, 1.0, 1.5], n_jobs=1, branch='principal')
+    wd = np.sqrt(4 - 0.01)
+    assert np.allclose(np.sort(np.abs(cd.damped_frequency[1])),
+                       np.sort(np.repeat([wd - 1, wd, wd + 1], 2)), atol=1e-10)
+    # each crossing once (not for both tracks of a complex pair)
+    pairs = [(n, round(v, 9)) for _, n, v, _ in cd.crossings]
+    assert len(pairs) == len(set(pairs))
+
+
+def test_aerodyn_states_blade_by_blade_grouped(tmp_path):
+    # first-order AeroDyn states written blade by blade after the structure:
+    # uncoupled lags of rate 5 1/s become -5 (collective) and -5 ± jΩ (cyclic)
+    Omega, desc = 0.9, turbine_descriptions()
+    ad = [f'AD UA x{j} blade {b}, node 2, rad' for b in (1, 2, 3) for j in (1, 2)]
+    for k in range(6):
+        psi = 2 * np.pi * k / 6
+        A = np.zeros((22, 22))
+        A[:16, :16] = turbine_A(psi / Omega, Omega)
+        A[16:, 16:] = np.diag([-5.0, -7.0] * 3)
+        write_lin(tmp_path / f'ad.{k + 1}.lin', A, Omega, psi, 8.0, desc + ad,
+                  ['blade' in d for d in desc + ad], [2] * 16 + [1] * 6, digits=16)
+    lin = ltp.read_lin(tmp_path)
+    nr, _ = ltp.mbc(lin, 3)
+    assert [nr.state_labels[i].rsplit('_', 1)[1] for i in (16, 18, 20)] == ['0', 'c1', 's1']
+    ev = np.linalg.eigvals(nr.average(method='samples').A)
+    for lam in (-5, -5 + 0.9j, -5 - 0.9j, -7, -7 + 0.9j, -7 - 0.9j):
+        assert np.abs(ev - lam).min() < 1e-10
+
+
+def test_tower_azimuths_dropped_and_operating_point_speeds():
+    files = sorted(DATA.glob('Main_Rotating.*.lin'))
+    lin = ltp.read_lin(files)
+    # MBC3 takes Ω from the generator azimuth's derivative at the operating point, Ω̇
+    # from its rate's
+    assert np.allclose(lin.sample_speeds, 0.9425)
+    assert np.allclose(lin.sample_accelerations, [-7.308e-06, 6.543e-06, 7.905e-06])
+    # azimuths (deg) 0.5, 110.1, 230.0: the first only is 55 degrees away from the
+    # tower passages at 60, 180 and 300
+    kept = ltp.read_lin(files, drop_near_tower=55.0)
+    assert np.allclose(np.degrees(kept.azimuths), np.degrees(lin.azimuths[[0]]))
+    with pytest.raises(ValueError, match="every file"):
+        ltp.read_lin(files[1:], drop_near_tower=55.0)
+
+
+def test_campbell_frame_follows_the_rotor_speed():
+    # rotating-frame models of uncoupled blades: measured in the multi-blade frame of
+    # each rotor speed, the exponents are the whirl ones ω ± Ω
+    desc = [f'ED 1st edgewise bending-mode DOF of blade {b}, m' for b in (1, 2, 3)]
+    desc += [d.replace('ED ', 'ED First time derivative of ') + '/s' for d in desc]
+
+    def rotating(Omega):
+        A = ltp.PeriodicMatrix.constant(np.kron(AB, np.eye(3)), 2 * np.pi / Omega)
+        return ltp.RotorStateSpace(A, np.zeros((6, 0)), np.zeros((0, 6)), np.zeros((0, 0)),
+                                   2 * np.pi / Omega, rotor=dict(
+                                       rotor_speed=Omega, state_descriptions=desc,
+                                       rotating_states=np.ones(6, bool),
+                                       derivative_order=np.full(6, 2)))
+    cd = ltp.campbell(rotating, [0.5, 0.8], frame='multiblade', n_jobs=1,
+                      branch='principal')
+    wd = np.sqrt(4 - 0.01)
+    for k, Om in enumerate([0.5, 0.8]):
+        assert np.allclose(np.sort(np.abs(cd.damped_frequency[k])),
+                           np.sort(np.repeat([wd - Om, wd, wd + Om], 2)), atol=1e-10)
+    with pytest.raises(ValueError, match="frame must be 'multiblade'"):
+        ltp.campbell(rotating, [0.5, 0.8], frame='rotating', n_jobs=1)
