@@ -84,10 +84,12 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, name=None):
                    sys.output_labels, sys.state_labels)
 
 
-def build(sys, K, internal_harmonics, method, where, stacklevel=2):
+def build(sys, K, internal_harmonics, method, where, stacklevel=2, warn_unstable=True):
     """The checked harmonic state space of `sys` with K harmonics.
 
-    `stacklevel` is that of the user's call as seen from the caller of `build`.
+    `stacklevel` is that of the user's call as seen from the caller of `build`;
+    `warn_unstable=False` skips the stability remark (and its Floquet
+    computation) for callers to whom an unstable system is no misuse.
 
     Examples
     --------
@@ -103,7 +105,7 @@ def build(sys, K, internal_harmonics, method, where, stacklevel=2):
     """
     if method not in ('auto', 'modal', 'solve'):
         raise ValueError(f"method must be 'auto', 'modal' or 'solve', got {method!r}")
-    if not sys.is_stable():
+    if warn_unstable and not sys.is_stable():
         warnings.warn(f"{sys.name} is unstable: its HTF is defined wherever the harmonic "
                       "resolvent exists, but on the imaginary axis it describes no "
                       "steady-state response", UserWarning, stacklevel=stacklevel + 1)

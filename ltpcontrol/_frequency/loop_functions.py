@@ -131,7 +131,7 @@ def siso_equivalent(L, nharmonics, omega=None, *, period=None, internal_harmonic
     """
     L = as_loop(L, 'L', period)
     loop = LoopHTF(L, nharmonics, internal_harmonics)
-    w = (default_omega(loop.H) if omega is None
+    w = (default_omega(loop) if omega is None
          else real_array(omega, 'omega', ndim=(0, 1)).reshape(-1))
     Lh = loop(1j * w)
     m, N = loop.m, loop.N
