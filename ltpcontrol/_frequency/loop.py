@@ -19,16 +19,19 @@ from .._core.floquet import floquet_exponents
 from .._core.ltpsys import LTPStateSpace, series
 from .._core.coerce import as_ltp
 from .._core.validation import check_positive_int
+from .._core.wellposed import check_well_posed
 
 __all__ = []
 
 
-def as_loop(L, name='L', period=None):
+def as_loop(L, name='L', period=None, where=None):
     """The loop as one square continuous-time `LTPStateSpace`.
 
     `L` is a system, or a sequence of systems ``(L_1, ..., L_k)`` meaning
     the product ``L_1 L_2 ... L_k`` (``L_k`` acts first), for example
-    ``(plant, controller)``.
+    ``(plant, controller)``.  The closed loop must be well posed: ``I +
+    D(t)`` nonsingular over the whole period (else ValueError naming the
+    function `where` and the instant).
 
     Examples
     --------
@@ -64,6 +67,7 @@ def as_loop(L, name='L', period=None):
         raise ControlDimension(f"{name} must be a square loop (as many outputs as inputs) "
                                "to be closed by negative feedback; it has "
                                f"{L.noutputs} outputs and {L.ninputs} inputs")
+    check_well_posed(np.eye(L.ninputs) + L.D, where or name)
     return L
 
 

@@ -41,6 +41,7 @@ from .nyquist import track
 from .._core.floquet import is_stable
 from .._core.ltpsys import feedback, series
 from .._core.validation import check_positive_int
+from .._core.wellposed import ill_posed_gains
 
 __all__ = ['harmonic_margins', 'stability_margins', 'HarmonicMargins', 'MarginPoint']
 
@@ -92,6 +93,9 @@ class HarmonicMargins:
     ----------
     gain_upper : MarginPoint
         Smallest gain margin above 1 (the loop gain may grow by this factor).
+        A gain that makes ``I + k D(t)`` singular at some instant ends the
+        range: the margin is then that gain, with ``frequency = inf`` (the
+        closed loop is ill-posed there).
     gain_lower : MarginPoint
         Largest gain margin below 1 (the loop gain may shrink to this
         factor); its value is 0 when no crossing lies below 1.
@@ -200,7 +204,7 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     >>> bool(np.isclose(m.gain_upper.frequency, wpc))
     True
     """
-    L = as_loop(L, 'L', period)
+    L = as_loop(L, 'L', period, 'harmonic_margins')
     loop = LoopHTF(L, nharmonics, internal_harmonics)
     num = check_positive_int(omega_num, 'omega_num', minimum=16)
     skew = float(skew)
@@ -220,7 +224,7 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     # near a pole on the axis every harmonic row is large: not a truncation effect
     far = (np.min(np.abs(w[:, None] - poles[None, :]), axis=1) > wp / 20 if poles.size
            else np.ones(len(w), bool))
-    _check_edge(loop, Lh[far], edge_tol)
+    _check_edge(loop, Lh[far] - loop.hss.J, edge_tol)     # the feedthrough is exact
     eig = _tracked(Lh)
 
     gains, phases = [], []
@@ -240,12 +244,20 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
                 pm = float(np.remainder(np.angle(hit[1], deg=True), 360.0) - 180.0)
                 phases.append(_point(loop, pm, hit, odd=True))
     gains, phases = _unique(gains, wp), _unique(phases, wp)
+    # gains k that make I + k D(t) singular end the range of the gain margins:
+    # the closed loop is ill-posed there (its exponents run off to infinity)
+    k_lo, k_hi = ill_posed_gains(L.D)
+    gains = [g for g in gains if k_lo < g.value < k_hi]
 
     above = [g for g in gains if g.value > 1]
     below = [g for g in gains if g.value < 1]
     upper = min(above, key=lambda g: g.value) if above else _NONE
     lower = (max(below, key=lambda g: g.value) if below
              else MarginPoint(0.0, float('nan'), 0, float('nan')))
+    if k_hi < upper.value:
+        upper = MarginPoint(k_hi, float('nan'), 0, float('inf'))
+    if k_lo > lower.value:
+        lower = MarginPoint(k_lo, float('nan'), 0, float('inf'))
     phase = min(phases, key=lambda p: abs(p.value)) if phases else _NONE
     stability = _extremum(loop, w, Lh, lambda M: np.linalg.svd(
         np.eye(len(M)) + M, compute_uv=False)[-1], 'min')
@@ -261,7 +273,7 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     disk = peak._replace(value=alpha)
     dgain, dphase = _disk_gain_phase(alpha, skew)
     if check:
-        _verify(L, upper.value, lower.value)
+        _verify(L, upper.value, lower.value, k_lo, k_hi)
     return HarmonicMargins(gain_upper=upper, gain_lower=lower, phase=phase,
                            stability=stability, disk=disk, disk_gain=dgain,
                            disk_phase=dphase, gain_crossings=gains,
@@ -448,8 +460,9 @@ def _disk_gain_phase(alpha, skew):
     return (float(gmin), float(gmax)), phase
 
 
-def _verify(L, upper, lower, delta=1e-3):
-    """Floquet check of the gain margins of a loop whose closed loop is stable."""
+def _verify(L, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3):
+    """Floquet check of the gain margins of a loop whose closed loop is stable
+    (not beyond a margin set by an ill-posed gain)."""
     eye = np.eye(L.ninputs)
 
     def stable(k):
@@ -461,11 +474,13 @@ def _verify(L, upper, lower, delta=1e-3):
         return
     bad = []
     if np.isfinite(upper):
-        bad += [k for k, want in ((upper * (1 - delta), True), (upper * (1 + delta), False))
-                if stable(k) != want]
+        pairs = ((upper * (1 - delta), True),) + (
+            ((upper * (1 + delta), False),) if upper < k_hi else ())
+        bad += [k for k, want in pairs if stable(k) != want]
     if lower > 0:
-        bad += [k for k, want in ((lower * (1 + delta), True), (lower * (1 - delta), False))
-                if stable(k) != want]
+        pairs = ((lower * (1 + delta), True),) + (
+            ((lower * (1 - delta), False),) if lower > k_lo else ())
+        bad += [k for k, want in pairs if stable(k) != want]
     if bad:
         warnings.warn(f"harmonic_margins: the Floquet multipliers of the closed loop with "
                       f"the gains {bad} contradict the gain margins ({lower:.6g}, "

@@ -299,7 +299,7 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     >>> ct.nyquist_response(ct.tf([2], [1, -1])).count == resp.count
     True
     """
-    L = as_loop(L, 'L', period)
+    L = as_loop(L, 'L', period, 'nyquist_htf')
     loop = LoopHTF(L, nharmonics, internal_harmonics)
     wp = L.omega_p
     r = 1e-4 * wp if indent_radius is None else check_positive(
