@@ -47,6 +47,7 @@ from ._rotors.read_lin import read_lin
 from ._rotors.campbell import campbell, CampbellDiagram
 from ._analysis.zeros import zeros
 from ._frequency.harmonic_ss import harmonic_ss
+from ._frequency.harmonic_modes import harmonic_modes, HarmonicModes
 from ._frequency.nyquist import nyquist_htf, HarmonicNyquistResponse
 from ._frequency.margins import harmonic_margins, stability_margins, HarmonicMargins, MarginPoint
 from ._frequency.loop_functions import (sensitivity_htf, complementary_sensitivity_htf,
@@ -117,6 +118,8 @@ __all__ = [
     'campbell', 'CampbellDiagram',
     # files
     'save', 'load',
+    # harmonic stability
+    'harmonic_modes', 'HarmonicModes',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

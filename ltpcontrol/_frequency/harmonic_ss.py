@@ -62,6 +62,13 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, name=None):
     ValueError
         If `sys` is discrete-time.
 
+    Notes
+    -----
+    For a periodic A the state matrix is truncated: besides shifted copies
+    of the Floquet exponents, its eigenvalues (``ct.poles``) include
+    truncation-edge artefacts, which may lie in the right half plane of a
+    stable system.  `harmonic_modes` marks them and gives the modes.
+
     Examples
     --------
     The HTF of an LTI system has the diagonal blocks ``G(s + jnω_p)``; the
