@@ -145,7 +145,8 @@ class HarmonicMargins:
 
 
 def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
-                     internal_harmonics=None, edge_tol=0.05, check=True):
+                     internal_harmonics=None, edge_tol=0.05, check=True,
+                     floquet_steps=None):
     """Gain, phase, stability and disk margins of a periodic loop.
 
     Parameters
@@ -174,6 +175,9 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
         Floquet multipliers of the closed loops with the gains 0.1 % inside
         (stable) and outside (unstable) them, and warn otherwise (a
         crossing between grid points missed: raise `omega_num`).
+    floquet_steps : int, optional
+        Steps per period of every Floquet computation (`monodromy`'s
+        `nsteps`; default: its own choice).
 
     Returns
     -------
@@ -209,7 +213,9 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     num = check_positive_int(omega_num, 'omega_num', minimum=16)
     skew = float(skew)
     wp = loop.omega_p
-    _, axis_w = open_loop_exponents(L)
+    nsteps = None if floquet_steps is None else check_positive_int(floquet_steps,
+                                                                   'floquet_steps')
+    _, axis_w = open_loop_exponents(L, nsteps=nsteps)
     # the strip, extended by ω_p/8 on both sides so that crossings at its edges
     # (multiplier -1) are seen from both sides
     w = np.linspace(-5 * wp / 8, 5 * wp / 8, num)
@@ -273,7 +279,7 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     disk = peak._replace(value=alpha)
     dgain, dphase = _disk_gain_phase(alpha, skew)
     if check:
-        _verify(L, upper.value, lower.value, k_lo, k_hi)
+        _verify(L, upper.value, lower.value, k_lo, k_hi, nsteps=nsteps)
     return HarmonicMargins(gain_upper=upper, gain_lower=lower, phase=phase,
                            stability=stability, disk=disk, disk_gain=dgain,
                            disk_phase=dphase, gain_crossings=gains,
@@ -460,7 +466,7 @@ def _disk_gain_phase(alpha, skew):
     return (float(gmin), float(gmax)), phase
 
 
-def _verify(L, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3):
+def _verify(L, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3, nsteps=None):
     """Floquet check of the gain margins of a loop whose closed loop is stable
     (not beyond a margin set by an ill-posed gain)."""
     eye = np.eye(L.ninputs)
@@ -469,7 +475,7 @@ def _verify(L, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3):
         with warnings.catch_warnings():
             # only the verdict is used, 0.1 % away from the boundary
             warnings.filterwarnings('ignore', message='product_eigenvalues')
-            return is_stable(feedback(series(L, k * eye), eye))
+            return is_stable(feedback(series(L, k * eye), eye), nsteps=nsteps)
     if not stable(1.0):
         return
     bad = []
