@@ -30,11 +30,11 @@ def test_biproper_loop_counted_at_every_truncation(N):
     assert resp.floquet_unstable == 1
 
 
-def test_unchecked_contour_closed_by_its_edges_warns():
+def test_unchecked_count_warns_when_truncation_edge_is_large():
     # 20/(s + 1) with N = 1: the curve on the axis alone does not close; the count
     # (exact for the truncated loop) is flagged when it is not cross-checked
     L = ltp.ltpss(ct.tf([20], [1, 1]), period=1.0)
-    with pytest.warns(UserWarning, match="horizontal edges"):
+    with pytest.warns(UserWarning, match="truncation edge"):
         resp = ltp.nyquist_htf(L, 1, check=False)
     assert resp.stable and resp.floquet_unstable is None
     with warnings.catch_warnings():

@@ -95,7 +95,7 @@ def path_phase(logdet, s0, s1, t, *, resolution=1e-13):
     return float(_wrap(np.diff(ph)).sum()), resolved, float(np.min(la))
 
 
-def strip_closure(logdet, s_top, s_bottom, omega_p, sigma_max, points=120):
+def strip_closure(logdet, s_top, s_bottom, omega_p, sigma_max, points=60):
     """Phase change of f along the three other sides of the half strip.
 
     From `s_top` (the end of the Nyquist curve, continued to

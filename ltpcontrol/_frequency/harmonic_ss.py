@@ -24,7 +24,7 @@ import warnings
 import numpy as np
 import control as ct
 from scipy import sparse
-from scipy.linalg import solve_banded
+from scipy.linalg.lapack import zgbsv
 from tqdm.auto import tqdm
 
 from .. import config
@@ -320,19 +320,21 @@ class _HarmonicStateSpace:
         return prod.reshape((len(x),) + shape)
 
     def _banded_chunk(self, x, r, c):
-        # (xI - F) X = G by banded LU: O(n_F b^2 + n_F b n_c) per point
+        # (xI - F) X = G by banded LU (LAPACK gbsv): O(n_F b^2 + n_F b n_c) per point
         l, u, ab = self.band
-        Gc = self.G[:, c]
+        Gc = np.asfortranarray(self.G[:, c])
         Hr = self.Hc[r]
+        work = np.zeros((2 * l + u + 1, ab.shape[1]), complex, order='F')
         out = np.empty((len(x), len(r), len(c)), complex)
         for i, xi in enumerate(x):
-            M = ab.copy()
-            M[u] += xi
-            try:
-                X = solve_banded((l, u), M, Gc, overwrite_ab=True, check_finite=False)
-            except np.linalg.LinAlgError:
+            work[:l] = 0
+            work[l:] = ab
+            work[l + u] += xi
+            _, _, X, info = zgbsv(l, u, work, Gc.copy(order='F'), overwrite_ab=1,
+                                  overwrite_b=1)
+            if info > 0:
                 raise ValueError("the HTF is not defined at a pole of the harmonic "
-                                 "state space (singular resolvent)") from None
+                                 "state space (singular resolvent)")
             out[i] = Hr @ X
         return out
 

@@ -239,9 +239,10 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
         Radius of the semicircles around open-loop exponents on the
         imaginary axis (default ``1e-4 ω_p``).
     closure_tol : float
-        Without a Floquet check, a closure gap above this together with
-        horizontal edges turning by more than an eighth of a turn warns
-        that the count is only that of the truncated loop.
+        Without a Floquet check, the outermost harmonic blocks of the
+        loop HTF less its feedthrough (which fills them exactly, e.g. for
+        a biproper loop) reaching this magnitude warn that the count is
+        only that of the truncated loop.
     internal_harmonics : int, optional
         Truncation of the harmonic state space (see `htf`).
     check : bool or 'auto'
@@ -271,8 +272,8 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     -----
     UserWarning
         When the count contradicts the closed loop's Floquet exponents
-        (increase `nharmonics`); when, unchecked, the contour closes only
-        through its horizontal edges; when the contour passes within
+        (increase `nharmonics`); when, unchecked, the truncation edge of
+        the loop HTF is not small; when the contour passes within
         rounding of a closed-loop exponent (the loop is at a stability
         boundary and the count is not reliable).
 
@@ -310,7 +311,7 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     P, axis_w = open_loop_exponents(L, nsteps=nsteps)
     w = _initial_grid(omega, wp, axis_w, r)
 
-    w, s, logabs, phase, eig = _refined_contour(loop, w, axis_w, r)
+    w, s, logabs, phase, eig, edge = _refined_contour(loop, w, axis_w, r)
     axis_turn = float(_wrap(np.diff(phase)).sum())
     closing = _wrap(phase[0] - phase[-1])
     with np.errstate(over='ignore', under='ignore'):
@@ -329,12 +330,11 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
                       f"{loop.N} (Z = {P - encirclements}) contradicts the closed loop's "
                       f"Floquet exponents (Z = {Zf}): increase nharmonics",
                       UserWarning, stacklevel=2)
-    elif Zf is None and gap > closure_tol and abs(edge_turn) > 0.25 * np.pi:
-        warnings.warn(f"nyquist_htf: the truncated contour closes only through its "
-                      f"horizontal edges ({edge_turn / (2 * np.pi):.2g} turns; closure gap "
-                      f"{gap:.2g} > closure_tol={closure_tol:g}) with nharmonics={loop.N}, "
-                      "and no Floquet check was made (check=False): the count is that of "
-                      "the truncated loop; increase nharmonics or pass check=True",
+    elif Zf is None and edge > closure_tol:
+        warnings.warn(f"nyquist_htf: the loop HTF is not small at its truncation edge "
+                      f"(|L̂ - D̂| up to {edge:.2g} in harmonics ±{loop.N} > closure_tol="
+                      f"{closure_tol:g}) and no Floquet check was made: the count is exact "
+                      "for the truncated loop only; increase nharmonics or pass check=True",
                       UserWarning, stacklevel=2)
     if dist < 1e-8 or not resolved:
         warnings.warn("nyquist_htf: the contour passes through a closed-loop exponent "
@@ -424,13 +424,22 @@ def _initial_grid(omega, wp, axis_w, r):
 def _evaluate(loop, s):
     Lh = loop(s)
     sign, logabs = np.linalg.slogdet(np.eye(loop.size) + Lh)
-    return logabs, np.angle(sign), np.linalg.eigvals(Lh)
+    return logabs, np.angle(sign), np.linalg.eigvals(Lh), _edge(loop, Lh)
+
+
+def _edge(loop, Lh):
+    """Largest entry of the outermost harmonic blocks of L̂_N without its
+    feedthrough (which fills them exactly): the truncation diagnostic."""
+    m = loop.m
+    dyn = Lh - loop.hss.J
+    return float(max(np.abs(dyn[:, :m, :]).max(), np.abs(dyn[:, -m:, :]).max(),
+                     np.abs(dyn[:, :, :m]).max(), np.abs(dyn[:, :, -m:]).max()))
 
 
 def _refined_contour(loop, w, axis_w, r):
     wp = loop.omega_p
     s = contour_points(w, axis_w, r, wp)
-    logabs, phase, eig = _evaluate(loop, s)
+    logabs, phase, eig, edge = _evaluate(loop, s)
     while True:
         # a fast turn of the phase, or a fast change of the modulus (a lightly
         # damped exponent nearby, where the phase may turn between samples)
@@ -440,7 +449,7 @@ def _refined_contour(loop, w, axis_w, r):
             break
         wn = 0.5 * (w[:-1][bad] + w[1:][bad])
         sn = contour_points(wn, axis_w, r, wp)
-        la, ph, ev = _evaluate(loop, sn)
+        la, ph, ev, _ = _evaluate(loop, sn)
         order = np.argsort(np.concatenate([w, wn]), kind='stable')
         w = np.concatenate([w, wn])[order]
         s = np.concatenate([s, sn])[order]
@@ -450,7 +459,7 @@ def _refined_contour(loop, w, axis_w, r):
     if np.any(np.isinf(logabs)):
         warnings.warn("nyquist_htf: det(I + L̂_N) vanishes on the contour: the loop is "
                       "at a stability boundary", UserWarning, stacklevel=3)
-    return w, s, logabs, phase, eig
+    return w, s, logabs, phase, eig, edge
 
 
 def _close_strip(loop, axis_w, r):
