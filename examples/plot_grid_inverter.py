@@ -25,7 +25,7 @@ bisection on those multipliers.
 """
 
 import os
-import sys
+import warnings
 
 import matplotlib
 
@@ -37,12 +37,10 @@ from scipy.integrate import solve_ivp  # noqa: E402
 
 import ltpcontrol as ltp  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)) if '__file__' in globals()
-                else os.path.join(os.getcwd(), 'examples'))
-import grid_inverter as gi  # noqa: E402
+from grid_inverter import admittance  # noqa: E402
 
 Lg0 = 10e-3                                   # nominal grid inductance (H)
-Y = gi.admittance(Lg0)                        # admittance at the nominal operating point
+Y = admittance(Lg0)                        # admittance at the nominal operating point
 T = Y.period
 C = Y.C(0.0)
 CB = float((C @ Y.B(0.0))[0, 0])
@@ -53,13 +51,20 @@ def loop(Lg):
     return ltp.ltpss(Y.A, Y.B, -Lg * (C @ Y.A), [[-Lg * CB]], period=T, name='-Zg Y')
 
 
+P = Y.A.fourier(1)                            # A(t) = P_0 + 2 Re(P_1 e^{jω_g t}), exact
+
+
 def radius(Lg):
-    """Closed-loop spectral radius by solve_ivp: v = L_g di/dt eliminated."""
-    def A(t):
-        At, Bt = Y.A(t), Y.B(0.0)
-        return At + Lg * Bt @ (C @ At) / (1 - Lg * CB)
-    sol = solve_ivp(lambda t, x: (A(t) @ x.reshape(8, 8)).ravel(), (0, T),
-                    np.eye(8).ravel(), method='DOP853', rtol=1e-11, atol=1e-13)
+    """Closed-loop spectral radius by solve_ivp: with v = L_g di/dt eliminated,
+    x' = M A(t) x, M = I + L_g B C / (1 - L_g C B)."""
+    M = np.eye(8) + Lg * Y.B(0.0) @ C / (1 - Lg * CB)
+    A0, Ac, As = M @ P[1].real, 2 * M @ P[2].real, -2 * M @ P[2].imag
+    w = 2 * np.pi / T
+
+    def rhs(t, x):
+        return ((A0 + Ac * np.cos(w * t) + As * np.sin(w * t)) @ x.reshape(8, 8)).ravel()
+    sol = solve_ivp(rhs, (0, T), np.eye(8).ravel(), method='DOP853', rtol=1e-10,
+                    atol=1e-12)
     return np.abs(np.linalg.eigvals(sol.y[:, -1].reshape(8, 8))).max()
 
 
@@ -67,14 +72,20 @@ def radius(Lg):
 # Verdicts side by side
 # ---------------------
 # The generalized Nyquist count (N = 10 harmonics) and the Floquet
-# multipliers agree on every grid; the closure gap of the curve on the
-# axis alone is large (biproper loop) and means nothing here.
+# multipliers agree; the closure gap of the curve on the axis alone is
+# large (biproper loop) and means nothing here: the horizontal edges carry
+# the missing part of a turn.  The current loop's dynamics reach the
+# kilohertz range, so the loop HTF is not small at harmonic ±10; the
+# crossings that matter are at low harmonics, and the Floquet check is
+# made here, independently, hence the truncation-edge remark is silenced.
 
+warnings.filterwarnings('ignore', message='.*truncation edge')
 N = 10
 print(f"{'L_g [mH]':>9} {'Nyquist Z':>10} {'edge turns':>11} {'closure gap':>12} "
       f"{'Floquet radius':>15}")
-for Lg in (5e-3, 20e-3, 50e-3):
-    resp = ltp.nyquist_htf(loop(Lg), N, check=False, floquet_steps=32)
+responses = {}
+for Lg in (Lg0, 50e-3):
+    resp = responses[Lg] = ltp.nyquist_htf(loop(Lg), N, check=False, floquet_steps=32)
     rho = radius(Lg)
     print(f"{Lg * 1e3:9.1f} {resp.closed_loop_unstable:10d} {resp.edge_turns:11.2f} "
           f"{resp.closure_gap:12.2f} {rho:15.4f}")
@@ -93,9 +104,9 @@ Lg_crit = m.gain_upper.value * Lg0
 print(f"gain margin {m.gain_upper.value:.6f}: critical L_g = {Lg_crit * 1e3:.5f} mH, "
       f"at {m.gain_upper.frequency / (2 * np.pi):.2f} Hz (harmonic {m.gain_upper.harmonic})")
 
-lo, hi = 0.98 * Lg_crit, 1.02 * Lg_crit
+lo, hi = 0.995 * Lg_crit, 1.005 * Lg_crit
 assert radius(lo) < 1 <= radius(hi)
-while hi - lo > 1e-7 * Lg_crit:
+while hi - lo > 2e-7 * Lg_crit:
     mid = 0.5 * (lo + hi)
     lo, hi = (mid, hi) if radius(mid) < 1 else (lo, mid)
 Lg_floquet = 0.5 * (lo + hi)
@@ -104,13 +115,13 @@ print(f"Floquet bisection (solve_ivp): critical L_g = {Lg_floquet * 1e3:.5f} mH,
 assert abs(Lg_crit - Lg_floquet) <= 1e-5 * Lg_floquet
 
 # %%
-# Nyquist plot at the nominal grid and near the boundary
-# -------------------------------------------------------
+# Nyquist plots: nominal grid (stable) and a weak grid (two exponents)
+# --------------------------------------------------------------------
 
 fig, axes = plt.subplots(1, 2, figsize=(10, 4.5))
-for ax, Lg in zip(axes, (Lg0, 0.999 * Lg_crit)):
-    ltp.nyquist_htf(loop(Lg), N, check=False, floquet_steps=32).plot(
-        ax=ax, max_curve_magnitude=3, title=f"L_g = {Lg * 1e3:.2f} mH")
+for ax, (Lg, resp) in zip(axes, responses.items()):
+    resp.plot(ax=ax, max_curve_magnitude=3,
+              title=f"L_g = {Lg * 1e3:.0f} mH: Z = {resp.closed_loop_unstable}")
 fig.tight_layout()
 if os.environ.get('LTP_SHOW'):
     plt.show()
