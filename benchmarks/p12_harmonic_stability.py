@@ -6,6 +6,8 @@
   Floquet exponents ('auto'); peer: one DOP853 monodromy (``solve_ivp``,
   rtol 1e-10) of the closed loop measured in the same run.  Target: within
   20x of the peer.
+* P12a0: the same without the closed-loop Floquet cross-check
+  (``check=False``): the share of the Floquet computation.
 * P12b: the same call with N = 40; target: within 10 s.
 * P12c: a seeded random 30-state SISO loop with ``A(t) = A_0 + A_1 cos ω_p t``,
   N = 20; target: within 30 s and 1 GB (tracemalloc peak of NumPy buffers).
@@ -60,18 +62,21 @@ def run(quick=False, log=print):
     T = L.period
     log("P12a: inverter loop, nyquist_htf N=10 vs DOP853 monodromy")
     t_peer, rho = timed(_radius, gi.closed_loop_matrix(Lg), 8, T)
-    for rid, N, target in (('P12a', cfg['N'], 'ratio'), ('P12b', cfg['N_big'], 'time')):
-        t_ours, resp = timed(ltp.nyquist_htf, L, N, floquet_steps=STEPS)
+    for rid, N, target, check in (('P12a', cfg['N'], 'ratio', 'auto'),
+                                  ('P12a0', cfg['N'], 'ratio', False),
+                                  ('P12b', cfg['N_big'], 'time', 'auto')):
+        t_ours, resp = timed(ltp.nyquist_htf, L, N, floquet_steps=STEPS, check=check)
         ok = resp.stable == (rho < 1)
         if target == 'ratio':
             ratio = t_ours / t_peer
             rows.append(row(rid, f"inverter loop -Zg*Y (8 states), nyquist_htf N={N}",
-                            ours=f"ltp.nyquist_htf(N={N}, floquet_steps={STEPS})",
+                            ours=f"ltp.nyquist_htf(N={N}, floquet_steps={STEPS}, "
+                                 f"check={check!r})",
                             peer="solve_ivp DOP853 closed-loop monodromy (rtol 1e-10)",
                             t_ours=t_ours, t_peer=t_peer, metric='time/peer', value=ratio,
                             target='<= 20x', target_met=ratio <= 20,
                             checks={'verdict equals the monodromy': ok,
-                                    'Floquet cross-check agrees':
+                                    'Floquet cross-check agrees': not check or
                                         resp.floquet_unstable == resp.closed_loop_unstable},
                             notes=f"rho={rho:.4f}, Z={resp.closed_loop_unstable}"))
         else:

@@ -123,5 +123,6 @@ for ax, (Lg, resp) in zip(axes, responses.items()):
     resp.plot(ax=ax, max_curve_magnitude=3,
               title=f"L_g = {Lg * 1e3:.0f} mH: Z = {resp.closed_loop_unstable}")
 fig.tight_layout()
+fig.savefig('grid_inverter.png', dpi=90)
 if os.environ.get('LTP_SHOW'):
     plt.show()
