@@ -87,3 +87,12 @@ def test_lti_loops_written_as_periodic_count_as_python_control(poles, num, d):
         resp = ltp.nyquist_htf(L, N, omega=np.linspace(-np.pi, np.pi, 101))
         assert resp.closed_loop_unstable == Z, (N, resp)
         assert resp.count == theirs
+
+
+def test_margin_report_in_hz():
+    G = ct.tf([4], [1, 3, 3, 1])
+    m = ltp.harmonic_margins(ltp.ltpss(G, period=1.0), 5, check=False)
+    gm, pm, sm, wpc, wgc, wms = ct.stability_margins(G)
+    row = next(r for r in m.report(hz=True).splitlines() if r.startswith('gain upper'))
+    assert abs(float(row.split()[-1]) - wpc / (2 * np.pi)) < 1e-5
+    assert "[rad/s]" in m.report()

@@ -138,6 +138,38 @@ class HarmonicMargins:
     nharmonics: int
     skew: float
 
+    def report(self, hz=False):
+        """The margins as a table, frequencies in rad/s or (``hz=True``) Hz.
+
+        Parameters
+        ----------
+        hz : bool
+            Physical frequencies in Hz instead of rad/s.
+
+        Returns
+        -------
+        str
+
+        Examples
+        --------
+        >>> m = ltp.harmonic_margins(ltp.ltpss(ct.tf([4], [1, 3, 3, 1]), period=1.0), 5)
+        >>> print(m.report(hz=True))          # doctest: +NORMALIZE_WHITESPACE
+        margin       value  harmonic  frequency [Hz]
+        gain upper       2         0         0.27566
+        gain lower       0         0             nan
+        phase [deg]  27.14         0         0.19621
+        stability   0.3333         0         0.22508
+        disk        0.3777         0         0.22117
+        """
+        unit = 'Hz' if hz else 'rad/s'
+        rows = [f"margin       value  harmonic  frequency [{unit}]"]
+        for name, p in (('gain upper', self.gain_upper), ('gain lower', self.gain_lower),
+                        ('phase [deg]', self.phase), ('stability', self.stability),
+                        ('disk', self.disk)):
+            f = p.frequency / (2 * np.pi) if hz else p.frequency
+            rows.append(f"{name:<11} {p.value:6.4g} {p.harmonic:9d} {f:15.5g}")
+        return "\n".join(rows)
+
     def __repr__(self):
         return (f"<HarmonicMargins N={self.nharmonics}: gain ({self.gain_lower.value:.4g}, "
                 f"{self.gain_upper.value:.4g}), phase {self.phase.value:.4g} deg, "
