@@ -61,6 +61,7 @@ def main(argv=None):
     import p11_orbits
     import p12_chatter
     import p13_campbell
+    import p15_harmonic_stability
 
     if args.wall:
         _common.use_wall_clock()
@@ -73,6 +74,7 @@ def main(argv=None):
     suites['P11'] = p11_orbits
     suites['P12'] = p12_chatter
     suites['P13'] = p13_campbell
+    suites['P15'] = p15_harmonic_stability
     only = [s.strip().upper() for s in args.only.split(',')] if args.only else list(suites)
     unknown = set(only) - set(suites)
     if unknown:

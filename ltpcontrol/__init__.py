@@ -49,6 +49,7 @@ from ._rotors.campbell_lin import campbell_lin
 from ._rotors.mode_labels import mode_labels
 from ._analysis.zeros import zeros
 from ._frequency.harmonic_ss import harmonic_ss
+from ._frequency.harmonic_modes import harmonic_modes, HarmonicModes
 from ._frequency.nyquist import nyquist_htf, HarmonicNyquistResponse
 from ._frequency.margins import harmonic_margins, stability_margins, HarmonicMargins, MarginPoint
 from ._frequency.loop_functions import (sensitivity_htf, complementary_sensitivity_htf,
@@ -139,6 +140,8 @@ __all__ = [
     'stability_chart', 'StabilityChart', 'StabilityChartError',
     # discrete periodic systems with time-varying dimensions, lifted forms
     'DiscreteLTPSystem', 'dltpss', 'unlift', 'sample_multirate', 'lifted_margins',
+    # harmonic stability
+    'harmonic_modes', 'HarmonicModes',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

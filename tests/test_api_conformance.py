@@ -229,6 +229,7 @@ _RESULT_CLASSES |= {'HTFEstimateInfo', 'ARXInfo', 'HTFFitInfo'}
 _RESULT_CLASSES |= {'FloquetModes', 'CampbellDiagram'}
 _RESULT_CLASSES |= {'HarmonicNyquistResponse', 'HarmonicMargins', 'MarginPoint'}
 _RESULT_CLASSES |= {'DelayMonodromy', 'StabilityChart'}
+_RESULT_CLASSES |= {'HarmonicModes'}
 
 DOC_DEFECTS = {}
 

@@ -27,6 +27,7 @@ from .display import html, text
 from .periodic_matrix import PeriodicMatrix, as_periodic
 from .refusals import refusal, refusal_error
 from .registry import aliased, overridden
+from .wellposed import check_well_posed
 from .validation import (check_period, check_positive, commensurate, index_list, real_array,
                          steps_per_period)
 
@@ -567,7 +568,9 @@ def feedback(sys1, sys2=1, sign=-1, **kwargs):
         raise ControlDimension("feedback: sys2 must map the outputs of sys1 to its inputs "
                                f"(sys1 {s1.shape}, sys2 {s2.shape})")
     n1, n2, p1 = s1.nstates, s2.nstates, s1.noutputs
-    F = _loop_inverse(np.eye(p1) - sign * (s1.D @ s2.D), "feedback")
+    loop = np.eye(p1) - sign * (s1.D @ s2.D)
+    check_well_posed(loop, "feedback", "I - sign D1(t) D2(t)")     # over the whole period
+    F = _loop_inverse(loop, "feedback")
     # y1 = F (C1 x1 + s D1 C2 x2 + D1 u);  u1 = u + s (C2 x2 + D2 y1)
     Cy = PeriodicMatrix.block([[F @ s1.C, sign * (F @ s1.D @ s2.C)]])
     Dy = F @ s1.D

@@ -24,6 +24,7 @@ import warnings
 import numpy as np
 import control as ct
 from scipy import sparse
+from scipy.linalg.lapack import zgbsv
 from tqdm.auto import tqdm
 
 from .. import config
@@ -62,6 +63,13 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, name=None):
     ValueError
         If `sys` is discrete-time.
 
+    Notes
+    -----
+    For a periodic A the state matrix is truncated: besides shifted copies
+    of the Floquet exponents, its eigenvalues (``ct.poles``) include
+    truncation-edge artefacts, which may lie in the right half plane of a
+    stable system.  `harmonic_modes` marks them and gives the modes.
+
     Examples
     --------
     The HTF of an LTI system has the diagonal blocks ``G(s + jnω_p)``; the
@@ -84,10 +92,12 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, name=None):
                    sys.output_labels, sys.state_labels)
 
 
-def build(sys, K, internal_harmonics, method, where, stacklevel=2):
+def build(sys, K, internal_harmonics, method, where, stacklevel=2, warn_unstable=True):
     """The checked harmonic state space of `sys` with K harmonics.
 
-    `stacklevel` is that of the user's call as seen from the caller of `build`.
+    `stacklevel` is that of the user's call as seen from the caller of `build`;
+    `warn_unstable=False` skips the stability remark (and its Floquet
+    computation) for callers to whom an unstable system is no misuse.
 
     Examples
     --------
@@ -103,7 +113,7 @@ def build(sys, K, internal_harmonics, method, where, stacklevel=2):
     """
     if method not in ('auto', 'modal', 'solve'):
         raise ValueError(f"method must be 'auto', 'modal' or 'solve', got {method!r}")
-    if not sys.is_stable():
+    if warn_unstable and not sys.is_stable():
         warnings.warn(f"{sys.name} is unstable: its HTF is defined wherever the harmonic "
                       "resolvent exists, but on the imaginary axis it describes no "
                       "steady-state response", UserWarning, stacklevel=stacklevel + 1)
@@ -156,12 +166,17 @@ def real_ss(hss, name, inputs, outputs, states):
 class _HarmonicStateSpace:
     """``H(x) = Hc (xI - F)^{-1} G + J`` with the central 2K+1 block rows/cols."""
 
-    def __init__(self, F, G, Hc, J, K, Ki, ny, nu, method, exact, floquet_A=None):
+    def __init__(self, F, G, Hc, J, K, Ki, ny, nu, method, exact, floquet_A=None,
+                 band=None):
         self.F, self.G, self.Hc, self.J = F, G, Hc, J
         self.K, self.Ki, self.ny, self.nu = K, Ki, ny, nu
         self.exact = exact
         self.modal = None
         self._residues = {}
+        # block-banded F (A(t) with few harmonics): (l, u) and -F in band storage
+        self.band = None
+        if band is not None and method in ('auto', 'solve'):
+            self.band = (band, band, _band_storage(-F, band, band))
         if floquet_A is not None and method in ('auto', 'modal'):
             # Floquet form: F = blkdiag(A - jnω_p I) has eigenvalues λ_i - jnω_p
             # and eigenvectors blkdiag(W) from ONE eigendecomposition A = W Λ W^{-1}
@@ -181,8 +196,10 @@ class _HarmonicStateSpace:
         """Diagonalise F once when it pays off (or when asked to)."""
         if self.modal is not None or self.method == 'solve':
             return
-        if self.method == 'auto' and npoints < _MODAL_BREAK_EVEN:
-            return                  # a few dense solves are cheaper than eig(F)
+        if self.method == 'auto' and (npoints < _MODAL_BREAK_EVEN or self.band is not None):
+            # a few dense solves are cheaper than eig(F); banded solves, O(n_F b^2)
+            # each, are cheaper than its O(n_F^3) for any number of points
+            return
         lam, V = np.linalg.eig(self.F)
         if self.method == 'modal' or np.linalg.cond(V) < 1e8:
             Vinv = np.linalg.solve(V, np.eye(len(lam)))
@@ -206,8 +223,14 @@ class _HarmonicStateSpace:
         cols = _central(Ki, K, nu)
         exact = sys.A.is_constant and _bandlimited(sys, Ki - K)
         floquet_A = (sys.A(0.0), w) if sys.A.is_constant else None
+        hA = sys.A.nharmonics
+        band = None
+        if not sys.A.is_constant and hA is not None:
+            b = (min(hA, 2 * Ki) + 1) * n - 1          # element bandwidth of 𝒜
+            if F.shape[0] >= _BAND_MIN and 3 * b + 1 <= F.shape[0] / 4:
+                band = b
         return cls(F, B_T[:, cols], C_T[rows], D_T[np.ix_(rows, cols)], K, Ki, ny, nu,
-                   method, exact, floquet_A)
+                   method, exact, floquet_A, band)
 
     @classmethod
     def discrete(cls, sys, K, method):
@@ -243,6 +266,8 @@ class _HarmonicStateSpace:
             sl = slice(a, a + chunk)
             if self.modal is not None:
                 out[sl] = self._modal_chunk(x[sl], r, c, rows, cols, use_residues)
+            elif self.band is not None:
+                out[sl] = self._banded_chunk(x[sl], r, c)
             else:
                 out[sl] = self._solve_chunk(x[sl], r, c)
             if J.any():
@@ -260,6 +285,10 @@ class _HarmonicStateSpace:
             use_residues = _BYTES * nF * nr * nc <= budget / 2
             fixed = _BYTES * nF * nr * nc if use_residues else 0
             per_point = _BYTES * (2 * nF + 2 * nr * nc + (0 if use_residues else nr * nF))
+        elif self.band is not None:
+            fixed = 0
+            rows_ab = self.band[2].shape[0] + self.band[0]
+            per_point = _BYTES * (rows_ab * nF + 2 * nF * nc + 2 * nr * nc)
         else:
             fixed = 0
             per_point = _BYTES * (2 * nF ** 2 + 2 * nF * nc + 2 * nr * nc)
@@ -290,6 +319,25 @@ class _HarmonicStateSpace:
         prod = (flat.T @ inv_gap.T).T if sparse.issparse(flat) else inv_gap @ flat
         return prod.reshape((len(x),) + shape)
 
+    def _banded_chunk(self, x, r, c):
+        # (xI - F) X = G by banded LU (LAPACK gbsv): O(n_F b^2 + n_F b n_c) per point
+        l, u, ab = self.band
+        Gc = np.asfortranarray(self.G[:, c])
+        Hr = self.Hc[r]
+        work = np.zeros((2 * l + u + 1, ab.shape[1]), complex, order='F')
+        out = np.empty((len(x), len(r), len(c)), complex)
+        for i, xi in enumerate(x):
+            work[:l] = 0
+            work[l:] = ab
+            work[l + u] += xi
+            _, _, X, info = zgbsv(l, u, work, Gc.copy(order='F'), overwrite_ab=1,
+                                  overwrite_b=1)
+            if info > 0:
+                raise ValueError("the HTF is not defined at a pole of the harmonic "
+                                 "state space (singular resolvent)")
+            out[i] = Hr @ X
+        return out
+
     def _solve_chunk(self, x, r, c):
         M = -np.broadcast_to(self.F, (len(x),) + self.F.shape)
         idx = np.arange(self.F.shape[0])
@@ -311,6 +359,30 @@ _BYTES = 16                 # one complex128
 # eig(F) costs about as much as 25-35 dense resolvent solves of the same size
 # (measured for 100 to 800 harmonic states), plus the inverse eigenvectors
 _MODAL_BREAK_EVEN = 40
+# banded solves for harmonic state spaces of at least this many states
+_BAND_MIN = 64
+
+
+def _band_storage(M, l, u):
+    """LAPACK band storage ``ab[u + i - j, j] = M[i, j]`` of a banded matrix.
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.harmonic_ss import _band_storage
+    >>> _band_storage(np.array([[1.0, 2.0, 0.0], [3.0, 4.0, 5.0], [0.0, 6.0, 7.0]]), 1, 1)
+    array([[0., 2., 5.],
+           [1., 4., 7.],
+           [3., 6., 0.]])
+    """
+    n = M.shape[0]
+    ab = np.zeros((l + u + 1, n), M.dtype)
+    for k in range(-l, u + 1):
+        d = np.diagonal(M, k)
+        if k >= 0:
+            ab[u - k, k:] = d
+        else:
+            ab[u - k, :n + k] = d
+    return ab
 
 
 def _size(nbytes):

@@ -14,21 +14,24 @@ import warnings
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
-from .htf import HTFModel
+from .harmonic_ss import build
 from .._core.floquet import floquet_exponents
 from .._core.ltpsys import LTPStateSpace, series
 from .._core.coerce import as_ltp
 from .._core.validation import check_positive_int
+from .._core.wellposed import check_well_posed
 
 __all__ = []
 
 
-def as_loop(L, name='L', period=None):
+def as_loop(L, name='L', period=None, where=None):
     """The loop as one square continuous-time `LTPStateSpace`.
 
     `L` is a system, or a sequence of systems ``(L_1, ..., L_k)`` meaning
     the product ``L_1 L_2 ... L_k`` (``L_k`` acts first), for example
-    ``(plant, controller)``.
+    ``(plant, controller)``.  The closed loop must be well posed: ``I +
+    D(t)`` nonsingular over the whole period (else ValueError naming the
+    function `where` and the instant).
 
     Examples
     --------
@@ -64,6 +67,7 @@ def as_loop(L, name='L', period=None):
         raise ControlDimension(f"{name} must be a square loop (as many outputs as inputs) "
                                "to be closed by negative feedback; it has "
                                f"{L.noutputs} outputs and {L.ninputs} inputs")
+    check_well_posed(np.eye(L.ninputs) + L.D, where or name)
     return L
 
 
@@ -71,23 +75,31 @@ class LoopHTF:
     """``L̂_N(s)`` evaluated at many points, shape ``(points, M, M)``.
 
     ``M = (2N+1) m`` with m loop channels, harmonic-major (Conventions).
+    The harmonic state space is built without the open loop's stability
+    remark (an unstable open loop is the point of the criterion), so that
+    the Floquet exponents are computed once per call, by the caller.
     """
 
-    def __init__(self, L, nharmonics, internal_harmonics=None):
+    def __init__(self, L, nharmonics, internal_harmonics=None, where='L'):
         self.L = L
         self.N = check_positive_int(nharmonics, 'nharmonics', minimum=1)
         self.m = L.ninputs
         self.omega_p = L.omega_p
+        self.nharmonics, self.dt = self.N, 0.0       # what default_omega reads
         with warnings.catch_warnings():
-            # an unstable open loop is the point of the criterion, not a misuse
-            warnings.filterwarnings('ignore', message='.* is unstable: its HTF')
-            # ... nor is the accuracy of the multipliers behind that remark
+            # the accuracy of the multipliers behind a remark is not the caller's concern
             warnings.filterwarnings('ignore', message='product_eigenvalues')
-            self.H = HTFModel(L, self.N, internal_harmonics=internal_harmonics)
+            self.hss = build(L, self.N, internal_harmonics, "auto", where, stacklevel=3,
+                             warn_unstable=False)
 
     def __call__(self, s):
         s = np.atleast_1d(np.asarray(s, complex))
-        return np.moveaxis(self.H(s), -1, 0)
+        return self.hss.evaluate(s)
+
+    def logdet(self, s):
+        """``(log|f|, arg f)`` of ``f = det(I + L̂_N(s))`` at the points `s`."""
+        sign, logabs = np.linalg.slogdet(np.eye(self.size) + self(s))
+        return logabs, np.angle(sign)
 
     @property
     def size(self):
@@ -99,12 +111,12 @@ class LoopHTF:
         return int(np.argmax(blocks.sum(axis=1))) - self.N
 
 
-def open_loop_exponents(L, atol=None):
+def open_loop_exponents(L, atol=None, nsteps=None):
     """(P, axis) of the open loop: count of exponents with positive real part
     and the strip frequencies of those on the imaginary axis.
 
     An exponent with ``|Re λ| <= atol`` (default ``1e-9 ω_p``) counts as on
-    the axis; the Nyquist contour indents to its right, so it is not counted
+    the axis (`nsteps`: Floquet steps, see `monodromy`); the Nyquist contour indents to its right, so it is not counted
     in P, as python-control does.
 
     Examples
@@ -121,7 +133,7 @@ def open_loop_exponents(L, atol=None):
     elif L.A.is_constant:
         lam = np.linalg.eigvals(L.A(0.0))           # constant A: its eigenvalues
     else:
-        lam = np.atleast_1d(floquet_exponents(L))
+        lam = np.atleast_1d(floquet_exponents(L, nsteps))
     on_axis = np.abs(lam.real) <= atol
     P = int(np.count_nonzero(lam.real > atol))
     w = fold(lam[on_axis].imag, wp)

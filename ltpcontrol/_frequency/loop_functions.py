@@ -61,7 +61,7 @@ def sensitivity_htf(L, nharmonics, *, period=None, internal_harmonics=None):
     >>> complex(np.round(S(0.0)[2, 2], 6))         # 1/(1 + L(0)) = 1/3
     (0.333333+0j)
     """
-    L = as_loop(L, 'L', period)
+    L = as_loop(L, 'L', period, 'sensitivity_htf')
     m = L.ninputs
     S = feedback(np.eye(m), L, name='S')
     return HTFModel(S, nharmonics, internal_harmonics=internal_harmonics)
@@ -93,7 +93,7 @@ def complementary_sensitivity_htf(L, nharmonics, *, period=None, internal_harmon
     >>> complex(np.round(T(0.0)[2, 2], 6))          # L(0)/(1 + L(0)) = 2/3
     (0.666667+0j)
     """
-    L = as_loop(L, 'L', period)
+    L = as_loop(L, 'L', period, 'complementary_sensitivity_htf')
     T = feedback(L, np.eye(L.ninputs), name='T')
     return HTFModel(T, nharmonics, internal_harmonics=internal_harmonics)
 
@@ -129,9 +129,9 @@ def siso_equivalent(L, nharmonics, omega=None, *, period=None, internal_harmonic
     >>> bool(np.allclose(Leq.frdata[0, 0], G(1j * np.array([0.5, 2.0]))))
     True
     """
-    L = as_loop(L, 'L', period)
+    L = as_loop(L, 'L', period, 'siso_equivalent')
     loop = LoopHTF(L, nharmonics, internal_harmonics)
-    w = (default_omega(loop.H) if omega is None
+    w = (default_omega(loop) if omega is None
          else real_array(omega, 'omega', ndim=(0, 1)).reshape(-1))
     Lh = loop(1j * w)
     m, N = loop.m, loop.N

@@ -41,6 +41,7 @@ from .nyquist import track
 from .._core.floquet import is_stable
 from .._core.ltpsys import feedback, series
 from .._core.validation import check_positive_int
+from .._core.wellposed import ill_posed_gains
 
 __all__ = ['harmonic_margins', 'stability_margins', 'HarmonicMargins', 'MarginPoint']
 
@@ -92,6 +93,9 @@ class HarmonicMargins:
     ----------
     gain_upper : MarginPoint
         Smallest gain margin above 1 (the loop gain may grow by this factor).
+        A gain that makes ``I + k D(t)`` singular at some instant ends the
+        range: the margin is then that gain, with ``frequency = inf`` (the
+        closed loop is ill-posed there).
     gain_lower : MarginPoint
         Largest gain margin below 1 (the loop gain may shrink to this
         factor); its value is 0 when no crossing lies below 1.
@@ -134,6 +138,38 @@ class HarmonicMargins:
     nharmonics: int
     skew: float
 
+    def report(self, hz=False):
+        """The margins as a table, frequencies in rad/s or (``hz=True``) Hz.
+
+        Parameters
+        ----------
+        hz : bool
+            Physical frequencies in Hz instead of rad/s.
+
+        Returns
+        -------
+        str
+
+        Examples
+        --------
+        >>> m = ltp.harmonic_margins(ltp.ltpss(ct.tf([4], [1, 3, 3, 1]), period=1.0), 5)
+        >>> print(m.report(hz=True))          # doctest: +NORMALIZE_WHITESPACE
+        margin       value  harmonic  frequency [Hz]
+        gain upper       2         0         0.27566
+        gain lower       0         0             nan
+        phase [deg]  27.14         0         0.19621
+        stability   0.3333         0         0.22508
+        disk        0.3777         0         0.22117
+        """
+        unit = 'Hz' if hz else 'rad/s'
+        rows = [f"margin       value  harmonic  frequency [{unit}]"]
+        for name, p in (('gain upper', self.gain_upper), ('gain lower', self.gain_lower),
+                        ('phase [deg]', self.phase), ('stability', self.stability),
+                        ('disk', self.disk)):
+            f = p.frequency / (2 * np.pi) if hz else p.frequency
+            rows.append(f"{name:<11} {p.value:6.4g} {p.harmonic:9d} {f:15.5g}")
+        return "\n".join(rows)
+
     def __repr__(self):
         return (f"<HarmonicMargins N={self.nharmonics}: gain ({self.gain_lower.value:.4g}, "
                 f"{self.gain_upper.value:.4g}), phase {self.phase.value:.4g} deg, "
@@ -141,7 +177,8 @@ class HarmonicMargins:
 
 
 def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
-                     internal_harmonics=None, edge_tol=0.05, check=True):
+                     internal_harmonics=None, edge_tol=0.05, check=True,
+                     floquet_steps=None):
     """Gain, phase, stability and disk margins of a periodic loop.
 
     Parameters
@@ -170,6 +207,9 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
         Floquet multipliers of the closed loops with the gains 0.1 % inside
         (stable) and outside (unstable) them, and warn otherwise (a
         crossing between grid points missed: raise `omega_num`).
+    floquet_steps : int, optional
+        Steps per period of every Floquet computation (`monodromy`'s
+        `nsteps`; default: its own choice).
 
     Returns
     -------
@@ -200,12 +240,14 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     >>> bool(np.isclose(m.gain_upper.frequency, wpc))
     True
     """
-    L = as_loop(L, 'L', period)
+    L = as_loop(L, 'L', period, 'harmonic_margins')
     loop = LoopHTF(L, nharmonics, internal_harmonics)
     num = check_positive_int(omega_num, 'omega_num', minimum=16)
     skew = float(skew)
     wp = loop.omega_p
-    _, axis_w = open_loop_exponents(L)
+    nsteps = None if floquet_steps is None else check_positive_int(floquet_steps,
+                                                                   'floquet_steps')
+    _, axis_w = open_loop_exponents(L, nsteps=nsteps)
     # the strip, extended by ω_p/8 on both sides so that crossings at its edges
     # (multiplier -1) are seen from both sides
     w = np.linspace(-5 * wp / 8, 5 * wp / 8, num)
@@ -220,7 +262,7 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     # near a pole on the axis every harmonic row is large: not a truncation effect
     far = (np.min(np.abs(w[:, None] - poles[None, :]), axis=1) > wp / 20 if poles.size
            else np.ones(len(w), bool))
-    _check_edge(loop, Lh[far], edge_tol)
+    _check_edge(loop, Lh[far] - loop.hss.J, edge_tol)     # the feedthrough is exact
     eig = _tracked(Lh)
 
     gains, phases = [], []
@@ -240,12 +282,20 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
                 pm = float(np.remainder(np.angle(hit[1], deg=True), 360.0) - 180.0)
                 phases.append(_point(loop, pm, hit, odd=True))
     gains, phases = _unique(gains, wp), _unique(phases, wp)
+    # gains k that make I + k D(t) singular end the range of the gain margins:
+    # the closed loop is ill-posed there (its exponents run off to infinity)
+    k_lo, k_hi = ill_posed_gains(L.D)
+    gains = [g for g in gains if k_lo < g.value < k_hi]
 
     above = [g for g in gains if g.value > 1]
     below = [g for g in gains if g.value < 1]
     upper = min(above, key=lambda g: g.value) if above else _NONE
     lower = (max(below, key=lambda g: g.value) if below
              else MarginPoint(0.0, float('nan'), 0, float('nan')))
+    if k_hi < upper.value:
+        upper = MarginPoint(k_hi, float('nan'), 0, float('inf'))
+    if k_lo > lower.value:
+        lower = MarginPoint(k_lo, float('nan'), 0, float('inf'))
     phase = min(phases, key=lambda p: abs(p.value)) if phases else _NONE
     stability = _extremum(loop, w, Lh, lambda M: np.linalg.svd(
         np.eye(len(M)) + M, compute_uv=False)[-1], 'min')
@@ -261,7 +311,7 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     disk = peak._replace(value=alpha)
     dgain, dphase = _disk_gain_phase(alpha, skew)
     if check:
-        _verify(L, upper.value, lower.value)
+        _verify(L, upper.value, lower.value, k_lo, k_hi, nsteps=nsteps)
     return HarmonicMargins(gain_upper=upper, gain_lower=lower, phase=phase,
                            stability=stability, disk=disk, disk_gain=dgain,
                            disk_phase=dphase, gain_crossings=gains,
@@ -448,24 +498,27 @@ def _disk_gain_phase(alpha, skew):
     return (float(gmin), float(gmax)), phase
 
 
-def _verify(L, upper, lower, delta=1e-3):
-    """Floquet check of the gain margins of a loop whose closed loop is stable."""
+def _verify(L, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3, nsteps=None):
+    """Floquet check of the gain margins of a loop whose closed loop is stable
+    (not beyond a margin set by an ill-posed gain)."""
     eye = np.eye(L.ninputs)
 
     def stable(k):
         with warnings.catch_warnings():
             # only the verdict is used, 0.1 % away from the boundary
             warnings.filterwarnings('ignore', message='product_eigenvalues')
-            return is_stable(feedback(series(L, k * eye), eye))
+            return is_stable(feedback(series(L, k * eye), eye), nsteps=nsteps)
     if not stable(1.0):
         return
     bad = []
     if np.isfinite(upper):
-        bad += [k for k, want in ((upper * (1 - delta), True), (upper * (1 + delta), False))
-                if stable(k) != want]
+        pairs = ((upper * (1 - delta), True),) + (
+            ((upper * (1 + delta), False),) if upper < k_hi else ())
+        bad += [k for k, want in pairs if stable(k) != want]
     if lower > 0:
-        bad += [k for k, want in ((lower * (1 + delta), True), (lower * (1 - delta), False))
-                if stable(k) != want]
+        pairs = ((lower * (1 + delta), True),) + (
+            ((lower * (1 - delta), False),) if lower > k_lo else ())
+        bad += [k for k, want in pairs if stable(k) != want]
     if bad:
         warnings.warn(f"harmonic_margins: the Floquet multipliers of the closed loop with "
                       f"the gains {bad} contradict the gain margins ({lower:.6g}, "

@@ -12,12 +12,16 @@ gives, by the argument principle,
     encirclements (counter-clockwise, of 0 by det(I + L̂)) = P - Z,
 
 with P the open-loop exponents and Z the closed-loop exponents in the
-open right half plane.  With the HTF truncated to N harmonics the curve
-``det(I + L̂_N(jω))`` over the strip does not close exactly: its *closure
-gap* ``|f(-jω_p/2) / f(jω_p/2) - 1|`` vanishes as N grows and measures the
-truncation.  Exponents on the imaginary axis are passed on the right by
-semicircles of radius ``indent_radius`` (not counted in P), as in
-`control.nyquist_response`.
+open right half plane.  With the HTF truncated to N harmonics the two
+horizontal edges no longer cancel — for a biproper loop (``L(∞) ≠ 0``)
+they carry whole turns at small N — so they are integrated (module
+`contour`): the count is then exact for the truncated loop, whose
+closed-loop exponents converge to the true ones as N grows.  The verdict
+is cross-checked by the closed loop's Floquet exponents when they are
+cheap.  The *closure gap* ``|f(-jω_p/2) / f(jω_p/2) - 1|`` of the curve on
+the axis alone is kept as information.  Exponents on the imaginary axis
+are passed on the right by semicircles of radius ``indent_radius`` (not
+counted in P), as in `control.nyquist_response`.
 
 For an LTI loop written as periodic, ``det(I + L̂_N(jω)) = Π_n (1 +
 L(jω + jnω_p))``, so the count is that of the ordinary Nyquist plot over
@@ -34,7 +38,9 @@ import control as ct
 import matplotlib.pyplot as plt
 from scipy.optimize import linear_sum_assignment
 
+from .contour import EDGE_OFFSET, abscissa_bound, path_phase, strip_closure
 from .loop import LoopHTF, as_loop, open_loop_exponents
+from .._core.ltpsys import feedback
 from .._core.validation import check_positive, check_positive_int, real_array
 
 __all__ = ['nyquist_htf', 'HarmonicNyquistResponse']
@@ -43,6 +49,8 @@ __all__ = ['nyquist_htf', 'HarmonicNyquistResponse']
 _MAX_TURN = np.pi / 4
 # bound on the number of contour points after refinement
 _MAX_POINTS = 50_000
+# check='auto' verifies the count by the closed loop's Floquet exponents up to this size
+_CHECK_STATES = 60
 
 
 @dataclass(frozen=True, repr=False)
@@ -67,7 +75,15 @@ class HarmonicNyquistResponse:
         True when Z is 0 (closed loop asymptotically stable).
     closure_gap : float
         ``|f(-jω_p/2) / f(jω_p/2) - 1|`` of ``f = det(I + L̂_N)``: zero for
-        the untruncated HTF; a truncation diagnostic.
+        the untruncated HTF.  Information only: the count integrates the
+        strip's horizontal edges, so it needs no closed curve.
+    edge_turns : float
+        Turns of f along the strip's other sides (horizontal edges and the
+        far side): zero for the untruncated HTF; whole turns at small N
+        for biproper loops.
+    floquet_unstable : int or None
+        Z from the closed loop's Floquet exponents (None when not
+        checked); a contradiction with the count warns.
     min_distance : float
         Smallest singular value of ``I + L̂_N`` on the contour (distance
         to a closed-loop exponent on the axis).
@@ -106,6 +122,8 @@ class HarmonicNyquistResponse:
     nharmonics: int
     omega_p: float
     sysname: str
+    edge_turns: float = 0.0
+    floquet_unstable: object = None
 
     @property
     def count(self):
@@ -192,7 +210,8 @@ class HarmonicNyquistResponse:
 
 
 def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
-                closure_tol=0.05, internal_harmonics=None):
+                closure_tol=0.05, internal_harmonics=None, check='auto',
+                floquet_steps=None):
     """Generalized Nyquist criterion for a periodic loop with negative feedback.
 
     Counts the encirclements of the origin by ``det(I + L̂_N(s))`` along the
@@ -220,9 +239,19 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
         Radius of the semicircles around open-loop exponents on the
         imaginary axis (default ``1e-4 ω_p``).
     closure_tol : float
-        A closure gap above this warns that N is too small.
+        Without a Floquet check, the outermost harmonic blocks of the
+        loop HTF less its feedthrough (which fills them exactly, e.g. for
+        a biproper loop) reaching this magnitude warn that the count is
+        only that of the truncated loop.
     internal_harmonics : int, optional
         Truncation of the harmonic state space (see `htf`).
+    check : bool or 'auto'
+        Cross-check the verdict by the Floquet exponents of the closed
+        loop (one more monodromy).  'auto' (default) checks loops with a
+        constant A or at most 60 states.
+    floquet_steps : int, optional
+        Steps per period of the Floquet computations (`monodromy`'s
+        `nsteps`; default: its own choice).
 
     Returns
     -------
@@ -242,15 +271,18 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     Warns
     -----
     UserWarning
-        When the closure gap exceeds `closure_tol` (increase `nharmonics`),
-        or when the contour passes within rounding of a closed-loop exponent
-        (the loop is at a stability boundary and the count is not
-        reliable).
+        When the count contradicts the closed loop's Floquet exponents
+        (increase `nharmonics`); when, unchecked, the truncation edge of
+        the loop HTF is not small; when the contour passes within
+        rounding of a closed-loop exponent (the loop is at a stability
+        boundary and the count is not reliable).
 
     Notes
     -----
-    The determinant's phase is accumulated on the contour; the closing
-    step from ``jω_p/2`` back to ``-jω_p/2`` takes the principal value.
+    The determinant's phase is accumulated on the axis and along the
+    strip's horizontal edges ``Im s = ±ω_p/2 + 10^-3 ω_p`` out to beyond
+    every exponent of the truncated loop (module notes); an open-loop
+    exponent whose harmonic representative lies beyond N is not seen.
     python-control's `control.nyquist_response` counts clockwise
     encirclements of -1: for an LTI loop written as periodic,
     ``ct.nyquist_response(L).count == -resp.encirclements`` when N covers
@@ -268,31 +300,43 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     >>> ct.nyquist_response(ct.tf([2], [1, -1])).count == resp.count
     True
     """
-    L = as_loop(L, 'L', period)
+    L = as_loop(L, 'L', period, 'nyquist_htf')
     loop = LoopHTF(L, nharmonics, internal_harmonics)
     wp = L.omega_p
     r = 1e-4 * wp if indent_radius is None else check_positive(
         indent_radius, 'indent_radius', below=wp / 4)
     closure_tol = check_positive(closure_tol, 'closure_tol')
-    P, axis_w = open_loop_exponents(L)
+    nsteps = _floquet_steps(floquet_steps)
+    do_check = _check_flag(check, L)
+    P, axis_w = open_loop_exponents(L, nsteps=nsteps)
     w = _initial_grid(omega, wp, axis_w, r)
 
-    w, s, logabs, phase, eig = _refined_contour(loop, w, axis_w, r)
-    dphi = _wrap(np.diff(phase))
+    w, s, logabs, phase, eig, edge = _refined_contour(loop, w, axis_w, r)
+    axis_turn = float(_wrap(np.diff(phase)).sum())
     closing = _wrap(phase[0] - phase[-1])
-    encirclements = int(np.round((dphi.sum() + closing) / (2 * np.pi)))
     with np.errstate(over='ignore', under='ignore'):
         gap = float(np.abs(np.exp(logabs[0] - logabs[-1] + 1j * closing) - 1))
         det = np.exp(logabs + 1j * phase)
+    edge_turn, resolved = _close_strip(loop, axis_w, r)
+    total = (axis_turn + edge_turn) / (2 * np.pi)
+    encirclements = int(np.round(total))
+    resolved &= abs(total - encirclements) < 0.05
     I = np.eye(loop.size)
     sv = np.linalg.svd(I + loop(s[::max(1, len(s) // 2000)]), compute_uv=False)
     dist = float(sv[:, -1].min())
-    if gap > closure_tol:
-        warnings.warn(f"nyquist_htf: the curve det(I + L̂_N) does not close: closure gap "
-                      f"{gap:.2g} > closure_tol={closure_tol:g} with nharmonics={loop.N}; "
-                      "the count may be wrong: increase nharmonics", UserWarning,
-                      stacklevel=2)
-    if dist < 1e-8:
+    Zf = closed_loop_unstable_count(L, nsteps) if do_check else None
+    if Zf is not None and Zf != P - encirclements:
+        warnings.warn(f"nyquist_htf: the count of the loop HTF truncated to nharmonics="
+                      f"{loop.N} (Z = {P - encirclements}) contradicts the closed loop's "
+                      f"Floquet exponents (Z = {Zf}): increase nharmonics",
+                      UserWarning, stacklevel=2)
+    elif Zf is None and edge > closure_tol:
+        warnings.warn(f"nyquist_htf: the loop HTF is not small at its truncation edge "
+                      f"(|L̂ - D̂| up to {edge:.2g} in harmonics ±{loop.N} > closure_tol="
+                      f"{closure_tol:g}) and no Floquet check was made: the count is exact "
+                      "for the truncated loop only; increase nharmonics or pass check=True",
+                      UserWarning, stacklevel=2)
+    if dist < 1e-8 or not resolved:
         warnings.warn("nyquist_htf: the contour passes through a closed-loop exponent "
                       f"(min singular value of I + L̂ = {dist:.1e}): the loop is at a "
                       "stability boundary and the count is not reliable", UserWarning,
@@ -300,7 +344,24 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     return HarmonicNyquistResponse(
         encirclements=encirclements, open_loop_unstable=P, closure_gap=gap,
         min_distance=dist, omega=w, contour=s, det=det, eigenloci=track(eig),
-        nharmonics=loop.N, omega_p=wp, sysname=L.name)
+        nharmonics=loop.N, omega_p=wp, sysname=L.name,
+        edge_turns=float(edge_turn / (2 * np.pi)), floquet_unstable=Zf)
+
+
+def closed_loop_unstable_count(L, nsteps=None):
+    """Closed-loop exponents with positive real part of ``feedback(L, I)``.
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.nyquist import closed_loop_unstable_count
+    >>> closed_loop_unstable_count(ltp.ltpss(ct.tf([3], [1, 1]), period=1.0))
+    0
+    >>> closed_loop_unstable_count(ltp.ltpss(ct.tf([-3], [1, 1]), period=1.0))
+    1
+    """
+    cl = feedback(L, np.eye(L.ninputs))
+    P, _ = open_loop_exponents(cl, nsteps=nsteps)
+    return P
 
 
 def contour_points(w, axis_w, r, wp):
@@ -363,13 +424,22 @@ def _initial_grid(omega, wp, axis_w, r):
 def _evaluate(loop, s):
     Lh = loop(s)
     sign, logabs = np.linalg.slogdet(np.eye(loop.size) + Lh)
-    return logabs, np.angle(sign), np.linalg.eigvals(Lh)
+    return logabs, np.angle(sign), np.linalg.eigvals(Lh), _edge(loop, Lh)
+
+
+def _edge(loop, Lh):
+    """Largest entry of the outermost harmonic blocks of L̂_N without its
+    feedthrough (which fills them exactly): the truncation diagnostic."""
+    m = loop.m
+    dyn = Lh - loop.hss.J
+    return float(max(np.abs(dyn[:, :m, :]).max(), np.abs(dyn[:, -m:, :]).max(),
+                     np.abs(dyn[:, :, :m]).max(), np.abs(dyn[:, :, -m:]).max()))
 
 
 def _refined_contour(loop, w, axis_w, r):
     wp = loop.omega_p
     s = contour_points(w, axis_w, r, wp)
-    logabs, phase, eig = _evaluate(loop, s)
+    logabs, phase, eig, edge = _evaluate(loop, s)
     while True:
         # a fast turn of the phase, or a fast change of the modulus (a lightly
         # damped exponent nearby, where the phase may turn between samples)
@@ -379,7 +449,7 @@ def _refined_contour(loop, w, axis_w, r):
             break
         wn = 0.5 * (w[:-1][bad] + w[1:][bad])
         sn = contour_points(wn, axis_w, r, wp)
-        la, ph, ev = _evaluate(loop, sn)
+        la, ph, ev, _ = _evaluate(loop, sn)
         order = np.argsort(np.concatenate([w, wn]), kind='stable')
         w = np.concatenate([w, wn])[order]
         s = np.concatenate([s, sn])[order]
@@ -389,7 +459,36 @@ def _refined_contour(loop, w, axis_w, r):
     if np.any(np.isinf(logabs)):
         warnings.warn("nyquist_htf: det(I + L̂_N) vanishes on the contour: the loop is "
                       "at a stability boundary", UserWarning, stacklevel=3)
-    return w, s, logabs, phase, eig
+    return w, s, logabs, phase, eig, edge
+
+
+def _close_strip(loop, axis_w, r):
+    """Phase change of det(I + L̂_N) over the other sides of the half strip."""
+    wp = loop.omega_p
+    eps = EDGE_OFFSET * wp
+    grid = np.linspace(0.0, 1.0, 9)
+
+    def along_axis(w0, w1):
+        return lambda t: contour_points(w0 + (w1 - w0) * np.asarray(t), axis_w, r, wp)
+    up, ok1, _ = path_phase(loop.logdet, along_axis(wp / 2, wp / 2 + eps), None, grid)
+    down, ok2, _ = path_phase(loop.logdet, along_axis(-wp / 2 + eps, -wp / 2), None, grid)
+    s_top = complex(contour_points(np.array([wp / 2 + eps]), axis_w, r, wp)[0])
+    s_bot = complex(contour_points(np.array([-wp / 2 + eps]), axis_w, r, wp)[0])
+    sigma = 2 * abscissa_bound(loop.hss) + wp
+    edges, ok3 = strip_closure(loop.logdet, s_top, s_bot, wp, sigma)
+    return up + edges + down, ok1 and ok2 and ok3
+
+
+def _floquet_steps(nsteps):
+    return None if nsteps is None else check_positive_int(nsteps, 'floquet_steps')
+
+
+def _check_flag(check, L):
+    if check == 'auto':
+        return L.A.is_constant or L.nstates <= _CHECK_STATES
+    if not isinstance(check, (bool, np.bool_)):
+        raise ValueError(f"check must be True, False or 'auto', got {check!r}")
+    return bool(check)
 
 
 def _wrap(x):

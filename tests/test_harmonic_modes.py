@@ -1,0 +1,96 @@
+"""Eigen-analysis of the harmonic state space: truncation-edge eigenvalues
+are marked, the modes equal the Floquet exponents of an independent
+monodromy (solve_ivp), and the sensitivities equal finite differences."""
+
+import numpy as np
+import control as ct
+import pytest
+from scipy.integrate import solve_ivp
+
+import ltpcontrol as ltp
+
+T = 2 * np.pi
+
+
+def mathieu(a, b, c):
+    A = ltp.PeriodicMatrix.from_function(
+        lambda t: np.array([[0.0, 1.0], [-(a + b * np.cos(t)), -c]]), T)
+    return ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=T)
+
+
+def monodromy_exponents(a, b, c):
+    def rhs(t, x):
+        return (np.array([[0.0, 1.0], [-(a + b * np.cos(t)), -c]]) @ x.reshape(2, 2)).ravel()
+    sol = solve_ivp(rhs, (0, T), np.eye(2).ravel(), method='DOP853', rtol=1e-12, atol=1e-14)
+    mu = np.linalg.eigvals(sol.y[:, -1].reshape(2, 2)).astype(complex)
+    return np.log(mu) / T
+
+
+def _same_mod(x, y, wp=1.0):
+    d = x - y
+    return np.hypot(d.real, np.remainder(d.imag + wp / 2, wp) - wp / 2)
+
+
+def test_stable_mathieu_has_no_unmarked_rhp_eigenvalue():
+    modes = ltp.harmonic_modes(mathieu(2.0, 3.0, 0.3))
+    lam = modes.eigenvalues
+    assert np.any(lam.real > 0.1)                 # the artefacts are there ...
+    assert np.all(modes.edge[lam.real > 0])       # ... and all of them are marked
+    assert not np.any(modes.floquet_consistent[lam.real > 0])
+    assert modes.stable
+    truth = monodromy_exponents(2.0, 3.0, 0.3)
+    for x in modes.exponents:
+        assert np.min(_same_mod(x, truth)) < 1e-8
+    assert "at the edge" in repr(modes)
+
+
+def test_unstable_mathieu_mode_is_unmarked():
+    modes = ltp.harmonic_modes(mathieu(1.0, 2.0, 0.3))
+    assert not modes.stable
+    unstable = modes.eigenvalues.real > 0.1
+    assert np.any(unstable & modes.floquet_consistent & ~modes.edge)
+    truth = monodromy_exponents(1.0, 2.0, 0.3)
+    assert abs(modes.exponents[0].real - truth.real.max()) < 1e-8
+
+
+def test_participation_and_table():
+    modes = ltp.harmonic_modes(mathieu(2.0, 3.0, 0.3), 12)
+    np.testing.assert_allclose(modes.participation.sum(axis=0), 1.0)
+    np.testing.assert_allclose(modes.harmonic_participation.sum(axis=0), 1.0)
+    assert modes.harmonic_participation.shape == (25, 2)
+    np.testing.assert_allclose(modes.frequency(hz=True), modes.frequency() / (2 * np.pi))
+    assert "frequency [Hz]" in modes.table(hz=True)
+    # physical exponents: the Floquet exponents shifted by whole harmonics
+    shift = (modes.exponents - modes.floquet).imag
+    np.testing.assert_allclose(shift, np.round(shift), atol=1e-8)
+    np.testing.assert_allclose(modes.exponents.real, modes.floquet.real, atol=1e-10)
+
+
+def test_lti_modes_are_the_poles():
+    G = ct.ss([[-0.5, 5.0], [-5.0, -0.5]], [[0.0], [1.0]], [[1.0, 0.0]], 0)
+    modes = ltp.harmonic_modes(ltp.ltpss(G, period=1.0))
+    by_imag = lambda z: z[np.argsort(z.imag)]
+    np.testing.assert_allclose(by_imag(modes.exponents), by_imag(ct.poles(G)), atol=1e-12)
+    np.testing.assert_allclose(modes.damping, 0.5 / np.hypot(0.5, 5.0))
+    assert not modes.edge.any()
+
+
+def test_sensitivity_equals_finite_difference():
+    a, b, c, h = 2.0, 3.0, 0.3, 1e-5
+    modes = ltp.harmonic_modes(mathieu(a, b, c))
+    d = modes.sensitivity([[0.0, 0.0], [-1.0, 0.0]])         # ∂A/∂a
+    plus, minus = monodromy_exponents(a + h, b, c), monodromy_exponents(a - h, b, c)
+    for lam, dl in zip(modes.exponents, d):
+        # follow the branch: the exponent nearest lam ± h dl
+        p = plus[np.argmin(_same_mod(plus, lam + h * dl))]
+        m = minus[np.argmin(_same_mod(minus, lam - h * dl))]
+        fd = (p - m) / (2 * h)
+        fd = fd.real + 1j * (np.remainder(fd.imag * 2 * h + 0.5, 1.0) - 0.5) / (2 * h)
+        assert abs(fd - dl) < 1e-4 * max(1.0, abs(dl))
+
+
+def test_bad_inputs():
+    with pytest.raises(ValueError, match="discrete"):
+        ltp.harmonic_modes(ltp.ltpss(ct.ss([[0.5]], [[1.0]], [[1.0]], 0, 0.1), period=0.2))
+    with pytest.raises(ValueError, match="edge_tol"):
+        ltp.harmonic_modes(mathieu(2.0, 3.0, 0.3), edge_tol=-1)
