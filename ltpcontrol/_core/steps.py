@@ -27,6 +27,7 @@ The steps are short (``h ‖A‖ <= 1`` by default), so the growing blocks
 """
 
 import numpy as np
+import scipy.linalg as la
 
 from .periodic_matrix import PeriodicMatrix
 from .transition import step_transitions
@@ -68,6 +69,55 @@ def step_grid(A, others=(), nsteps=None):
     grid = grid[np.concatenate([np.diff(grid) > 0, [True]])]
     grid[-1] = T
     return grid
+
+
+#: bytes of the step factors of a Floquet grid (with their QR copies)
+FACTOR_BUDGET = 512e6
+
+
+def floquet_grid(A, nsteps=None, budget=FACTOR_BUDGET):
+    """Grid of the Floquet factors ``Φ_k`` of one period of `A`.
+
+    As `step_grid`, with ``nsteps = ceil(T max_t ‖A(t)‖)`` by default, where
+    the norm is that of A after the exact diagonal balancing of the
+    integrator when it pays (states in mixed units), and the count is
+    clipped to [16, min(4096, budget / (24 n²))], so that the factors and
+    their periodic Schur copies fit `budget` bytes (512 MB) whatever the
+    size.  Each factor is integrated with as many sub-steps as its error
+    estimate asks (`step_transitions`), so a coarse grid loses no accuracy;
+    it only makes the factors less well conditioned.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.steps import floquet_grid
+    >>> A = ltp.PeriodicMatrix.constant(np.diag([-1.0, -1e4]), 1.0)
+    >>> len(floquet_grid(A)) - 1
+    4096
+    >>> len(floquet_grid(ltp.PeriodicMatrix.constant(-np.eye(300), 1.0))) - 1
+    16
+    """
+    if nsteps is not None:
+        return step_grid(A, nsteps=nsteps)
+    T, n = A.period, A.shape[0]
+    breaks = np.unique(np.mod(A.breakpoints, T))
+    few = n <= 64
+    probe = np.concatenate([[0.0] if A._piecewise_constant
+                            else np.arange(256 if few else 32) * T / (256 if few else 32),
+                            breaks])
+    At = A._eval(probe)
+    if n >= 2 and np.all(np.isfinite(At)):
+        big = np.abs(At).max(axis=0)
+        _, (s, _) = la.matrix_balance(big, permute=False, separate=True)
+        if (big * (s[None, :] / s[:, None])).sum(axis=0).max() * 8 < big.sum(axis=0).max():
+            At = At * (s[None, :] / s[:, None])
+    if few:
+        norm = np.max(np.linalg.norm(At, ord=2, axis=(1, 2)), initial=0.0)
+    else:
+        # sqrt(‖·‖₁ ‖·‖∞) bounds the 2-norm without an SVD per probe
+        norm = np.sqrt(np.abs(At).sum(axis=1).max(initial=0.0)
+                       * np.abs(At).sum(axis=2).max(initial=0.0))
+    cap = int(min(4096, max(16, budget // (24 * max(n, 1) ** 2))))
+    return step_grid(A, nsteps=int(np.clip(np.ceil(T * norm), 16, cap)))
 
 
 def gram_weight(F, adjoint=False):
