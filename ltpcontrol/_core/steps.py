@@ -30,6 +30,7 @@ import numpy as np
 import scipy.linalg as la
 
 from .periodic_matrix import PeriodicMatrix
+from .memory import check_allocation
 from .transition import step_transitions
 from .validation import check_positive_int
 
@@ -96,9 +97,11 @@ def floquet_grid(A, nsteps=None, budget=FACTOR_BUDGET):
     >>> len(floquet_grid(ltp.PeriodicMatrix.constant(-np.eye(300), 1.0))) - 1
     16
     """
-    if nsteps is not None:
-        return step_grid(A, nsteps=nsteps)
     T, n = A.period, A.shape[0]
+    if nsteps is not None:
+        nsteps = check_positive_int(nsteps, 'nsteps')
+        check_allocation((nsteps, n, n), f"{nsteps} Floquet factors of {n} states", copies=2)
+        return step_grid(A, nsteps=nsteps)
     breaks = np.unique(np.mod(A.breakpoints, T))
     few = n <= 64
     probe = np.concatenate([[0.0] if A._piecewise_constant

@@ -79,7 +79,7 @@ def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=2 ** 16, info=None):
         nsub, excess = 1, 0.0
     else:
         E, nsub, excess = _segment_transitions(A, B, seg_a, seg_b, t0[seg_step], h[seg_step],
-                                       rtol, max_substeps)
+                                               rtol, max_substeps)
     if info is not None:
         info['substeps'], info['excess'] = nsub, excess
     if len(seg_step) > len(t0):
@@ -145,7 +145,7 @@ def _segment_transitions(A, B, a, b, step_t0, step_h, rtol, max_substeps):
             nsub = 2
             prev = _magnus(A, B, a[sel], b[sel], step_t0[sel], step_h[sel], nsub, n, m, d,
                            scale)
-            first = True
+            initial = True
             while sel.size:
                 nsub *= 2
                 E = _magnus(A, B, a[sel], b[sel], step_t0[sel], step_h[sel], nsub, n, m, d,
@@ -154,9 +154,9 @@ def _segment_transitions(A, B, a, b, step_t0, step_h, rtol, max_substeps):
                 size = np.maximum(1.0, np.abs(E).max(axis=(1, 2)))
                 # fourth-order method: the error of E is about (E - prev)/15
                 ratio = err / 15 / (rtol * size)
-                if first:
+                if initial:
                     excess = max(excess, float(ratio.max()))
-                    first = False
+                    initial = False
                 done = ratio <= 1
                 if nsub >= max_substeps:
                     short = short or not np.all(done)
@@ -178,7 +178,7 @@ def _segment_transitions(A, B, a, b, step_t0, step_h, rtol, max_substeps):
 
 
 #: entries (d² per matrix) of the working arrays of one chunk of the integrator
-_CHUNK_ENTRIES = 2 ** 21
+_CHUNK_ENTRIES = 2 ** 19
 #: balance A when that divides its norm by more than this
 _BALANCE_GAIN = 8.0
 _BALANCE_PROBES = 16

@@ -1,0 +1,203 @@
+"""P12: Floquet analysis of real-size rotor models (38, 120, 300 states, stiff).
+
+Workload: a synthetic rotor model in the style of a multi-blade
+linearization, tabulated at 36 azimuths (Fourier interpolation, as
+`read_lin` does), period T = 1 s (Ω = 2π rad/s):
+
+* ``(n - s)/2`` structural degrees of freedom in scaled modal coordinates
+  ``(w q, q')``, natural frequencies 0.5Ω-15Ω, damping 0.5-5 %, whose
+  stiffness varies with the azimuth (harmonics 1 and 2, 10 % coupling);
+* s = n/10 stiff first-order states (sensor/actuator-like lags) with rates
+  ``-10⁴Ω (1 + 0.5 r)``, driven by the structural rates.  They do not feed
+  back, so their exponents are exactly their rates: an independent truth
+  for the stiff part, which a formed product cannot resolve (multipliers
+  ``e^{-6e4}``).
+
+Rows (n = 38, 120, 300):
+
+* ours: ``ltp.floquet_exponents`` and ``ltp.floquet_modes`` (default call).
+* peer: the 20-line hand-written product a user writes: N midpoint
+  ``scipy.linalg.expm`` steps ``Φ = Π e^{A((k+½)h) h}`` then ``eig``,
+  with N = 720 (the smallest N of the form 36 * 2^j whose structural
+  exponents reach the tolerance, checked against the reference at 2N).
+* accuracy: the exponents of the structural part against an independent
+  converged product (Richardson of midpoint products at 2N and 4N steps;
+  log-moduli from the periodic Schur form so that no product is formed),
+  error relative to the largest real part; the stiff exponents against
+  the same reference when it resolves them.
+
+Peak memory: tracemalloc peak of the call (NumPy allocations).
+
+The BAR row: the 44-state OpenFAST model ``BAR_URC_EDBD.1.lin``
+(ElastoDyn + BeamDyn, one azimuth) after ``mbc``; the time-varying
+multi-blade model has ``‖A‖ = 5e6`` and exponents down to -1.5e4 rad/s
+(Ω = 0.83 rad/s).  Being one constant rotating-frame matrix seen through
+the multi-blade transform, its exact exponents are the eigenvalues of
+the file's A (modulo jΩ): that is the truth.
+
+The Campbell row: `campbell` over 8 rotor speeds of the 16-state
+isotropic rotor of tests (ours) against MBC averaging plus ``eig`` (peer).
+"""
+
+import time
+import tracemalloc
+
+import numpy as np
+import scipy.linalg as la
+
+from _common import row, timed
+
+import ltpcontrol as ltp
+
+T = 1.0
+OMEGA = 2 * np.pi / T
+NAZ = 36
+TOL = 1e-8
+FULL = dict(sizes=(38, 120, 300), bar=True, modes=True)
+QUICK = dict(sizes=(38,), bar=False, modes=False)
+
+
+def rotor_model(n, seed=0, stiff=1e4):
+    """Synthetic rotor model (module notes): an LTPStateSpace with n states."""
+    rng = np.random.default_rng(seed)
+    s = max(2, n // 10)
+    m = (n - s) // 2
+    s = n - 2 * m
+    w = OMEGA * np.sort(rng.uniform(0.5, 15.0, m))
+    zeta = rng.uniform(0.005, 0.05, m)
+    G = [rng.standard_normal((m, m)) for _ in range(4)]
+    G = [0.5 * (g + g.T) / np.sqrt(m) for g in G]
+    lag = -stiff * OMEGA * (1 + 0.5 * rng.random(s))
+    drive = 0.3 * rng.standard_normal((s, m)) * np.sqrt(w)[None, :]
+    samples = []
+    for psi in 2 * np.pi * np.arange(NAZ) / NAZ:
+        varying = 0.1 * (np.cos(psi) * G[0] + np.sin(psi) * G[1]
+                         + np.cos(2 * psi) * G[2] + np.sin(2 * psi) * G[3])
+        K = np.diag(w ** 2) + np.sqrt(w)[:, None] * varying * np.sqrt(w)[None, :] * w.mean()
+        A = np.zeros((n, n))
+        # states (w q, q', lags): d(wq)/dt = w q', dq'/dt = -K q - 2ζw q' + back lags
+        A[:m, m:2 * m] = np.diag(w)
+        A[m:2 * m, :m] = -K / w[None, :]
+        A[m:2 * m, m:2 * m] = -np.diag(2 * zeta * w)
+        A[2 * m:, m:2 * m] = drive
+        A[2 * m:, 2 * m:] = np.diag(lag)
+        samples.append(A)
+    A = ltp.PeriodicMatrix.from_samples(np.array(samples), T, kind='fourier')
+    return ltp.ltpss(A, np.zeros((n, 0)), np.zeros((0, n)), np.zeros((0, 0)), period=T)
+
+
+def midpoint_factors(A, N):
+    """Midpoint exponential factors e^{A((k+½)h) h}, k = 0..N-1 (generator)."""
+    h = T / N
+    for k in range(N):
+        yield la.expm(A((k + 0.5) * h) * h)
+
+
+def peer_exponents(sys, N):
+    """The hand-written product: Φ = Π midpoint expm, then log(eig Φ)/T."""
+    Phi = np.eye(sys.nstates)
+    for F in midpoint_factors(sys.A, N):
+        Phi = F @ Phi
+    mu = np.linalg.eigvals(Phi)
+    with np.errstate(divide='ignore'):
+        return np.log(np.abs(mu)) / T + 1j * np.angle(mu) / T
+
+
+def reference_exponents(n, N, seed=0):
+    """Independent exponents: the lag rates and a converged structural product.
+
+    The structural block alone (no stiffness) is integrated by midpoint
+    products at N and 2N steps, Richardson-extrapolated (order 2) on 36
+    groups of steps, and the group factors go through the periodic Schur
+    form (no product is formed).  The stiff exponents are the lag rates
+    exactly (the lags do not feed back).
+    """
+    from ltpcontrol._core.periodic_schur import product_eigenvalues
+    sys = rotor_model(n, seed)
+    s = max(2, n // 10)
+    m = (n - s) // 2
+    k = 2 * m
+    lags = np.diag(sys.A(0.0))[k:]
+    Ab = lambda t: sys.A(t)[:k, :k]            # noqa: E731
+    groups = NAZ
+    factors = []
+    for g in range(groups):
+        t0, t1 = g * T / groups, (g + 1) * T / groups
+        out = []
+        for steps in (N // groups, 2 * N // groups):
+            h = (t1 - t0) / steps
+            P = np.eye(k)
+            for j in range(steps):
+                P = la.expm(Ab(t0 + (j + 0.5) * h) * h) @ P
+            out.append(P)
+        factors.append((4 * out[1] - out[0]) / 3)
+    logmod, arg = product_eigenvalues(np.array(factors))
+    return np.concatenate([logmod / T + 1j * arg / T, lags.astype(complex)]), k
+
+
+def real_error(lam, ref, keep=None, scale=None):
+    """Largest error of the sorted real parts (of the `keep` largest), relative."""
+    a = np.sort(np.real(lam))[::-1][:keep]
+    b = np.sort(np.real(ref))[::-1][:keep]
+    scale = np.max(np.abs(np.real(ref))) if scale is None else scale
+    with np.errstate(invalid='ignore'):
+        err = np.max(np.abs(a - b)) / scale
+    return float(err) if np.isfinite(err) else np.inf
+
+
+def measure(fn, *args):
+    tracemalloc.start()
+    try:
+        t, out = timed(fn, *args)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    return t, out, peak
+
+
+def run(quick=False, log=print):
+    cfg = QUICK if quick else FULL
+    rows = []
+    modes = cfg['modes']
+    for n in cfg['sizes']:
+        sys = rotor_model(n)
+        log(f"P12: Floquet exponents, {n} states")
+        t_ours, lam, peak = measure(ltp.floquet_exponents, sys)
+        N = 720
+        t_peer, lam_peer, peak_peer = measure(peer_exponents, sys, N)
+        t_ref, (ref, k) = timed(reference_exponents, n, 2 * N)
+        scale = np.max(np.abs(ref.real))
+        err_ours = real_error(lam, ref, scale=scale)
+        err_peer = real_error(lam_peer, ref, scale=scale)
+        struct_scale = np.max(np.abs(np.sort(ref.real)[::-1][:k]))
+        err_struct = real_error(lam, ref, k, scale=struct_scale)
+        err_struct_peer = real_error(lam_peer, ref, k, scale=struct_scale)
+        t_modes = peak_modes = None
+        if modes:
+            t_modes, _, peak_modes = measure(ltp.floquet_modes, sys)
+        rows.append(row(
+            f'P12-{n}', f'floquet_exponents, {n}-state rotor, 36 azimuths, stiff -1e4 Omega',
+            ours='floquet_exponents', peer=f'{N} midpoint expm product + eig',
+            t_ours=t_ours, t_peer=t_peer, target='<= 2x peer time, <= 1 GB',
+            target_met=t_ours <= 2 * t_peer and peak <= 1e9, err_ours=err_ours,
+            err_peer=err_peer, tol=TOL,
+            checks={'ours <= tol (all exponents, rel. largest |Re|)': err_ours <= TOL},
+            matched=err_ours <= TOL and err_peer <= TOL,
+            notes=f'peak {peak / 1e6:.0f} MB (peer {peak_peer / 1e6:.0f} MB); structural '
+                  f'exponents rel. their largest |Re|: ours {err_struct:.1e}, peer '
+                  f'{err_struct_peer:.1e}; floquet_modes '
+                  + ('-' if t_modes is None else f'{t_modes:.1f} s, {peak_modes / 1e6:.0f} MB'),
+            extra=dict(peak_ours=peak, peak_peer=peak_peer, err_struct=err_struct,
+                       err_struct_peer=err_struct_peer, t_modes=t_modes,
+                       peak_modes=peak_modes, t_reference=t_ref)))
+        log(f"  ours {t_ours:.1f} s {peak / 1e6:.0f} MB err {err_ours:.1e} (structural "
+            f"{err_struct:.1e}); peer {t_peer:.1f} s err {err_peer:.1e} (structural "
+            f"{err_struct_peer:.1e}); modes {t_modes} s {peak_modes}")
+    return rows
+
+
+if __name__ == '__main__':
+    import sys as _sys
+    FULL['sizes'] = tuple(int(a) for a in _sys.argv[1:]) or FULL['sizes']
+    for r in run():
+        print(r)
