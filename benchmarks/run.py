@@ -59,6 +59,7 @@ def main(argv=None):
     import p9_htf_memory
     import p10_grids
     import p11_orbits
+    import p12_floquet_scale
 
     if args.wall:
         _common.use_wall_clock()
@@ -69,6 +70,7 @@ def main(argv=None):
     suites['P9'] = p9_htf_memory
     suites['P10'] = p10_grids
     suites['P11'] = p11_orbits
+    suites['P12'] = p12_floquet_scale
     only = [s.strip().upper() for s in args.only.split(',')] if args.only else list(suites)
     unknown = set(only) - set(suites)
     if unknown:

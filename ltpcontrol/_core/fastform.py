@@ -44,7 +44,7 @@ def fast_form(A, band_tol=BAND_TOL):
     >>> F.nharmonics, bool(np.allclose(F(0.3), A(0.3)))
     (2, True)
     """
-    if A._coeffs is not None or A._pieces is not None or A.breakpoints.size \
+    if A.nharmonics is not None or A.switching_times is not None or A.breakpoints.size \
             or A._piecewise_constant:
         return A
     T = A.period
@@ -84,15 +84,16 @@ def constant_value(A, rtol=CONSTANT_RTOL):
     >>> constant_value(A, rtol=1e-14) is None
     True
     """
-    if A._coeffs is None:
+    if A.nharmonics is None:
         A = fast_form(A)
-        if A._coeffs is None:
+        if A.nharmonics is None:
             return None
+    K = A.nharmonics
+    coeffs = A.fourier(K)
+    mean = np.real(coeffs[K])
     if A.is_constant:
-        return np.real(A._coeffs[A._coeffs.shape[0] // 2]).copy()
-    K = A._coeffs.shape[0] // 2
-    mean = np.real(A._coeffs[K])
+        return mean.copy()
     # max_t |A(t) - mean| <= 2 Σ_{k>0} |A_k|
-    variation = 2 * np.abs(A._coeffs[K + 1:]).sum(axis=0).max(initial=0.0)
+    variation = 2 * np.abs(coeffs[K + 1:]).sum(axis=0).max(initial=0.0)
     scale = np.abs(mean).max(initial=0.0) + variation
     return mean.copy() if variation <= rtol * scale else None
