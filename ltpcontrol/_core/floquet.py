@@ -34,7 +34,7 @@ from .pm_ops import register_func
 from .steps import floquet_grid
 from .fastform import constant_value, fast_form
 from .memory import check_allocation
-from .transition import expm_batch, step_transitions
+from .transition import expm_batch, step_transitions, uniform_transitions
 from .coerce import as_ltp
 from .validation import check_positive_int, steps_per_period
 from .registry import method_alias
@@ -420,8 +420,7 @@ def _factors(sys, nsteps):
     if mean is not None:
         # constant to the precision of its data: every factor is e^{Ā h}
         return grid, expm_batch(np.diff(grid)[:, None, None] * mean)
-    phi, _, _ = step_transitions(A, None, grid[:-1], np.diff(grid))
-    return grid, phi
+    return grid, uniform_transitions(A, grid[:-1], np.diff(grid))
 
 
 def _log_multipliers(sys, nsteps, grid=None, factors=None):

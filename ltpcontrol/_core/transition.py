@@ -95,6 +95,82 @@ def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=2 ** 16, info=None):
     return E[:, :n, :n], E[:, :n, n:n + m], E[:, :n, n + m:]
 
 
+#: probe steps that choose the common sub-step count of `uniform_transitions`
+_PROBE_STEPS = 24
+
+
+def uniform_transitions(A, t0, h, rtol=1e-12, max_substeps=2 ** 16):
+    """Transition matrices of many steps of a smooth A, one sub-step count for all.
+
+    For long runs of similar steps (the factors of a Floquet grid) the
+    per-step doubling of `step_transitions` integrates every step at two
+    or three resolutions.  Here the adaptive integration runs on probe
+    steps spread over the run (and on the longest one); every step is then
+    integrated once with the largest sub-step count the probes accepted,
+    and a second, interleaved set of probes checks that count (error
+    estimate from the half count, as in `step_transitions`).  If the check
+    fails, every step is integrated adaptively.  Memory O(S n²).
+
+    Parameters
+    ----------
+    A : PeriodicMatrix
+    t0, h : ndarray
+        Step starts and lengths (1D, same length).
+    rtol : float
+        Relative accuracy target.
+
+    Returns
+    -------
+    Phi : ndarray, shape (S, n, n)
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.transition import uniform_transitions
+    >>> A = ltp.PeriodicMatrix.from_function(
+    ...     lambda t: np.array([[-1.0 + 0.5 * np.cos(2 * np.pi * t)]]), 1.0)
+    >>> t = np.linspace(0, 1, 101)
+    >>> Phi = uniform_transitions(A, t[:-1], np.diff(t))
+    >>> bool(np.isclose(np.prod(Phi[:, 0, 0]), np.exp(-1.0)))
+    True
+    """
+    t0 = np.asarray(t0, float)
+    h = np.broadcast_to(np.asarray(h, float), t0.shape)
+    S, n = len(t0), A.shape[0]
+    if S <= 4 * _PROBE_STEPS or A._piecewise_constant or A.breakpoints.size or n == 0:
+        return step_transitions(A, None, t0, h, rtol, max_substeps)[0]
+    check_allocation((S, n, n), f"the transition matrices of {S} steps ({n} x {n})")
+    spacing = (S - 1) / (_PROBE_STEPS - 1)
+    probe = np.union1d(np.round(np.arange(_PROBE_STEPS) * spacing).astype(int),
+                       [int(np.argmax(h))])
+    with warnings.catch_warnings():
+        warnings.simplefilter('error', UserWarning)
+        try:
+            _, nsub, _ = _segment_transitions(A, None, t0[probe], t0[probe] + h[probe],
+                                              t0[probe], h[probe], rtol, max_substeps)
+        except UserWarning:
+            return step_transitions(A, None, t0, h, rtol, max_substeps)[0]
+    scale = _balancing(A, n, n)
+    out = np.empty((S, n, n))
+    chunk = max(1, _CHUNK_ENTRIES // (n * n))
+    check = np.unique(np.minimum(S - 1, np.round((np.arange(_PROBE_STEPS - 1) + 0.5)
+                                                 * spacing).astype(int)))
+    with small_blas(n):
+        for c0 in range(0, S, chunk):
+            sel = slice(c0, min(S, c0 + chunk))
+            out[sel] = _magnus(A, None, t0[sel], t0[sel] + h[sel], t0[sel], h[sel], nsub,
+                               n, 0, n, scale)
+        if nsub >= 2:
+            half = _magnus(A, None, t0[check], t0[check] + h[check], t0[check], h[check],
+                           nsub // 2, n, 0, n, scale)
+            E = out[check]
+            err = np.abs(E - half).max(axis=(1, 2)) / 15
+            if np.any(err > rtol * np.maximum(1.0, np.abs(E).max(axis=(1, 2)))):
+                return step_transitions(A, None, t0, h, rtol, max_substeps)[0]
+    if scale is not None:
+        out *= scale[:, None] / scale[None, :]
+    return out
+
+
 def _segments(t0, h, bps, period):
     """Split each step at the switching instants ``bps + j T`` inside it.
 
