@@ -103,7 +103,7 @@ def grid_march(A, B, C, D, t, u, x0, hold, rtol, states=True):
         # steps longer than or not dividing the period: a cell table, when worthwhile
         count = len(h) if repeat is None else repeat[0]
         if count > 2 * math.ceil(T / h.min()) or (repeat is not None and repeat[1] > 1):
-            if np.allclose(h, h[0], rtol=1e-10, atol=0):
+            if repeat is None and np.allclose(h, h[0], rtol=1e-10, atol=0):
                 # a uniform grid: the step data are smooth periodic functions of the phase
                 table = _phase_table(A, B, float(h[0]), T, rtol)
             if table is None:
