@@ -185,8 +185,6 @@ def bar_row(log=print):
     # transform: the exponents are its eigenvalues (real parts exactly)
     ev = np.linalg.eigvals(lin.A(0.0))
     err = real_error(lam, ev)
-    t_avg, _ = timed(lambda: np.linalg.eigvals(nr.average(method='samples').A(0.0))
-                     if hasattr(nr, 'average') else None)
     log(f"  ours {t_ours:.1f} s, peak {peak / 1e6:.0f} MB, error {err:.1e}")
     return row('P12-BAR', 'floquet_exponents, BAR_URC_EDBD.1.lin after mbc, 44 states, '
                '|A| = 5e6, exponents to -1.5e4', ours='floquet_exponents', peer=None,
