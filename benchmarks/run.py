@@ -62,6 +62,7 @@ def main(argv=None):
     import p12_chatter
     import p13_campbell
     import p15_harmonic_stability
+    import p14_floquet_scale
 
     if args.wall:
         _common.use_wall_clock()
@@ -75,6 +76,7 @@ def main(argv=None):
     suites['P12'] = p12_chatter
     suites['P13'] = p13_campbell
     suites['P15'] = p15_harmonic_stability
+    suites['P14'] = p14_floquet_scale
     only = [s.strip().upper() for s in args.only.split(',')] if args.only else list(suites)
     unknown = set(only) - set(suites)
     if unknown:

@@ -35,7 +35,8 @@ from control.exception import ControlArgument, ControlDimension
 
 from .._core.periodic_matrix import PeriodicMatrix
 from .._core.periodic_schur import product_eigenvalues
-from .._core.steps import step_grid
+from .._core.steps import floquet_grid
+from .._core.fastform import fast_form
 from .._core.transition import step_transitions
 from .._core.coerce import as_ltp
 from .._core.validation import check_positive_int, steps_per_period
@@ -446,7 +447,8 @@ def _continuous_grid(sys, nharmonics, nsteps):
         K = check_positive_int(nharmonics, 'nharmonics')
     S = 2 * K + 1
     samples = np.arange(S) * T / S
-    base = step_grid(A, nsteps=nsteps)
+    A = fast_form(A)               # one sampling; cheap evaluations in the integrator
+    base = floquet_grid(A, nsteps=nsteps)
     # drop base points too close to a sample instant, then merge
     near = np.min(np.abs(base[:, None] - samples[None, :]), axis=1) < 1e-9 * T
     grid = np.union1d(base[~near], samples)

@@ -31,8 +31,10 @@ from .ltpsys import ltpss
 from .periodic_matrix import PeriodicMatrix
 from .periodic_schur import product_eigenvalues
 from .pm_ops import register_func
-from .steps import step_grid
-from .transition import expm_batch, step_transitions
+from .steps import floquet_grid
+from .fastform import constant_value, fast_form
+from .memory import check_allocation
+from .transition import expm_batch, step_transitions, uniform_transitions
 from .coerce import as_ltp
 from .validation import check_positive_int, steps_per_period
 from .registry import method_alias, overridden
@@ -61,8 +63,15 @@ def monodromy(sys, nsteps=None):
         Continuous- or discrete-time LTP system.
     nsteps : int, optional
         Continuous time only: number of uniform steps per period.  By
-        default ``ceil(T max_t ||A(t)||_2)`` clipped to [16, 4096], so that
-        every factor is well conditioned.
+        default ``ceil(T max_t ||A(t)||_2)`` (A balanced when its states
+        are badly scaled) clipped to [16, 4096] and to a memory budget of
+        512 MB for the factors, so that every factor is well conditioned.
+        Each factor is integrated with the sub-steps its error estimate
+        asks for (fourth-order Magnus, relative accuracy 1e-12), so the
+        memory is O(nsteps n²) whatever the stiffness.  A matrix that is
+        constant to 1e-10 of its size (e.g. an isotropic rotor in
+        multi-blade coordinates read from linearization files) is taken as
+        its mean.
 
     Returns
     -------
@@ -184,8 +193,8 @@ def floquet_exponents(sys, nsteps=None):
         A = sys.A.sample(nper)
         return lti_representatives(rho, A[0], nper=nper) if np.all(A == A[0]) else rho
     lam = logmod / sys.period + 1j * (arg / sys.period)
-    return lti_representatives(lam, sys.A(0.0), period=sys.period) \
-        if sys.A.is_constant else lam
+    mean = constant_value(fast_form(sys.A))
+    return lam if mean is None else lti_representatives(lam, mean, period=sys.period)
 
 
 def lti_representatives(values, A, *, period=None, nper=None):
@@ -418,15 +427,29 @@ def _factors(sys, nsteps):
         return np.arange(nper + 1) * sys.dt, A.sample(nper)
     if n == 0:
         return np.array([0.0, T]), np.zeros((1, 0, 0))
-    grid = step_grid(A, nsteps=nsteps)
-    zero = PeriodicMatrix.constant(np.zeros((n, 0)), T)
-    phi, _, _ = step_transitions(A, zero, grid[:-1], np.diff(grid))
-    return grid, phi
+    A = fast_form(A)
+    grid = floquet_grid(A, nsteps=nsteps)
+    check_allocation((len(grid) - 1, n, n), f"the {len(grid) - 1} Floquet factors of "
+                     f"{n} states", copies=2)
+    mean = constant_value(A)
+    if mean is not None:
+        # constant to the precision of its data: every factor is e^{Ā h}
+        return grid, expm_batch(np.diff(grid)[:, None, None] * mean)
+    return grid, uniform_transitions(A, grid[:-1], np.diff(grid))
 
 
 def _log_multipliers(sys, nsteps, grid=None, factors=None):
     """``log|μ_i|`` and ``arg μ_i`` from the periodic Schur form, sorted."""
     if factors is None:
+        sys = as_ltp(sys)
+        mean = None if sys.dt or sys.nstates == 0 else constant_value(fast_form(sys.A))
+        if mean is not None:
+            # constant to the precision of its data: μ = e^{λT}, λ the eigenvalues of Ā
+            lam = np.linalg.eigvals(mean) * sys.period
+            arg = np.angle(np.exp(1j * lam.imag))
+            arg[arg == -np.pi] = np.pi
+            order = np.lexsort((-arg, -lam.real))
+            return lam.real[order], arg[order]
         grid, factors = _factors(sys, nsteps)
     if factors.shape[1] == 0:
         return np.zeros(0), np.zeros(0)

@@ -30,6 +30,8 @@ import warnings
 import numpy as np
 from control.exception import ControlDimension
 
+from .threads import small_blas
+
 __all__ = ['product_eigenvalues']
 
 
@@ -121,8 +123,9 @@ def product_eigenvalues(factors, *, error=False, rank_tol=None):
     # eigenvalues left by factors singular to working precision are rounding noise:
     # they are kept, but their (undetermined) moduli do not enter the error estimate
     noise = 0 if n == 0 else max(0, _rank_deficiency(H, n * np.finfo(float).eps) - zeros)
-    logmod, arg, err = (np.zeros(0), np.zeros(0), 0.0) if n == 0 else \
-        _product_qr(H, zeros, noise)
+    with small_blas(n):
+        logmod, arg, err = (np.zeros(0), np.zeros(0), 0.0) if n == 0 else \
+            _product_qr(H, zeros, noise)
     return (logmod, arg, err) if error else (logmod, arg)
 
 

@@ -26,9 +26,13 @@ The steps are short (``h ‖A‖ <= 1`` by default), so the growing blocks
 ``e^{-Aᵀh}`` stay moderate even for stiff A.
 """
 
+import warnings
+
 import numpy as np
+import scipy.linalg as la
 
 from .periodic_matrix import PeriodicMatrix
+from .memory import check_allocation
 from .transition import step_transitions
 from .validation import check_positive_int
 
@@ -68,6 +72,69 @@ def step_grid(A, others=(), nsteps=None):
     grid = grid[np.concatenate([np.diff(grid) > 0, [True]])]
     grid[-1] = T
     return grid
+
+
+#: bytes of the step factors of a Floquet grid (with their QR copies)
+FACTOR_BUDGET = 512e6
+#: largest log-spread ``h ‖A‖`` of a factor whose small multipliers stay above rounding
+_LOG_SPREAD = 36.0
+
+
+def floquet_grid(A, nsteps=None, budget=FACTOR_BUDGET):
+    """Grid of the Floquet factors ``Φ_k`` of one period of `A`.
+
+    As `step_grid`, with ``nsteps = ceil(T max_t ‖A(t)‖)`` by default, where
+    the norm is that of A after the exact diagonal balancing of the
+    integrator when it pays (states in mixed units), and the count is
+    clipped to [16, min(4096, budget / (24 n²))], so that the factors and
+    their periodic Schur copies fit `budget` bytes (512 MB) whatever the
+    size.  Each factor is integrated with as many sub-steps as its error
+    estimate asks (`step_transitions`).  A factor holds its multipliers
+    down to about ``e^{-36}`` of its largest to working precision, so when
+    the budget caps the grid below ``T max‖A‖ / 36`` steps the most stiff
+    exponents may be lost to rounding (as in a formed product), which is
+    announced by a warning; the others keep full accuracy.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.steps import floquet_grid
+    >>> A = ltp.PeriodicMatrix.constant(np.diag([-1.0, -1e4]), 1.0)
+    >>> len(floquet_grid(A)) - 1
+    4096
+    >>> len(floquet_grid(ltp.PeriodicMatrix.constant(-np.eye(300), 1.0))) - 1
+    16
+    """
+    T, n = A.period, A.shape[0]
+    if nsteps is not None:
+        nsteps = check_positive_int(nsteps, 'nsteps')
+        check_allocation((nsteps, n, n), f"{nsteps} Floquet factors of {n} states", copies=2)
+        return step_grid(A, nsteps=nsteps)
+    breaks = np.unique(np.mod(A.breakpoints, T))
+    few = n <= 64
+    probe = np.concatenate([[0.0] if A._piecewise_constant
+                            else np.arange(256 if few else 32) * T / (256 if few else 32),
+                            breaks])
+    At = A._eval(probe)
+    if n >= 2 and np.all(np.isfinite(At)):
+        big = np.abs(At).max(axis=0)
+        _, (s, _) = la.matrix_balance(big, permute=False, separate=True)
+        if (big * (s[None, :] / s[:, None])).sum(axis=0).max() * 8 < big.sum(axis=0).max():
+            At = At * (s[None, :] / s[:, None])
+    if few:
+        norm = np.max(np.linalg.norm(At, ord=2, axis=(1, 2)), initial=0.0)
+    else:
+        # sqrt(‖·‖₁ ‖·‖∞) bounds the 2-norm without an SVD per probe
+        norm = np.sqrt(np.abs(At).sum(axis=1).max(initial=0.0)
+                       * np.abs(At).sum(axis=2).max(initial=0.0))
+    cap = int(min(4096, max(16, budget // (24 * max(n, 1) ** 2))))
+    nsteps = int(np.clip(np.ceil(T * norm), 16, cap))
+    if T * norm > _LOG_SPREAD * nsteps:
+        warnings.warn(f"the Floquet factors of {n} states are capped at {nsteps} steps "
+                      f"(memory budget {budget / 1e6:.0f} MB) while T max‖A(t)‖ = "
+                      f"{T * norm:.3g}: exponents below about {-_LOG_SPREAD * nsteps / T:.3g} "
+                      "fall under the rounding of the factors and may be inaccurate",
+                      UserWarning, stacklevel=3)
+    return step_grid(A, nsteps=nsteps)
 
 
 def gram_weight(F, adjoint=False):

@@ -23,13 +23,17 @@ matrix exponential, no sub-steps.  Everything is vectorised over steps.
 import warnings
 
 import numpy as np
+import scipy.linalg as la
+
+from .memory import check_allocation
+from .threads import small_blas
 
 __all__ = []
 
 _C1, _C2 = 0.5 - np.sqrt(3) / 6, 0.5 + np.sqrt(3) / 6
 
 
-def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=4096, info=None):
+def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=2 ** 16, info=None):
     """Transition data of many steps ``[t0[k], t0[k] + h[k]]``.
 
     Parameters
@@ -75,7 +79,7 @@ def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=4096, info=None):
         nsub, excess = 1, 0.0
     else:
         E, nsub, excess = _segment_transitions(A, B, seg_a, seg_b, t0[seg_step], h[seg_step],
-                                       rtol, max_substeps)
+                                               rtol, max_substeps)
     if info is not None:
         info['substeps'], info['excess'] = nsub, excess
     if len(seg_step) > len(t0):
@@ -89,6 +93,82 @@ def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=4096, info=None):
             out[seg_step[sel]] = E[sel] @ out[seg_step[sel]]
         E = out
     return E[:, :n, :n], E[:, :n, n:n + m], E[:, :n, n + m:]
+
+
+#: probe steps that choose the common sub-step count of `uniform_transitions`
+_PROBE_STEPS = 24
+
+
+def uniform_transitions(A, t0, h, rtol=1e-12, max_substeps=2 ** 16):
+    """Transition matrices of many steps of a smooth A, one sub-step count for all.
+
+    For long runs of similar steps (the factors of a Floquet grid) the
+    per-step doubling of `step_transitions` integrates every step at two
+    or three resolutions.  Here the adaptive integration runs on probe
+    steps spread over the run (and on the longest one); every step is then
+    integrated once with the largest sub-step count the probes accepted,
+    and a second, interleaved set of probes checks that count (error
+    estimate from the half count, as in `step_transitions`).  If the check
+    fails, every step is integrated adaptively.  Memory O(S n²).
+
+    Parameters
+    ----------
+    A : PeriodicMatrix
+    t0, h : ndarray
+        Step starts and lengths (1D, same length).
+    rtol : float
+        Relative accuracy target.
+
+    Returns
+    -------
+    Phi : ndarray, shape (S, n, n)
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.transition import uniform_transitions
+    >>> A = ltp.PeriodicMatrix.from_function(
+    ...     lambda t: np.array([[-1.0 + 0.5 * np.cos(2 * np.pi * t)]]), 1.0)
+    >>> t = np.linspace(0, 1, 101)
+    >>> Phi = uniform_transitions(A, t[:-1], np.diff(t))
+    >>> bool(np.isclose(np.prod(Phi[:, 0, 0]), np.exp(-1.0)))
+    True
+    """
+    t0 = np.asarray(t0, float)
+    h = np.broadcast_to(np.asarray(h, float), t0.shape)
+    S, n = len(t0), A.shape[0]
+    if S <= 4 * _PROBE_STEPS or A._piecewise_constant or A.breakpoints.size or n == 0:
+        return step_transitions(A, None, t0, h, rtol, max_substeps)[0]
+    check_allocation((S, n, n), f"the transition matrices of {S} steps ({n} x {n})")
+    spacing = (S - 1) / (_PROBE_STEPS - 1)
+    probe = np.union1d(np.round(np.arange(_PROBE_STEPS) * spacing).astype(int),
+                       [int(np.argmax(h))])
+    with warnings.catch_warnings():
+        warnings.simplefilter('error', UserWarning)
+        try:
+            _, nsub, _ = _segment_transitions(A, None, t0[probe], t0[probe] + h[probe],
+                                              t0[probe], h[probe], rtol, max_substeps)
+        except UserWarning:
+            return step_transitions(A, None, t0, h, rtol, max_substeps)[0]
+    scale = _balancing(A, n, n)
+    out = np.empty((S, n, n))
+    chunk = max(1, _CHUNK_ENTRIES // (n * n))
+    check = np.unique(np.minimum(S - 1, np.round((np.arange(_PROBE_STEPS - 1) + 0.5)
+                                                 * spacing).astype(int)))
+    with small_blas(n):
+        for c0 in range(0, S, chunk):
+            sel = slice(c0, min(S, c0 + chunk))
+            out[sel] = _magnus(A, None, t0[sel], t0[sel] + h[sel], t0[sel], h[sel], nsub,
+                               n, 0, n, scale)
+        if nsub >= 2:
+            half = _magnus(A, None, t0[check], t0[check] + h[check], t0[check], h[check],
+                           nsub // 2, n, 0, n, scale)
+            E = out[check]
+            err = np.abs(E - half).max(axis=(1, 2)) / 15
+            if np.any(err > rtol * np.maximum(1.0, np.abs(E).max(axis=(1, 2)))):
+                return step_transitions(A, None, t0, h, rtol, max_substeps)[0]
+    if scale is not None:
+        out *= scale[:, None] / scale[None, :]
+    return out
 
 
 def _segments(t0, h, bps, period):
@@ -120,54 +200,136 @@ def _segments(t0, h, bps, period):
 
 
 def _segment_transitions(A, B, a, b, step_t0, step_h, rtol, max_substeps):
+    """Magnus transitions of the segments ``[a, b]``, refined segment by segment.
+
+    Segments are processed in chunks whose working arrays fit a fixed
+    budget; within a chunk each segment doubles its sub-steps until its own
+    error estimate meets `rtol`, so the memory is O(S d²) whatever the
+    number of sub-steps and the time is linear in the sub-steps.
+    """
     n, m = A.shape[0], 0 if B is None else B.shape[1]
     d = n + 2 * m
-    nsub = 2
-    prev = None
-    excess = None
-    while True:
-        E = _magnus(A, B, a, b, step_t0, step_h, nsub, n, m, d)
-        if prev is not None:
-            err = np.abs(E - prev).max(axis=(1, 2))
-            scale = np.maximum(1.0, np.abs(E).max(axis=(1, 2)))
-            # fourth-order method: the error of E is about (E - prev)/15
-            ratio = err / 15 / (rtol * scale)
-            if excess is None:
-                excess = float(ratio.max()) if ratio.size else 0.0
-            if np.all(ratio <= 1):
-                return E + (E - prev) / 15, nsub, excess
-        if nsub >= max_substeps:
-            warnings.warn("transition matrices did not reach the requested accuracy "
-                          f"with {nsub} sub-steps per step; use a finer time grid",
-                          UserWarning, stacklevel=4)
-            return E, nsub, excess or 0.0
-        prev = E
-        nsub *= 2
+    S = len(a)
+    check_allocation((S, d, d), f"the transition matrices of {S} steps ({d} x {d})")
+    out = np.empty((S, d, d))
+    scale = _balancing(A, n, d)
+    chunk = max(1, _CHUNK_ENTRIES // (d * d))
+    nsub_max, excess, short = 1, 0.0, False
+    with small_blas(d):
+        for c0 in range(0, S, chunk):
+            sel = np.arange(c0, min(S, c0 + chunk))
+            nsub = 2
+            prev = _magnus(A, B, a[sel], b[sel], step_t0[sel], step_h[sel], nsub, n, m, d,
+                           scale)
+            initial = True
+            while sel.size:
+                nsub *= 2
+                E = _magnus(A, B, a[sel], b[sel], step_t0[sel], step_h[sel], nsub, n, m, d,
+                            scale)
+                err = np.abs(E - prev).max(axis=(1, 2))
+                size = np.maximum(1.0, np.abs(E).max(axis=(1, 2)))
+                # fourth-order method: the error of E is about (E - prev)/15
+                ratio = err / 15 / (rtol * size)
+                if initial:
+                    excess = max(excess, float(ratio.max()))
+                    initial = False
+                done = ratio <= 1
+                if nsub >= max_substeps:
+                    short = short or not np.all(done)
+                    out[sel] = E
+                    out[sel[done]] = E[done] + (E[done] - prev[done]) / 15
+                    nsub_max = max(nsub_max, nsub)
+                    break
+                if np.any(done):
+                    out[sel[done]] = E[done] + (E[done] - prev[done]) / 15
+                    nsub_max = max(nsub_max, nsub)
+                sel, prev = sel[~done], E[~done]
+    if short:
+        warnings.warn("transition matrices did not reach the requested accuracy "
+                      f"with {max_substeps} sub-steps per step; use a finer time grid",
+                      UserWarning, stacklevel=4)
+    if scale is not None:
+        out *= scale[:, None] / scale[None, :]
+    return out, nsub_max, excess
 
 
-def _magnus(A, B, a, b, step_t0, step_h, nsub, n, m, d):
+#: entries (d² per matrix) of the working arrays of one chunk of the integrator
+_CHUNK_ENTRIES = 2 ** 19
+#: balance A when that divides its norm by more than this
+_BALANCE_GAIN = 8.0
+_BALANCE_PROBES = 16
+
+
+def _balancing(A, n, d):
+    """Diagonal scaling (powers of 2, exact) of badly scaled states, or None.
+
+    Models in physical units (OpenFAST's metres, radians and their rates)
+    can have ``‖A‖`` many orders above their eigenvalues; the similarity
+    ``D⁻¹ A D`` that balances A (probed over the period) brings the norm,
+    and with it the Magnus sub-steps needed, down to the scale of the
+    dynamics.  Applied only when it divides the norm by more than 8, so
+    well-scaled models are integrated unchanged.
+    """
+    if n < 2:
+        return None
+    T = A.period
+    probe = np.concatenate([[0.0], A.breakpoints % T]) if A._piecewise_constant \
+        else np.arange(_BALANCE_PROBES) * T / _BALANCE_PROBES
+    At = np.abs(A._eval(probe)).max(axis=0)
+    if not np.all(np.isfinite(At)):
+        return None
+    norm = np.abs(At).sum(axis=0).max()
+    _, (s, _) = la.matrix_balance(At, permute=False, separate=True)
+    balanced = (np.abs(At) * (s[None, :] / s[:, None])).sum(axis=0).max()
+    if not balanced * _BALANCE_GAIN < norm:
+        return None
+    return np.concatenate([s, np.ones(d - n)])
+
+
+def _tree_product(E):
+    """``E[:, J-1] @ ... @ E[:, 0]`` for a stack (S, J, d, d), by pairwise products."""
+    while E.shape[1] > 1:
+        J = E.shape[1]
+        pairs = E[:, 1:J - J % 2:2] @ E[:, 0:J - J % 2:2]
+        E = np.concatenate([pairs, E[:, J - 1:]], axis=1) if J % 2 else pairs
+    return E[:, 0]
+
+
+def _magnus(A, B, a, b, step_t0, step_h, nsub, n, m, d, scale=None):
+    """Product of `nsub` Magnus sub-steps on each segment, accumulated in blocks.
+
+    Blocks of sub-steps whose node values fit the chunk budget are
+    evaluated and exponentiated together and multiplied into the running
+    product; no array holds all the sub-steps.
+    """
     nseg = len(a)
     delta = (b - a) / nsub                                   # (S,)
-    starts = a[:, None] + delta[:, None] * np.arange(nsub)   # (S, nsub)
-    nodes = np.stack([starts + _C1 * delta[:, None], starts + _C2 * delta[:, None]], -1)
-    tflat = nodes.ravel()
-    if m:
-        Mt = np.zeros((tflat.size, d, d))
-        Mt[:, :n, :n] = A._eval(tflat)
-        Bt = B._eval(tflat)
-        sigma = ((nodes - step_t0[:, None, None]) / step_h[:, None, None]).ravel()
-        Mt[:, :n, n:n + m] = Bt
-        Mt[:, :n, n + m:] = sigma[:, None, None] * Bt
-    else:
-        Mt = A._eval(tflat)
-    Mt = Mt.reshape(nseg, nsub, 2, d, d)
-    M1, M2 = Mt[:, :, 0], Mt[:, :, 1]
-    dl = delta[:, None, None, None]
-    Omega = 0.5 * dl * (M1 + M2) + (np.sqrt(3) / 12) * dl ** 2 * (M2 @ M1 - M1 @ M2)
-    Esub = expm_batch(Omega.reshape(-1, d, d)).reshape(nseg, nsub, d, d)
-    E = Esub[:, 0]
-    for j in range(1, nsub):
-        E = Esub[:, j] @ E
+    block = int(max(1, min(nsub, _CHUNK_ENTRIES // max(1, 2 * nseg * d * d))))
+    ratio = None if scale is None else scale[None, :] / scale[:, None]
+    E = None
+    for j0 in range(0, nsub, block):
+        J = min(block, nsub - j0)
+        starts = a[:, None] + delta[:, None] * np.arange(j0, j0 + J)   # (S, J)
+        nodes = np.stack([starts + _C1 * delta[:, None], starts + _C2 * delta[:, None]], -1)
+        tflat = nodes.ravel()
+        if m:
+            Mt = np.zeros((tflat.size, d, d))
+            Mt[:, :n, :n] = A._eval(tflat)
+            Bt = B._eval(tflat)
+            sigma = ((nodes - step_t0[:, None, None]) / step_h[:, None, None]).ravel()
+            Mt[:, :n, n:n + m] = Bt
+            Mt[:, :n, n + m:] = sigma[:, None, None] * Bt
+        else:
+            Mt = A._eval(tflat)
+        if ratio is not None:
+            Mt = Mt * ratio
+        Mt = Mt.reshape(nseg, J, 2, d, d)
+        M1, M2 = Mt[:, :, 0], Mt[:, :, 1]
+        dl = delta[:, None, None, None]
+        Omega = 0.5 * dl * (M1 + M2) + (np.sqrt(3) / 12) * dl ** 2 * (M2 @ M1 - M1 @ M2)
+        del Mt, M1, M2
+        P = _tree_product(expm_batch(Omega.reshape(-1, d, d)).reshape(nseg, J, d, d))
+        E = P if E is None else P @ E
     return E
 
 

@@ -23,6 +23,7 @@ import warnings
 
 import numpy as np
 import control as ct
+import scipy.linalg as sla
 from scipy import sparse
 from scipy.linalg.lapack import zgbsv
 from tqdm.auto import tqdm
@@ -172,6 +173,7 @@ class _HarmonicStateSpace:
         self.K, self.Ki, self.ny, self.nu = K, Ki, ny, nu
         self.exact = exact
         self.modal = None
+        self._schur = None
         self._residues = {}
         # block-banded F (A(t) with few harmonics): (l, u) and -F in band storage
         self.band = None
@@ -290,8 +292,9 @@ class _HarmonicStateSpace:
             rows_ab = self.band[2].shape[0] + self.band[0]
             per_point = _BYTES * (rows_ab * nF + 2 * nF * nc + 2 * nr * nc)
         else:
-            fixed = 0
-            per_point = _BYTES * (2 * nF ** 2 + 2 * nF * nc + 2 * nr * nc)
+            # Schur form, its transformed inputs/outputs and one shifted copy
+            fixed = _BYTES * (2 * nF ** 2 + nF * (nr + nc))
+            per_point = _BYTES * (2 * nF * min(nr, nc) + 2 * nr * nc)
         room = budget - fixed - out_bytes
         if room < per_point:
             raise MemoryError(
@@ -339,16 +342,31 @@ class _HarmonicStateSpace:
         return out
 
     def _solve_chunk(self, x, r, c):
-        M = -np.broadcast_to(self.F, (len(x),) + self.F.shape)
-        idx = np.arange(self.F.shape[0])
-        M[:, idx, idx] += x[:, None]
-        Gc = self.G[:, c]
-        try:
-            X = np.linalg.solve(M, np.broadcast_to(Gc, (len(x),) + Gc.shape))
-        except np.linalg.LinAlgError:
-            raise ValueError("the HTF is not defined at a pole of the harmonic "
-                             "state space (singular resolvent)") from None
-        return self.Hc[r] @ X
+        # dense path: the complex Schur form F = Z T Zᴴ once, then per point one
+        # triangular solve of (xI - T) with the fewer of the requested rows (from
+        # the left) or columns (from the right): O(nF²) per point, O(nF²) memory
+        if self._schur is None:
+            T, Z = sla.schur(np.asarray(self.F, complex), output='complex')
+            self._schur = (T, Z.conj().T @ self.G, self.Hc @ Z)
+        T, ZG, HZ = self._schur
+        idx = np.arange(T.shape[0])
+        left = len(r) < len(c)
+        rhs = HZ[r].T if left else ZG[:, c]
+        out = np.empty((len(x), len(r), len(c)), complex)
+        a = np.empty_like(T)
+        for p, xp in enumerate(x):
+            np.negative(T, out=a)
+            a[idx, idx] += xp
+            try:
+                if not np.all(a[idx, idx]):
+                    raise np.linalg.LinAlgError
+                sol = sla.solve_triangular(a, rhs, trans='T' if left else 'N',
+                                           check_finite=False)
+            except np.linalg.LinAlgError:
+                raise ValueError("the HTF is not defined at a pole of the harmonic "
+                                 "state space (singular resolvent)") from None
+            out[p] = sol.T @ ZG[:, c] if left else HZ[r] @ sol
+        return out
 
 
 #

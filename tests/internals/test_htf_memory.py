@@ -50,11 +50,18 @@ def test_chunks_bound_the_working_memory():
         peak = tracemalloc.get_traced_memory()[1]
         tracemalloc.stop()
     assert peak <= 1.5 * budget
-    tracemalloc.start()
-    H(S)
-    unbounded = tracemalloc.get_traced_memory()[1]
-    tracemalloc.stop()
-    assert unbounded > 2 * budget            # the bound did something
+    # the dense path through the Schur form needs O(nF²) once and O(nF) per point:
+    # its memory is linear in the points (the result dominates)
+    nF = H._hss.F.shape[0]
+    peaks = []
+    for reps in (1, 8):
+        s = np.tile(S, reps)
+        tracemalloc.start()
+        out = H(s)
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+        assert peaks[-1] <= 3 * out.nbytes + 16 * 4 * nF ** 2 + 1e6
+    assert peaks[1] < 8 * peaks[0]
 
 
 def test_requests_that_cannot_fit_are_refused_with_their_size():
