@@ -22,7 +22,7 @@ from control.exception import ControlArgument, ControlDimension
 from .._core.floquet import lti_representatives
 from .._core.ltpsys import LTPStateSpace, series
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
-from .riccati import _GainTable, _check_weights, care, dare
+from .riccati import _GainTable, _care_solution, _check_weights, _table_edges, care, dare
 from .._core.coerce import as_ltp
 from .._core.validation import check_method, real_array
 
@@ -191,12 +191,16 @@ def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None):
                      shape=(G.shape[1], sys.noutputs))
     probe = np.arange(16) * T / 16
     _check_weights(QN(probe), RN(probe), 'QN', 'RN')
-    X, E, Gd = care(_reverse(sys.A, True), _reverse(sys.C, True),
-                    _reverse(G @ QN @ G.T, False), _reverse(RN, False),
-                    _reverse(G @ NN, False), period=T, nsteps=nsteps)
-    L, exact = _reversed_gain(Gd)
     if all(M.is_constant for M in (sys.A, G, sys.C, QN, RN, NN)):   # LTI data
-        E = lti_representatives(E, sys.A(0.0) - exact(0.0) @ sys.C(0.0), period=T)
+        X, E, Gd, _ = _care_solution(sys.A.T, sys.C.T, G @ QN @ G.T, RN, G @ NN, T, nsteps)
+        L = PeriodicMatrix.constant(Gd(0.0).T, T)
+        E = lti_representatives(E, sys.A(0.0) - L(0.0) @ sys.C(0.0), period=T)
+        return L, X, E
+    X, E, Gd, exact = _care_solution(_reverse(sys.A, True), _reverse(sys.C, True),
+                                    _reverse(G @ QN @ G.T, False), _reverse(RN, False),
+                                    _reverse(G @ NN, False), T, nsteps)
+    L = _reversed_gain(exact, T - Gd.function.grid[::-1])
+    L.function._build()                          # tabulated now, bounded
     return L, _reverse(X, False), E
 
 
@@ -411,21 +415,15 @@ def _held(values, sys):
     return PeriodicMatrix.from_samples(values, sys.period, kind='hold')
 
 
-def _reversed_gain(Gd):
-    """``(L, exact)``: ``L(t) = Gd(-t)ᵀ`` as a verified gain table, like `care`'s gains.
-
-    The table is tabulated from the exact reversed gain on the reversed step
-    grid of the dual problem, on first use (or when pickled or saved).
-    """
-    table = Gd.function
-    exact = PeriodicMatrix.from_function(_Reversed(table.exact, True), Gd.period,
-                                         Gd.shape[::-1],
-                                         breakpoints=np.mod(-table.exact.breakpoints, Gd.period),
-                                         check=False)
-    L = PeriodicMatrix.from_function(_GainTable(exact=exact, grid=Gd.period - table.grid[::-1]),
-                                     Gd.period, exact.shape, breakpoints=exact.breakpoints,
-                                     check=False)
-    return L, exact
+def _reversed_gain(exact, grid):
+    """``L(t) = Gd(-t)ᵀ`` of the dual problem's exact gain, as a verified gain
+    table like `care`'s on the reversed step grid (built by the caller)."""
+    rev = PeriodicMatrix.from_function(_Reversed(exact, True), exact.period, exact.shape[::-1],
+                                       breakpoints=np.mod(-exact.breakpoints, exact.period),
+                                       check=False)
+    return PeriodicMatrix.from_function(
+        _GainTable(exact=rev, grid=_table_edges(grid, rev.breakpoints)), rev.period,
+        rev.shape, breakpoints=rev.breakpoints, check=False)
 
 
 class _Reversed:
