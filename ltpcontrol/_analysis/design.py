@@ -29,7 +29,7 @@ from .._core.validation import check_method, real_array
 __all__ = ['lqr', 'dlqr', 'lqe', 'dlqe', 'lqg']
 
 
-def lqr(sys, Q, R, N=None, nsteps=None, *, integral_action=None, method=None):
+def lqr(sys, Q, R, N=None, nsteps=None, *, integral_action=None, method=None, output=False):
     """Periodic linear quadratic regulator, as `control.lqr`.
 
     Minimizes ``∫ (xᵀQx + uᵀRu + 2xᵀNu) dt`` for ``ẋ = A(t)x + B(t)u``
@@ -55,6 +55,10 @@ def lqr(sys, Q, R, N=None, nsteps=None, *, integral_action=None, method=None):
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
         call works; the periodic algorithm is always used.
+    output : bool, optional
+        Q weights the outputs ``y = Cx + Du`` instead of the state (Q is
+        (p, p)): the cost ``∫ (yᵀQy + uᵀRu + 2xᵀNu) dt`` is the state
+        problem with ``CᵀQC``, ``R + DᵀQD`` and ``N + CᵀQD``.
 
     Returns
     -------
@@ -83,13 +87,15 @@ def lqr(sys, Q, R, N=None, nsteps=None, *, integral_action=None, method=None):
     """
     check_method(method)
     if _discrete(sys, nsteps):
-        return dlqr(sys, Q, R, N, integral_action=integral_action)
+        return dlqr(sys, Q, R, N, integral_action=integral_action, output=output)
+    if output:
+        Q, R, N = _output_weights(as_ltp(sys), Q, R, N, integral_action)
     A, B = _with_integrators(sys, integral_action, 'lqr')
     X, E, K = care(A, B, Q, R, N, period=sys.period, nsteps=nsteps)
     return K, X, E
 
 
-def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None):
+def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None, output=False):
     """Periodic discrete-time linear quadratic regulator, as `control.dlqr`.
 
     Minimizes ``Σ_k (x_kᵀQ_kx_k + u_kᵀR_ku_k + 2x_kᵀN_ku_k)`` for
@@ -109,6 +115,8 @@ def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None):
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
         call works; the periodic algorithm is always used.
+    output : bool, optional
+        Q weights the outputs ``y_k = C_kx_k + D_ku_k`` (see `lqr`).
 
     Returns
     -------
@@ -133,10 +141,16 @@ def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None):
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqr: sys must be a discrete-time system (use lqr)")
     steps = sys.nsteps
+    if output:
+        Q, R, N = _output_weights(sys, Q, R, N, integral_action)
     A, B = _with_integrators(sys, integral_action, 'dlqr')
     A, B = A.sample(steps), B.sample(steps)
-    X, E, K = dare(A, B, _steps(Q, sys, 'Q'), _steps(R, sys, 'R'),
-                   None if N is None else _steps(N, sys, 'N'))
+    Qs, Rs = _steps(Q, sys, 'Q'), _steps(R, sys, 'R')
+    Ns = None if N is None else _steps(N, sys, 'N')
+    X, E, K = dare(A, B, Qs, Rs, Ns)
+    if _same_steps(A, B, Qs, Rs, Ns):             # LTI data: constant gain and X
+        return (PeriodicMatrix.constant(K[0], sys.period),
+                PeriodicMatrix.constant(X[0], sys.period), E)
     return _held(K, sys), _held(X, sys), E
 
 
@@ -260,6 +274,9 @@ def dlqe(sys, QN, RN, NN=None, *, method=None):
                     flip(G @ NN))
     P = np.roll(X[::-1], 1, axis=0)              # P_k = X̃_{N-k}
     L = np.swapaxes(Gd[::-1], 1, 2)              # L_k = G̃_{N-1-k}ᵀ
+    if _same_steps(A, G, C, QN, RN, NN):          # LTI data: constant gain and P
+        return (PeriodicMatrix.constant(L[0], sys.period),
+                PeriodicMatrix.constant(P[0], sys.period), E)
     return _held(L, sys), _held(P, sys), E
 
 
@@ -384,6 +401,26 @@ def _with_integrators(sys, C, where):
     return A, B
 
 
+def _output_weights(sys, Q, R, N, integral_action):
+    """State weights ``(CᵀQC, R + DᵀQD, N + CᵀQD)`` of an output weight Q."""
+    if integral_action is not None:
+        raise ControlArgument("output=True cannot be combined with integral_action")
+    T, (n, m, p) = sys.period, (sys.nstates, sys.ninputs, sys.noutputs)
+
+    def periodic(M, name, shape):
+        if sys.isdtime(strict=True) and not (isinstance(M, PeriodicMatrix) or callable(M)):
+            steps = _steps(M, sys, name)
+            _shape_check(steps, shape, name)
+            return (_held(steps, sys) if len(steps) > 1
+                    else PeriodicMatrix.constant(steps[0], T))
+        return as_periodic(M, T, name, shape=shape)
+    Q, R = periodic(Q, 'Q', (p, p)), periodic(R, 'R', (m, m))
+    C, D = sys.C, sys.D
+    Nq = C.T @ Q @ D
+    N = Nq if N is None else periodic(N, 'N', (n, m)) + Nq
+    return C.T @ Q @ C, R + D.T @ Q @ D, N
+
+
 def _discrete(sys, nsteps):
     """True for a discrete-time plant (which takes no nsteps)."""
     sys = as_ltp(sys)
@@ -404,6 +441,11 @@ def _steps(M, sys, name):
                                f"{sys.nsteps} steps")
     arr = np.atleast_2d(arr)
     return arr if arr.ndim == 3 else arr[np.newaxis]
+
+
+def _same_steps(*mats):
+    """True when every per-step stack holds one matrix (LTI data)."""
+    return all(M is None or np.all(M == M[:1]) for M in mats)
 
 
 def _shape_check(M, shape, name):
