@@ -63,6 +63,7 @@ from ._identification.montecarlo import monte_carlo, MonteCarloResult
 from ._identification.scenarios import sample_models
 from .storage import save, load
 from ._analysis.output_feedback import ofstab, oflqr, OutputFeedbackResult
+from ._analysis.hinf import hinfnorm
 
 __version__ = "0.1.0"
 
@@ -119,7 +120,7 @@ __all__ = [
     # files
     'save', 'load',
     # periodic design beyond state feedback
-    'ofstab', 'oflqr', 'OutputFeedbackResult',
+    'ofstab', 'oflqr', 'OutputFeedbackResult', 'hinfnorm',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

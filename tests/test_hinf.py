@@ -1,0 +1,46 @@
+"""H∞ norm: infinite for unstable systems; the peak frequency located and unfolded."""
+
+import control as ct
+import numpy as np
+import pytest
+from scipy.optimize import minimize_scalar
+
+import ltpcontrol as ltp
+
+
+def _rotated(A0, B0, C0, w=2.0, T=np.pi):
+    # an LTI plant in rotating state coordinates x_r = P(t) x (same input/output map)
+    P = lambda t: np.array([[np.cos(w * t), np.sin(w * t)], [-np.sin(w * t), np.cos(w * t)]])  # noqa: E731
+    Pd = lambda t: w * np.array([[-np.sin(w * t), np.cos(w * t)], [-np.cos(w * t), -np.sin(w * t)]])  # noqa: E731
+    return ltp.ltpss(lambda t: Pd(t) @ P(t).T + P(t) @ A0 @ P(t).T, lambda t: P(t) @ B0,
+                     lambda t: C0 @ P(t).T, 0, period=T)
+
+
+def _lti_peak(G, lo, hi):
+    res = minimize_scalar(lambda w: -abs(np.squeeze(G(1j * w))), bounds=(lo, hi),
+                          method='bounded', options={'xatol': 1e-14})
+    return -res.fun, res.x
+
+
+def test_rotated_lti_case_peak_equals_the_lti_peak_unfolded():
+    # the reference toolbox's rotated LTI case (period π, rotation 2 rad/s)
+    A0, B0, C0 = np.array([[-1, -0.5], [-3, -5.0]]), np.array([[3.0], [1.0]]), np.array([[1.0, 2.0]])
+    sys = _rotated(A0, B0, C0)
+    g0, w0 = _lti_peak(ct.ss(A0, B0, C0, 0), 0.5, 3.0)
+    g, w = ltp.hinfnorm(sys, tol=1e-8, unfolded=True)
+    assert abs(g - g0) <= 1e-7 * g0
+    assert abs(w - w0) <= 1e-6 * w0
+    gf, wf = ltp.hinfnorm(sys, tol=1e-8)
+    assert gf == g and 0 <= wf <= sys.omega_p / 2
+    n = np.round((w - wf) / sys.omega_p)
+    assert abs(abs(wf + n * sys.omega_p) - w) < 1e-12 or abs(abs(-wf + n * sys.omega_p) - w) < 1e-9
+
+
+def test_unstable_system_has_infinite_hinf_norm_with_a_warning():
+    sys = ltp.ltpss(ct.tf([1.0], [1.0, -1.0, 4.0]), period=1.0)
+    with pytest.warns(UserWarning, match="unstable"):
+        g, w = ltp.hinfnorm(sys)
+    assert g == np.inf and np.isnan(w)
+    assert np.isfinite(ltp.norm(sys, 'inf'))       # the L∞ norm stays finite
+    with pytest.raises(TypeError, match="unfolded"):
+        ltp.hinfnorm(sys, unfolded=1)
