@@ -64,6 +64,7 @@ from ._identification.scenarios import sample_models
 from .storage import save, load
 from ._analysis.output_feedback import ofstab, oflqr, OutputFeedbackResult
 from ._analysis.hinf import hinfnorm
+from ._analysis.finite_horizon import care_finite, lyap_finite, h2norm_finite
 
 __version__ = "0.1.0"
 
@@ -121,6 +122,7 @@ __all__ = [
     'save', 'load',
     # periodic design beyond state feedback
     'ofstab', 'oflqr', 'OutputFeedbackResult', 'hinfnorm',
+    'care_finite', 'lyap_finite', 'h2norm_finite',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise
