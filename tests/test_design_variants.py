@@ -56,3 +56,28 @@ def test_lti_exponents_are_those_of_the_loop_built_from_the_gain(T):
     estd = ltp.ltpss(sysd.A - Ld @ sysd.C, sysd.B, sysd.C, 0, period=T, dt=T / 4)
     np.testing.assert_allclose(_sorted(Ed), _sorted(ltp.floquet_exponents(loopd)), atol=1e-9)
     np.testing.assert_allclose(_sorted(ELd), _sorted(ltp.floquet_exponents(estd)), atol=1e-9)
+
+
+def test_kalman_gain_with_separate_noise_inputs_and_feedthrough_equals_python_control():
+    A, B, C, D = _plant(2)
+    rng = np.random.default_rng(7)
+    G, Dw = rng.normal(size=(3, 2)), 0.5 * rng.normal(size=(2, 2))
+    QN, RN = np.diag([1.0, 0.4]), np.diag([0.2, 0.1])
+    RNe, NNe = RN + Dw @ QN @ Dw.T, QN @ Dw.T
+    L, P, E = ltp.lqe(ltp.ltpss(A, B, C, D, period=0.9), QN, RN, G=G, Dw=Dw)
+    # python-control's lqe has no cross covariance: its dual care does
+    P0, _, K0 = ct.care(A.T, C.T, G @ QN @ G.T, RNe, G @ NNe)
+    L0 = K0.T
+    assert L.is_constant
+    assert np.abs(L(0.2) - L0).max() <= 1e-9 * np.abs(L0).max()
+    assert np.abs(P(0.2) - P0).max() <= 1e-9 * np.abs(P0).max()
+    Gd = ct.c2d(ct.ss(A, B, C, D), 0.1)
+    Ld, Pd, _ = ltp.dlqe(ltp.ltpss(Gd, period=0.3), QN, RN, G=G)
+    L0, P0, _ = ct.dlqe(Gd.A, G, Gd.C, QN, RN)
+    assert np.abs(Ld(0.1) - L0).max() <= 1e-9 * np.abs(L0).max()
+    # with Dw: the correlated problem through B = G (python-control's dlqe has no NN)
+    Ld, _, _ = ltp.dlqe(ltp.ltpss(Gd, period=0.3), QN, RN, G=G, Dw=Dw)
+    Lx, _, _ = ltp.dlqe(ltp.ltpss(Gd.A, G, Gd.C, 0, period=0.3, dt=0.1), QN, RNe, NNe)
+    assert np.abs(Ld(0.1) - Lx(0.1)).max() <= 1e-12 * np.abs(Lx(0.1)).max()
+    with pytest.raises(ct.ControlDimension, match="G must have"):
+        ltp.lqe(ltp.ltpss(A, B, C, D, period=0.9), QN, RN, G=G[:2])

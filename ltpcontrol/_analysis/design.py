@@ -154,7 +154,7 @@ def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None, output=False):
     return _held(K, sys), _held(X, sys), E
 
 
-def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None):
+def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None, G=None, Dw=None):
     """Periodic Kalman(-Bucy) filter gain, as `control.lqe`.
 
     For ``ẋ = A(t)x + B(t)u + G(t)w``, ``y = C(t)x + v`` with white noises
@@ -176,6 +176,15 @@ def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None):
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
         call works; the periodic algorithm is always used.
+    G : array_like, PeriodicMatrix or callable, optional
+        Noise input matrix (n, q) when the process noise w does not enter
+        through B (the reference toolbox's separate noise inputs); QN is
+        then (q, q) and NN (q, p).
+    Dw : array_like, PeriodicMatrix or callable, optional
+        Feedthrough (p, q) of w to the measurement, ``y = Cx + Du + Dw w +
+        v``: the filter sees the sensor noise ``Dw w + v`` (covariance
+        ``RN + Dw QN Dwᵀ + Dw NN + NNᵀDwᵀ``) correlated with the process
+        noise (cross term ``G(QN Dwᵀ + NN)``).
 
     Returns
     -------
@@ -198,11 +207,17 @@ def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None):
     if _discrete(sys, nsteps):
         return dlqe(sys, QN, RN, NN)
     T = sys.period
-    G = sys.B
+    G = sys.B if G is None else as_periodic(G, T, 'G')
+    if G.shape[0] != sys.nstates:
+        raise ControlDimension(f"G must have {sys.nstates} rows, got shape {G.shape}")
     QN = as_periodic(QN, T, 'QN', shape=(G.shape[1],) * 2)
     RN = as_periodic(RN, T, 'RN', shape=(sys.noutputs,) * 2)
     NN = as_periodic(np.zeros((G.shape[1], sys.noutputs)) if NN is None else NN, T, 'NN',
                      shape=(G.shape[1], sys.noutputs))
+    if Dw is not None:
+        Dw = as_periodic(Dw, T, 'Dw', shape=(sys.noutputs, G.shape[1]))
+        RN = RN + Dw @ QN @ Dw.T + Dw @ NN + NN.T @ Dw.T
+        NN = QN @ Dw.T + NN
     probe = np.arange(16) * T / 16
     _check_weights(QN(probe), RN(probe), 'QN', 'RN')
     if all(M.is_constant for M in (sys.A, G, sys.C, QN, RN, NN)):   # LTI data
@@ -218,7 +233,7 @@ def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None):
     return L, _reverse(X, False), E
 
 
-def dlqe(sys, QN, RN, NN=None, *, method=None):
+def dlqe(sys, QN, RN, NN=None, *, method=None, G=None, Dw=None):
     """Periodic discrete-time Kalman filter gain (predictor form), as `control.dlqe`.
 
     For ``x_{k+1} = A_kx_k + B_ku_k + G_kw_k``, ``y_k = C_kx_k + v_k``, the
@@ -236,6 +251,15 @@ def dlqe(sys, QN, RN, NN=None, *, method=None):
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
         call works; the periodic algorithm is always used.
+    G : array_like, PeriodicMatrix or callable, optional
+        Noise input matrix (n, q), 2D or one per step when the process noise w does not enter
+        through B (the reference toolbox's separate noise inputs); QN is
+        then (q, q) and NN (q, p).
+    Dw : array_like, PeriodicMatrix or callable, optional
+        Feedthrough (p, q) of w to the measurement, ``y = Cx + Du + Dw w +
+        v``: the filter sees the sensor noise ``Dw w + v`` (covariance
+        ``RN + Dw QN Dwᵀ + Dw NN + NNᵀDwᵀ``) correlated with the process
+        noise (cross term ``G(QN Dwᵀ + NN)``).
 
     Returns
     -------
@@ -259,12 +283,22 @@ def dlqe(sys, QN, RN, NN=None, *, method=None):
     if not sys.isdtime(strict=True):
         raise ControlArgument("dlqe: sys must be a discrete-time system (use lqe)")
     steps = sys.nsteps
-    A, G, C = (M.sample(steps) for M in (sys.A, sys.B, sys.C))
+    A, C = (M.sample(steps) for M in (sys.A, sys.C))
+    G = sys.B.sample(steps) if G is None else np.broadcast_to(
+        _steps(G, sys, 'G'), (steps,) + _steps(G, sys, 'G').shape[1:])
+    if G.shape[1] != sys.nstates:
+        raise ControlDimension(f"G must have {sys.nstates} rows, got shape {G.shape[1:]}")
     QN, RN = _steps(QN, sys, 'QN'), _steps(RN, sys, 'RN')
     NN = np.zeros((1, G.shape[2], C.shape[1])) if NN is None else _steps(NN, sys, 'NN')
     _shape_check(QN, (G.shape[2],) * 2, 'QN')
     _shape_check(RN, (C.shape[1],) * 2, 'RN')
     _shape_check(NN, (G.shape[2], C.shape[1]), 'NN')
+    if Dw is not None:
+        Dw = _steps(Dw, sys, 'Dw')
+        _shape_check(Dw, (C.shape[1], G.shape[2]), 'Dw')
+        Dwt, NNt = np.swapaxes(Dw, 1, 2), np.swapaxes(NN, 1, 2)
+        RN = RN + Dw @ QN @ Dwt + Dw @ NN + NNt @ Dwt
+        NN = QN @ Dwt + NN
     _check_weights(QN, RN, 'QN', 'RN')
     Gt = np.swapaxes(G, 1, 2)
     # dual problem on the reversed step order j = N-1-k
