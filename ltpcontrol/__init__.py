@@ -65,6 +65,7 @@ from .storage import save, load
 from ._analysis.output_feedback import ofstab, oflqr, OutputFeedbackResult
 from ._analysis.hinf import hinfnorm
 from ._analysis.finite_horizon import care_finite, lyap_finite, h2norm_finite
+from ._analysis.sylvester import sylvester, dsylvester
 
 __version__ = "0.1.0"
 
@@ -122,7 +123,7 @@ __all__ = [
     'save', 'load',
     # periodic design beyond state feedback
     'ofstab', 'oflqr', 'OutputFeedbackResult', 'hinfnorm',
-    'care_finite', 'lyap_finite', 'h2norm_finite',
+    'care_finite', 'lyap_finite', 'h2norm_finite', 'sylvester', 'dsylvester',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise
