@@ -44,3 +44,21 @@ def test_unstable_system_has_infinite_hinf_norm_with_a_warning():
     assert np.isfinite(ltp.norm(sys, 'inf'))       # the L∞ norm stays finite
     with pytest.raises(TypeError, match="unfolded"):
         ltp.hinfnorm(sys, unfolded=1)
+
+
+def test_lmi_hinf_state_feedback_bound_covers_the_independent_closed_loop_norm():
+    rng = np.random.default_rng(3)
+    N, n = 3, 2
+    A = 0.9 * rng.normal(size=(N, n, n))
+    B = rng.normal(size=(N, n, 1))
+    sysd = ltp.ltpss(A, B, np.eye(n), 0, period=0.3, dt=0.1)
+    res = ltp.lmi_statefbk(sysd, objective='hinf')
+    K = res.K.sample(N)
+    # closed loop w -> z = [x; -K x] (Q = I, R = I, G = I), built by hand
+    Acl = A - B @ K
+    Ccl = np.concatenate([np.broadcast_to(np.eye(n), (N, n, n)), -K], axis=1)
+    cl = ltp.ltpss(Acl, np.broadcast_to(np.eye(n), (N, n, n)), Ccl, np.zeros((N, n + 1, n)),
+                   period=0.3, dt=0.1)
+    gamma = ltp.norm(cl, 'inf', tol=1e-8)
+    assert gamma <= res.bound * (1 + 1e-6)
+    assert gamma >= 0.9 * res.bound           # the certificate is not loose
