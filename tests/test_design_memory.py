@@ -11,7 +11,8 @@ T = 1.0
 
 
 def _stiff_plant():
-    # slow periodic (Mathieu-like) dynamics and a fast pole at -600/T (a stiff solver grid)
+    # slow periodic (Mathieu-like) dynamics and a fast pole at -300/T: the solver grid
+    # exceeds the 256 steps on which gains are tabulated directly
     def A(t):
         t = np.asarray(t, float)
         a = np.zeros(np.shape(t) + (3, 3))
@@ -20,7 +21,7 @@ def _stiff_plant():
         a[..., 1, 1] = -0.5
         a[..., 0, 2] = 0.5
         a[..., 2, 0] = 1.0
-        a[..., 2, 2] = -600.0 / T
+        a[..., 2, 2] = -300.0 / T
         return a
     return ltp.ltpss(A, [[0.0], [1.0], [1.0]], [[1.0, 0.0, 1.0]], 0, period=T)
 
@@ -53,4 +54,4 @@ def test_stiff_lqr_lqe_lqg_bounded_and_tabulated_when_designed():
     assert np.abs(L(ts) - Lx).max() <= 1e-8 * np.abs(Lx).max()
     assert np.all(np.isfinite(Kt)) and np.all(np.isfinite(Lt))
     assert np.all(E.real < 0) and np.all(EL.real < 0)
-    assert E.real.min() < -500                  # the fast pole is kept
+    assert E.real.min() < -250                  # the fast pole is kept

@@ -1,4 +1,4 @@
-"""Finite-horizon Riccati/Lyapunov differential equations and H2 norm against independent integration."""
+"""Finite-horizon Riccati/Lyapunov equations and H2 norm against independent integration."""
 
 import numpy as np
 import pytest

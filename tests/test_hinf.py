@@ -33,7 +33,8 @@ def _lti_peak(G, lo, hi):
 
 def test_rotated_lti_case_peak_equals_the_lti_peak_unfolded():
     # the reference toolbox's rotated LTI case (period π, rotation 2 rad/s)
-    A0, B0, C0 = np.array([[-1, -0.5], [-3, -5.0]]), np.array([[3.0], [1.0]]), np.array([[1.0, 2.0]])
+    A0, B0 = np.array([[-1, -0.5], [-3, -5.0]]), np.array([[3.0], [1.0]])
+    C0 = np.array([[1.0, 2.0]])
     sys = _rotated(A0, B0, C0)
     g0, w0 = _lti_peak(ct.ss(A0, B0, C0, 0), 0.5, 3.0)
     g, w = ltp.hinfnorm(sys, tol=1e-8, unfolded=True)

@@ -16,8 +16,10 @@ def _random_plant(seed, n=3, m=2, p=2, T=1.3):
     A1 = 0.5 * rng.normal(size=(n, n))
     B0, C0 = rng.normal(size=(n, m)), rng.normal(size=(p, n))
     w = 2 * np.pi / T
-    A = ltp.PeriodicMatrix.from_function(lambda t: A0 + A1 * np.cos(w * np.asarray(t))[..., None, None], T)
-    B = ltp.PeriodicMatrix.from_function(lambda t: B0 * (1 + 0.3 * np.sin(w * np.asarray(t)))[..., None, None], T)
+    cos = lambda t: np.cos(w * np.asarray(t))[..., None, None]  # noqa: E731
+    sin = lambda t: np.sin(w * np.asarray(t))[..., None, None]  # noqa: E731
+    A = ltp.PeriodicMatrix.from_function(lambda t: A0 + A1 * cos(t), T)
+    B = ltp.PeriodicMatrix.from_function(lambda t: B0 * (1 + 0.3 * sin(t)), T)
     return ltp.ltpss(A, B, C0, 0, period=T), rng
 
 

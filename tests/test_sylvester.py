@@ -34,7 +34,8 @@ def test_continuous_periodic_sylvester_equals_independent_integration():
 @pytest.mark.parametrize("N", [1, 4, 5])
 def test_discrete_periodic_sylvester_residual_and_dense_solution(N):
     rng = np.random.default_rng(N)
-    A, B, C = rng.normal(size=(N, 3, 3)), 0.5 * rng.normal(size=(N, 2, 2)), rng.normal(size=(N, 3, 2))
+    A, B = rng.normal(size=(N, 3, 3)), 0.5 * rng.normal(size=(N, 2, 2))
+    C = rng.normal(size=(N, 3, 2))
     X = ltp.dsylvester(A, B, C)
     res = X[(np.arange(N) + 1) % N] - (A @ X @ B + C)
     assert np.abs(res).max() <= 1e-12 * max(1.0, np.abs(X).max())

@@ -146,7 +146,7 @@ def sylvester(A, B, C, *, period=None, nsteps=None):
 
 
 def _step_maps(G, t0, h, n):
-    """``(Θ₁₁, Θ₂₂⁻¹, Θ₁₂Θ₂₂⁻¹)`` of the block generator over the steps."""
+    """``(Θ₁₁, Θ₂₂⁻¹, Θ₁₂Θ₂₂⁻¹)`` of the block generator over the given steps."""
     Theta, _, _ = step_transitions(G, None, t0, h)
     inv22 = np.linalg.inv(Theta[:, n:, n:])
     return Theta[:, :n, :n], inv22, Theta[:, :n, n:] @ inv22
