@@ -492,14 +492,16 @@ class _ContinuousProblem(_Problem):
         def implemented(f, d):
             M = np.eye(self.m) - f @ d
             return np.linalg.solve(M, f)
-        # K has a pole where det(I - FD) vanishes: look for a sign change or a
-        # near-zero on a fine probe of the period
-        probe = np.concatenate([np.arange(4096) * self.sys.period / 4096, F.breakpoints,
-                                self.D.breakpoints])
+        # K has a pole where det(I - FD) vanishes: look for a near-zero, or a
+        # sign change between neighbouring probes of the same smooth piece
+        # (a switching gain may jump across zero without passing through it)
+        T = self.sys.period
+        breaks = np.unique(np.mod(np.concatenate([F.breakpoints, self.D.breakpoints]), T))
+        probe = np.union1d(np.arange(4096) * T / 4096, breaks)
         det = np.linalg.det(np.eye(self.m) - F(probe) @ self.D(probe))
-        order = np.argsort(np.mod(probe, self.sys.period))
-        det = det[order]
-        if np.min(np.abs(det)) < 1e-8 or np.any(np.sign(det) != np.sign(det[0])):
+        piece = np.searchsorted(breaks, probe + 1e-12 * T, side='right')
+        same = piece[1:] == piece[:-1]
+        if np.min(np.abs(det)) < 1e-8 or np.any(same & (np.sign(det[1:]) != np.sign(det[:-1]))):
             return None
         return PeriodicMatrix.pointwise(implemented, [F, self.D], (self.m, self.p),
                                         breakpoints=F.breakpoints)
