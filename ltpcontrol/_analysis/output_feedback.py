@@ -154,9 +154,10 @@ def ofstab(sys, *, times=None, order=None, K0=None, target=None, maxiter=100, gt
 
     Returns
     -------
-    K : PeriodicMatrix
+    K : PeriodicMatrix or None
         Gain (m, p) for ``u = -K y``: switching, a Fourier series (D = 0),
-        or held samples (discrete time).
+        or held samples (discrete time); None (with ``success=False``) when
+        the loop gain found needs an unbounded K (``I - F(t)D(t)`` singular).
     info : OutputFeedbackResult
         `success` only if the loop ``feedback(sys, K)`` is verified stable.
 
