@@ -69,6 +69,10 @@ from ._core.tvsystem import DiscreteLTPSystem, dltpss
 from ._core.lifting_forms import unlift
 from ._core.multirate import sample_multirate
 from ._analysis.multirate_loop import lifted_margins
+from ._analysis.output_feedback import ofstab, oflqr, OutputFeedbackResult
+from ._analysis.hinf import hinfnorm
+from ._analysis.finite_horizon import care_finite, lyap_finite, h2norm_finite
+from ._analysis.sylvester import sylvester, dsylvester
 
 __version__ = "0.1.0"
 
@@ -142,6 +146,9 @@ __all__ = [
     'DiscreteLTPSystem', 'dltpss', 'unlift', 'sample_multirate', 'lifted_margins',
     # harmonic stability
     'harmonic_modes', 'HarmonicModes',
+    # periodic design beyond state feedback
+    'ofstab', 'oflqr', 'OutputFeedbackResult', 'hinfnorm',
+    'care_finite', 'lyap_finite', 'h2norm_finite', 'sylvester', 'dsylvester',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

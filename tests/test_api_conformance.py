@@ -230,6 +230,7 @@ _RESULT_CLASSES |= {'FloquetModes', 'CampbellDiagram'}
 _RESULT_CLASSES |= {'HarmonicNyquistResponse', 'HarmonicMargins', 'MarginPoint'}
 _RESULT_CLASSES |= {'DelayMonodromy', 'StabilityChart'}
 _RESULT_CLASSES |= {'HarmonicModes'}
+_RESULT_CLASSES |= {'OutputFeedbackResult'}
 
 DOC_DEFECTS = {}
 

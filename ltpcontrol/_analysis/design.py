@@ -22,7 +22,7 @@ from control.exception import ControlArgument, ControlDimension
 from .._core.floquet import lti_representatives
 from .._core.ltpsys import LTPStateSpace, series
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
-from .riccati import _GainTable, _check_weights, care, dare
+from .riccati import _GainTable, _care_solution, _check_weights, _table_edges, care, dare
 from .._core.coerce import as_ltp
 from .._core.validation import check_method, real_array
 from .._core.subperiods import align_weights
@@ -33,7 +33,7 @@ from .tvdesign import tv_dlqe, tv_dlqr
 __all__ = ['lqr', 'dlqr', 'lqe', 'dlqe', 'lqg']
 
 
-def lqr(sys, Q, R, N=None, nsteps=None, *, integral_action=None, method=None):
+def lqr(sys, Q, R, N=None, nsteps=None, *, integral_action=None, method=None, output=False):
     """Periodic linear quadratic regulator, as `control.lqr`.
 
     Minimizes ``∫ (xᵀQx + uᵀRu + 2xᵀNu) dt`` for ``ẋ = A(t)x + B(t)u``
@@ -59,6 +59,10 @@ def lqr(sys, Q, R, N=None, nsteps=None, *, integral_action=None, method=None):
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
         call works; the periodic algorithm is always used.
+    output : bool, optional
+        Q weights the outputs ``y = Cx + Du`` instead of the state (Q is
+        (p, p)): the cost ``∫ (yᵀQy + uᵀRu + 2xᵀNu) dt`` is the state
+        problem with ``CᵀQC``, ``R + DᵀQD`` and ``N + CᵀQD``.
 
     Returns
     -------
@@ -87,13 +91,15 @@ def lqr(sys, Q, R, N=None, nsteps=None, *, integral_action=None, method=None):
     """
     check_method(method)
     if _discrete(sys, nsteps):
-        return dlqr(sys, Q, R, N, integral_action=integral_action)
+        return dlqr(sys, Q, R, N, integral_action=integral_action, output=output)
+    if output:
+        Q, R, N = _output_weights(as_ltp(sys), Q, R, N, integral_action)
     A, B = _with_integrators(sys, integral_action, 'lqr')
     X, E, K = care(A, B, Q, R, N, period=sys.period, nsteps=nsteps)
     return K, X, E
 
 
-def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None):
+def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None, output=False):
     """Periodic discrete-time linear quadratic regulator, as `control.dlqr`.
 
     Minimizes ``Σ_k (x_kᵀQ_kx_k + u_kᵀR_ku_k + 2x_kᵀN_ku_k)`` for
@@ -115,6 +121,8 @@ def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None):
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
         call works; the periodic algorithm is always used.
+    output : bool, optional
+        Q weights the outputs ``y_k = C_kx_k + D_ku_k`` (see `lqr`).
 
     Returns
     -------
@@ -142,14 +150,20 @@ def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None):
         raise ControlArgument("dlqr: sys must be a discrete-time system (use lqr)")
     sys, (Q, R, N) = align_weights(sys, {'Q': Q, 'R': R, 'N': N})   # sub-periods
     steps = sys.nsteps
+    if output:
+        Q, R, N = _output_weights(sys, Q, R, N, integral_action)
     A, B = _with_integrators(sys, integral_action, 'dlqr')
     A, B = A.sample(steps), B.sample(steps)
-    X, E, K = dare(A, B, _steps(Q, sys, 'Q'), _steps(R, sys, 'R'),
-                   None if N is None else _steps(N, sys, 'N'))
+    Qs, Rs = _steps(Q, sys, 'Q'), _steps(R, sys, 'R')
+    Ns = None if N is None else _steps(N, sys, 'N')
+    X, E, K = dare(A, B, Qs, Rs, Ns)
+    if _same_steps(A, B, Qs, Rs, Ns):             # LTI data: constant gain and X
+        return (PeriodicMatrix.constant(K[0], sys.period),
+                PeriodicMatrix.constant(X[0], sys.period), E)
     return _held(K, sys), _held(X, sys), E
 
 
-def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None):
+def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None, G=None, Dw=None):
     """Periodic Kalman(-Bucy) filter gain, as `control.lqe`.
 
     For ``ẋ = A(t)x + B(t)u + G(t)w``, ``y = C(t)x + v`` with white noises
@@ -171,6 +185,15 @@ def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None):
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
         call works; the periodic algorithm is always used.
+    G : array_like, PeriodicMatrix or callable, optional
+        Noise input matrix (n, q) when the process noise w does not enter
+        through B (the reference toolbox's separate noise inputs); QN is
+        then (q, q) and NN (q, p).
+    Dw : array_like, PeriodicMatrix or callable, optional
+        Feedthrough (p, q) of w to the measurement, ``y = Cx + Du + Dw w +
+        v``: the filter sees the sensor noise ``Dw w + v`` (covariance
+        ``RN + Dw QN Dwᵀ + Dw NN + NNᵀDwᵀ``) correlated with the process
+        noise (cross term ``G(QN Dwᵀ + NN)``).
 
     Returns
     -------
@@ -193,23 +216,33 @@ def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None):
     if _discrete(sys, nsteps):
         return dlqe(sys, QN, RN, NN)
     T = sys.period
-    G = sys.B
+    G = sys.B if G is None else as_periodic(G, T, 'G')
+    if G.shape[0] != sys.nstates:
+        raise ControlDimension(f"G must have {sys.nstates} rows, got shape {G.shape}")
     QN = as_periodic(QN, T, 'QN', shape=(G.shape[1],) * 2)
     RN = as_periodic(RN, T, 'RN', shape=(sys.noutputs,) * 2)
     NN = as_periodic(np.zeros((G.shape[1], sys.noutputs)) if NN is None else NN, T, 'NN',
                      shape=(G.shape[1], sys.noutputs))
+    if Dw is not None:
+        Dw = as_periodic(Dw, T, 'Dw', shape=(sys.noutputs, G.shape[1]))
+        RN = RN + Dw @ QN @ Dw.T + Dw @ NN + NN.T @ Dw.T
+        NN = QN @ Dw.T + NN
     probe = np.arange(16) * T / 16
     _check_weights(QN(probe), RN(probe), 'QN', 'RN')
-    X, E, Gd = care(_reverse(sys.A, True), _reverse(sys.C, True),
-                    _reverse(G @ QN @ G.T, False), _reverse(RN, False),
-                    _reverse(G @ NN, False), period=T, nsteps=nsteps)
-    L, exact = _reversed_gain(Gd)
     if all(M.is_constant for M in (sys.A, G, sys.C, QN, RN, NN)):   # LTI data
-        E = lti_representatives(E, sys.A(0.0) - exact(0.0) @ sys.C(0.0), period=T)
+        X, E, Gd, _ = _care_solution(sys.A.T, sys.C.T, G @ QN @ G.T, RN, G @ NN, T, nsteps)
+        L = PeriodicMatrix.constant(Gd(0.0).T, T)
+        E = lti_representatives(E, sys.A(0.0) - L(0.0) @ sys.C(0.0), period=T)
+        return L, X, E
+    X, E, Gd, exact = _care_solution(_reverse(sys.A, True), _reverse(sys.C, True),
+                                    _reverse(G @ QN @ G.T, False), _reverse(RN, False),
+                                    _reverse(G @ NN, False), T, nsteps)
+    L = _reversed_gain(exact, T - Gd.function.grid[::-1])
+    L.function._build()                          # tabulated now, bounded
     return L, _reverse(X, False), E
 
 
-def dlqe(sys, QN, RN, NN=None, *, method=None):
+def dlqe(sys, QN, RN, NN=None, *, method=None, G=None, Dw=None):
     """Periodic discrete-time Kalman filter gain (predictor form), as `control.dlqe`.
 
     For ``x_{k+1} = A_kx_k + B_ku_k + G_kw_k``, ``y_k = C_kx_k + v_k``, the
@@ -227,6 +260,15 @@ def dlqe(sys, QN, RN, NN=None, *, method=None):
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
         call works; the periodic algorithm is always used.
+    G : array_like, PeriodicMatrix or callable, optional
+        Noise input matrix (n, q), 2D or one per step when the process noise w does not enter
+        through B (the reference toolbox's separate noise inputs); QN is
+        then (q, q) and NN (q, p).
+    Dw : array_like, PeriodicMatrix or callable, optional
+        Feedthrough (p, q) of w to the measurement, ``y = Cx + Du + Dw w +
+        v``: the filter sees the sensor noise ``Dw w + v`` (covariance
+        ``RN + Dw QN Dwᵀ + Dw NN + NNᵀDwᵀ``) correlated with the process
+        noise (cross term ``G(QN Dwᵀ + NN)``).
 
     Returns
     -------
@@ -253,12 +295,22 @@ def dlqe(sys, QN, RN, NN=None, *, method=None):
         raise ControlArgument("dlqe: sys must be a discrete-time system (use lqe)")
     sys, (QN, RN, NN) = align_weights(sys, {'QN': QN, 'RN': RN, 'NN': NN})   # sub-periods
     steps = sys.nsteps
-    A, G, C = (M.sample(steps) for M in (sys.A, sys.B, sys.C))
+    A, C = (M.sample(steps) for M in (sys.A, sys.C))
+    G = sys.B.sample(steps) if G is None else np.broadcast_to(
+        _steps(G, sys, 'G'), (steps,) + _steps(G, sys, 'G').shape[1:])
+    if G.shape[1] != sys.nstates:
+        raise ControlDimension(f"G must have {sys.nstates} rows, got shape {G.shape[1:]}")
     QN, RN = _steps(QN, sys, 'QN'), _steps(RN, sys, 'RN')
     NN = np.zeros((1, G.shape[2], C.shape[1])) if NN is None else _steps(NN, sys, 'NN')
     _shape_check(QN, (G.shape[2],) * 2, 'QN')
     _shape_check(RN, (C.shape[1],) * 2, 'RN')
     _shape_check(NN, (G.shape[2], C.shape[1]), 'NN')
+    if Dw is not None:
+        Dw = _steps(Dw, sys, 'Dw')
+        _shape_check(Dw, (C.shape[1], G.shape[2]), 'Dw')
+        Dwt, NNt = np.swapaxes(Dw, 1, 2), np.swapaxes(NN, 1, 2)
+        RN = RN + Dw @ QN @ Dwt + Dw @ NN + NNt @ Dwt
+        NN = QN @ Dwt + NN
     _check_weights(QN, RN, 'QN', 'RN')
     Gt = np.swapaxes(G, 1, 2)
     # dual problem on the reversed step order j = N-1-k
@@ -268,6 +320,9 @@ def dlqe(sys, QN, RN, NN=None, *, method=None):
                     flip(G @ NN))
     P = np.roll(X[::-1], 1, axis=0)              # P_k = X̃_{N-k}
     L = np.swapaxes(Gd[::-1], 1, 2)              # L_k = G̃_{N-1-k}ᵀ
+    if _same_steps(A, G, C, QN, RN, NN):          # LTI data: constant gain and P
+        return (PeriodicMatrix.constant(L[0], sys.period),
+                PeriodicMatrix.constant(P[0], sys.period), E)
     return _held(L, sys), _held(P, sys), E
 
 
@@ -392,6 +447,26 @@ def _with_integrators(sys, C, where):
     return A, B
 
 
+def _output_weights(sys, Q, R, N, integral_action):
+    """State weights ``(CᵀQC, R + DᵀQD, N + CᵀQD)`` of an output weight Q."""
+    if integral_action is not None:
+        raise ControlArgument("output=True cannot be combined with integral_action")
+    T, (n, m, p) = sys.period, (sys.nstates, sys.ninputs, sys.noutputs)
+
+    def periodic(M, name, shape):
+        if sys.isdtime(strict=True) and not (isinstance(M, PeriodicMatrix) or callable(M)):
+            steps = _steps(M, sys, name)
+            _shape_check(steps, shape, name)
+            return (_held(steps, sys) if len(steps) > 1
+                    else PeriodicMatrix.constant(steps[0], T))
+        return as_periodic(M, T, name, shape=shape)
+    Q, R = periodic(Q, 'Q', (p, p)), periodic(R, 'R', (m, m))
+    C, D = sys.C, sys.D
+    Nq = C.T @ Q @ D
+    N = Nq if N is None else periodic(N, 'N', (n, m)) + Nq
+    return C.T @ Q @ C, R + D.T @ Q @ D, N
+
+
 def _discrete(sys, nsteps):
     """True for a discrete-time plant (which takes no nsteps)."""
     sys = as_ltp(sys)
@@ -414,6 +489,11 @@ def _steps(M, sys, name):
     return arr if arr.ndim == 3 else arr[np.newaxis]
 
 
+def _same_steps(*mats):
+    """True when every per-step stack holds one matrix (LTI data)."""
+    return all(M is None or np.all(M == M[:1]) for M in mats)
+
+
 def _shape_check(M, shape, name):
     if M.shape[1:] != shape:
         raise ControlDimension(f"{name} must have shape {shape}, got {M.shape[1:]}")
@@ -423,21 +503,15 @@ def _held(values, sys):
     return PeriodicMatrix.from_samples(values, sys.period, kind='hold')
 
 
-def _reversed_gain(Gd):
-    """``(L, exact)``: ``L(t) = Gd(-t)ᵀ`` as a verified gain table, like `care`'s gains.
-
-    The table is tabulated from the exact reversed gain on the reversed step
-    grid of the dual problem, on first use (or when pickled or saved).
-    """
-    table = Gd.function
-    exact = PeriodicMatrix.from_function(_Reversed(table.exact, True), Gd.period,
-                                         Gd.shape[::-1],
-                                         breakpoints=np.mod(-table.exact.breakpoints, Gd.period),
-                                         check=False)
-    L = PeriodicMatrix.from_function(_GainTable(exact=exact, grid=Gd.period - table.grid[::-1]),
-                                     Gd.period, exact.shape, breakpoints=exact.breakpoints,
-                                     check=False)
-    return L, exact
+def _reversed_gain(exact, grid):
+    """``L(t) = Gd(-t)ᵀ`` of the dual problem's exact gain, as a verified gain
+    table like `care`'s on the reversed step grid (built by the caller)."""
+    rev = PeriodicMatrix.from_function(_Reversed(exact, True), exact.period, exact.shape[::-1],
+                                       breakpoints=np.mod(-exact.breakpoints, exact.period),
+                                       check=False)
+    return PeriodicMatrix.from_function(
+        _GainTable(exact=rev, grid=_table_edges(grid, rev.breakpoints)), rev.period,
+        rev.shape, breakpoints=rev.breakpoints, check=False)
 
 
 class _Reversed:

@@ -69,13 +69,20 @@ __all__ = ['care', 'dare']
 _RESIDUAL_WARN = 1e-8
 # degree of the Chebyshev interpolant of X(t) on every step
 _CHEB_DEG = 16
+# steps per call of the integrator (bounded memory)
+_FLOW_CHUNK = 512
+# uniform pieces a verified table (gain, X) starts from before bisection;
+# step grids up to _GRID_STEPS steps are used directly (cheaper short flows),
+# longer (stiff) ones give way to these coarse pieces and exact values
+_TABLE_PIECES = 32
+_GRID_STEPS = 256
 # multipliers within this distance of the unit circle count as on it
 _CIRCLE_TOL = 1e-10
 # tabulated gain: degree on every piece, verified relative accuracy (to
 # 1 + max |G| on the piece), finest bisection of a step
 _GAIN_DEG = 16
 _GAIN_TOL = 1e-9
-_GAIN_DEPTH = 8
+_GAIN_DEPTH = 12
 # closed-loop log|μ| above -first: not stabilizing; above -second: doubtful
 # (a defective unit-circle pair splits by about sqrt(eps))
 _CLOSED_LOOP_TOL = (1e-9, 1e-6)
@@ -129,6 +136,15 @@ def care(A, B, Q, R, S=None, period=None, nsteps=None):
     >>> np.allclose(X(0.3), ct.care(A, B, np.eye(2), [[1.0]])[0])
     True
     """
+    X, L, G, _ = _care_solution(A, B, Q, R, S, period, nsteps)
+    if isinstance(G.function, _GainTable):
+        G.function._build()                      # tabulated now, bounded (module notes)
+    return X, L, G
+
+
+def _care_solution(A, B, Q, R, S, period, nsteps):
+    """``(X, L, G, exact)`` of `care`; G's table not built yet (``exact`` is the
+    pointwise gain ``R⁻¹(BᵀX + Sᵀ)``)."""
     period = _period_of((A, B, Q, R, S), period)
     A = as_periodic(A, period, 'A')
     n = A.shape[0]
@@ -164,15 +180,21 @@ def care(A, B, Q, R, S=None, period=None, nsteps=None):
         return Xg, (Psi @ _stack(Xg[:-1]))[:, :n]
     Xg, factors = _refine(X0, sweep)
     L = _exponents(factors, period=period)
-    solution = _RiccatiSolution(H, grid, Xg)
-    X = PeriodicMatrix.from_function(solution, period, (n, n), breakpoints=grid[:-1],
+    if all(M.is_constant for M in ops):
+        # LTI data: constant X and gain (flagged constant), the eigenvalues of A - BG
+        X = PeriodicMatrix.constant(Xg[0], period)
+        G0 = _gain(B(0.0)[None], R(0.0)[None], S(0.0)[None], Xg[:1])[0]
+        L = lti_representatives(L, A(0.0) - B(0.0) @ G0, period=period)
+        G = PeriodicMatrix.constant(G0, period)
+        return X, L, G, G
+    solution = _RiccatiSolution(H, grid, Xg, breaks=breaks)
+    X = PeriodicMatrix.from_function(solution, period, (n, n), breakpoints=breaks,
                                      check=False)
     exact = PeriodicMatrix.pointwise(_gain, [B, R, S, X], (m, n), breakpoints=breaks)
-    G = PeriodicMatrix.from_function(_GainTable(exact=exact, grid=grid), period, (m, n),
-                                     breakpoints=exact.breakpoints, check=False)
-    if all(M.is_constant for M in ops):          # LTI data: the eigenvalues of A - BG
-        L = lti_representatives(L, A(0.0) - B(0.0) @ exact(0.0), period=period)
-    return X, L, G
+    G = PeriodicMatrix.from_function(
+        _GainTable(exact=exact, grid=_table_edges(grid, exact.breakpoints)), period,
+        (m, n), breakpoints=exact.breakpoints, check=False)
+    return X, L, G, exact
 
 
 def _gain(b, r, s, x):
@@ -255,6 +277,11 @@ class _GainTable:
                 self.edges, self.coefs = table
                 self.exact = self.grid = None
                 self._setup()
+            else:
+                warnings.warn("the periodic gain could not be verified as a Chebyshev table "
+                              f"(relative accuracy {_GAIN_TOL:.0e}); it is evaluated from the "
+                              "Riccati solution at every call instead (slower)", UserWarning,
+                              stacklevel=5)
             self._ready = True
         return self.coefs is not None
 
@@ -316,14 +343,17 @@ register_func('gain_table', _GainTable)
 
 
 class _RiccatiSolution:
-    """X(t) of `care`: exact at the step boundaries, interpolated inside the steps.
+    """X(t) of `care`: exact at the step boundaries and, between them, by the
+    backward Hamiltonian flow over the partial step (exact, bounded cost).
 
-    The interpolant is built on first use from the Hamiltonian flow, or
-    when the solution is pickled or saved, so that it is data-backed.
+    A verified piecewise Chebyshev interpolant (`_interpolant`) is built
+    when the solution is pickled or saved, so that it is data-backed; once
+    built (or after loading) it serves the evaluations.
     """
 
-    def __init__(self, H, grid, Xg, interp=None):
+    def __init__(self, H, grid, Xg, interp=None, breaks=()):
         self.H, self.grid, self.Xg, self.interp = H, grid, Xg, interp
+        self.breaks = np.asarray(breaks, float)
 
     def __call__(self, t):
         grid = self.grid
@@ -333,16 +363,23 @@ class _RiccatiSolution:
         on = np.abs(grid[np.minimum(k, len(grid) - 1)] - tau) <= 1e-14 * period
         if np.all(on):                      # step boundaries: no interpolant needed
             return self.Xg[k]
-        return self._interpolant()(t)
+        if self.interp is not None or self.H is None or len(grid) - 1 <= _GRID_STEPS:
+            return self._interpolant()(t)
+        return _exact_values(self.H, grid, self.Xg, tau)
 
     def _interpolant(self):
         if self.interp is None:
-            self.interp = _interpolant(self.H, self.grid, self.Xg)
+            self.interp = _interpolant(self.H, self.grid, self.Xg, self.breaks)
         return self.interp
 
     def __getstate__(self):
         self._interpolant()
-        return {'H': None, 'grid': self.grid, 'Xg': self.Xg, 'interp': self.interp}
+        return {'H': None, 'grid': self.grid, 'Xg': self.Xg, 'interp': self.interp,
+                'breaks': self.breaks}
+
+    def __setstate__(self, state):
+        self.__init__(state['H'], state['grid'], state['Xg'], state['interp'],
+                      state.get('breaks', ()))
 
     def _portable(self):
         it = self._interpolant()
@@ -475,8 +512,9 @@ def _hamiltonian(ops, breaks):
     return PeriodicMatrix.pointwise(hamiltonian, ops, (2 * n, 2 * n), breakpoints=breaks)
 
 
-def _interpolant(H, grid, Xg):
-    """X(t) inside the steps: the backward flow at Chebyshev points, interpolated."""
+def _grid_interpolant(H, grid, Xg):
+    """X(t) inside the steps of a short grid: the backward flow at Chebyshev
+    points of every step, interpolated (``16 x len(grid)`` short flows)."""
     n = Xg.shape[1]
     cheb = chebyshev_nodes(_CHEB_DEG)
     nodes = grid[:-1, None] + np.diff(grid)[:, None] * cheb
@@ -498,6 +536,72 @@ def _interpolant(H, grid, Xg):
                       f"{err:.1e} inside the steps; increase nsteps", UserWarning,
                       stacklevel=4)
     return interp
+
+
+
+def _exact_values(H, grid, Xg, tau):
+    """X at the times tau in [0, T): ``[U; V] = Φ_H(t_{k+1}, τ)⁻¹ [I; X_{k+1}]``
+    on the step k that holds τ (the backward flow contracts onto the
+    stabilizing solution)."""
+    n = Xg.shape[1]
+    k = np.clip(np.searchsorted(grid, tau, side='right') - 1, 0, len(grid) - 2)
+    Phi = _flow(H, tau, grid[k + 1] - tau)
+    return _graph(np.linalg.solve(Phi, _stack(Xg[k + 1])), n)
+
+
+def _interpolant(H, grid, Xg, breaks):
+    """`_grid_interpolant` for a grid of at most `_GRID_STEPS` steps, else
+    `_coarse_interpolant`."""
+    if len(grid) - 1 <= _GRID_STEPS:
+        return _grid_interpolant(H, grid, Xg)
+    return _coarse_interpolant(H, grid, Xg, breaks)
+
+
+def _coarse_interpolant(H, grid, Xg, breaks):
+    """Verified piecewise Chebyshev interpolant of X (`PiecewiseChebyshev`).
+
+    Pieces start from `_coarse_edges` (X is smooth between switching
+    instants, whatever the solver's step grid) and are bisected, at most
+    `_GAIN_DEPTH` times, until the interpolant matches the exact values at
+    interior probes to 1e-10 relative.  The cost is set by the smoothness
+    of X, not by the stiffness of the data.
+    """
+    n = Xg.shape[1]
+    period = grid[-1]
+    scale = max(np.abs(Xg).max(), 1e-300)
+    nodes = chebyshev_nodes(_CHEB_DEG)
+    probe = np.array([0.1234, 0.3717, 0.6543, 0.8911])
+    bary = (-1.0) ** np.arange(_CHEB_DEG + 1)
+    bary[[0, -1]] *= 0.5
+    weights = bary / (probe[:, None] - nodes[None, :])
+    weights /= weights.sum(axis=1, keepdims=True)
+    edges = _coarse_edges(period, breaks)
+    lo, hi = edges[:-1], edges[1:]
+    starts, values, err = [], [], 0.0
+    for depth in range(_GAIN_DEPTH + 1):
+        h = (hi - lo)[:, None]
+        vals = _exact_values(H, grid, Xg, (lo[:, None] + h * nodes).ravel())
+        vals = vals.reshape(len(lo), _CHEB_DEG + 1, n, n)
+        exact = _exact_values(H, grid, Xg, (lo[:, None] + h * probe).ravel())
+        approx = np.einsum('pj,kjab->kpab', weights, vals)
+        dev = np.abs(approx - exact.reshape(approx.shape)).max(axis=(1, 2, 3)) / scale
+        ok = dev <= 1e-10
+        if depth == _GAIN_DEPTH:
+            ok[:] = True
+            err = float(dev.max(initial=0.0))
+        starts.append(lo[ok])
+        values.append(vals[ok])
+        mid = 0.5 * (lo + hi)
+        lo, hi = np.concatenate([lo[~ok], mid[~ok]]), np.concatenate([mid[~ok], hi[~ok]])
+        if not len(lo):
+            break
+    starts, values = np.concatenate(starts), np.concatenate(values)
+    order = np.argsort(starts)
+    if err > 1e-10:
+        warnings.warn(f"the interpolated Riccati solution has relative errors up to "
+                      f"{err:.1e} inside the steps; increase nsteps", UserWarning,
+                      stacklevel=4)
+    return PiecewiseChebyshev(np.append(starts[order], period), values[order])
 
 
 def _stable_solution(Lk, Mk, n):
@@ -568,8 +672,38 @@ def _stack(X):
 
 
 def _flow(H, t0, h):
-    Psi, _, _ = step_transitions(H, None, np.asarray(t0, float), np.asarray(h, float))
-    return Psi
+    """Transition matrices of many steps, computed in chunks of `_FLOW_CHUNK`
+    steps so that the integrator's sub-step stacks stay bounded."""
+    t0 = np.atleast_1d(np.asarray(t0, float))
+    h = np.broadcast_to(np.asarray(h, float), t0.shape)
+    if len(t0) <= _FLOW_CHUNK:
+        return step_transitions(H, None, t0, h)[0]
+    d = H.shape[0]
+    out = np.empty((len(t0), d, d))
+    for i in range(0, len(t0), _FLOW_CHUNK):
+        out[i:i + _FLOW_CHUNK] = step_transitions(H, None, t0[i:i + _FLOW_CHUNK],
+                                                  h[i:i + _FLOW_CHUNK])[0]
+    return out
+
+
+def _table_edges(grid, breaks):
+    """Initial pieces of a gain table: the step grid when it is short, else
+    `_coarse_edges`."""
+    if len(grid) - 1 <= _GRID_STEPS:
+        return np.asarray(grid, float)
+    return _coarse_edges(grid[-1], breaks)
+
+
+def _coarse_edges(period, breaks):
+    """Initial pieces of a verified table: `_TABLE_PIECES` uniform pieces and
+    the switching instants (the solution is smooth in between, whatever the
+    step grid of the solver)."""
+    edges = np.linspace(0.0, period, _TABLE_PIECES + 1)
+    edges = np.union1d(edges, np.mod(np.asarray(breaks, float), period))
+    keep = np.concatenate([[True], np.diff(edges) > 1e-12 * period])
+    edges = edges[keep]
+    edges[-1] = period
+    return edges
 
 
 def _exponents(factors, period=None, nper=None):
