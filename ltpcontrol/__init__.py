@@ -62,6 +62,7 @@ from ._identification.refine import refine_ltp, RefineInfo
 from ._identification.montecarlo import monte_carlo, MonteCarloResult
 from ._identification.scenarios import sample_models
 from .storage import save, load
+from ._identification.validate import validate_ltp, LTPValidation
 
 __version__ = "0.1.0"
 
@@ -117,6 +118,8 @@ __all__ = [
     'campbell', 'CampbellDiagram',
     # files
     'save', 'load',
+    # validation of identified models on time records
+    'validate_ltp', 'LTPValidation',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

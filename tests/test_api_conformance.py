@@ -228,6 +228,7 @@ _RESULT_CLASSES |= {'RefineInfo', 'MonteCarloResult'}
 _RESULT_CLASSES |= {'HTFEstimateInfo', 'ARXInfo', 'HTFFitInfo'}
 _RESULT_CLASSES |= {'FloquetModes', 'CampbellDiagram'}
 _RESULT_CLASSES |= {'HarmonicNyquistResponse', 'HarmonicMargins', 'MarginPoint'}
+_RESULT_CLASSES |= {'LTPValidation'}
 
 DOC_DEFECTS = {}
 
