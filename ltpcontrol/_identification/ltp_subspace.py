@@ -105,8 +105,9 @@ class LTPSubspaceInfo:
         `identify_ltp`); NaN when the noise is unknown.
     holdout_error : float
         The model's share of the held-out NRMSE, ``sqrt(holdout_nrmse² -
-        holdout_noise²)`` (``holdout_nrmse`` when the noise is unknown):
-        compared with ``validation_tol``.
+        holdout_noise²)`` (``holdout_nrmse`` when the noise is unknown; NaN
+        when the noise level exceeds ``holdout_nrmse``): compared with
+        ``validation_tol``.
     holdout_lines : ndarray
         The held-out lines (rad/s); empty without validation.
     data_harmonics : int
@@ -325,7 +326,12 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         If the model's share of its held-out error exceeds
         `validation_tol` (the warning names ``holdout_error`` and
         ``holdout_nrmse``); if the data (lifted response or HTF) hold fewer
-        output harmonics than the model produces.  With
+        output harmonics than the model produces; if the noise level exceeds
+        the held-out NRMSE (the model's share is then unknown, NaN); if the
+        free DFT bins of the records hold a transient or lines rather than
+        noise; if a valid model's share exceeds 3 times the noise's (and a
+        tenth of `validation_tol`: the structure underfits); with
+        ``input_hold='auto'`` when the assumed hold matters.  With
         'refit': if the returned model misses the data by more than
         the realization's ``fit_tol`` (default 0.05, relative residual less
         the noise's share) or the refit stops before converging without a
@@ -408,8 +414,10 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     Noise in the held-out data raises the NRMSE of a perfect model.  When
     the noise is known, ``holdout_noise = sqrt(Σ σ²) / ‖G‖`` is the NRMSE
     of the noise alone over the same entries and ``holdout_error =
-    sqrt(holdout_nrmse² - holdout_noise²)`` (0 if negative) the model's
-    share, which decides ``success``.  Time records give σ² themselves: in
+    sqrt(holdout_nrmse² - holdout_noise²)`` the model's share, which
+    decides ``success``; with the noise level above ``holdout_nrmse`` the
+    share is unknown (NaN, with a warning; never 0) and ``holdout_nrmse``,
+    which bounds it, decides.  Time records give σ² themselves: in
     the analysis window of P periods ω_p is P DFT bins and the response to
     a line at bin l occupies only the bins ``±l + mP`` (and ``mP``); the
     mean power of the nearest four free bins around each output frequency
@@ -419,9 +427,15 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     holdout_nrmse``.  The held-out noise was not fitted, so
     ``holdout_nrmse >= holdout_noise`` up to the spread of the estimate: a
     level above 1.5 times it is not noise (a transient left in the window,
-    or too large a `std`) and is not used, with a warning.  The relative
-    residual is compared with the realization's ``fit_tol`` the same way,
-    less the noise's share over all lines.
+    or too large a `std`) and is not used, with a warning.  The free bins
+    of time records must also hold noise: a content that is not stationary
+    over the window (a transient) or that has lines (nonlinear or event
+    distortion) is not used (module ``noise_check``; broadband stationary
+    distortion passes as noise: simulate the model on fresh records with
+    `validate_ltp`).  The relative residual is compared with the
+    realization's ``fit_tol`` the same way, less the noise's share over
+    all lines (a residual below the noise counts as 0 there: the fitted
+    lines absorb part of their noise).
 
     With ``refine='ml'`` the refined model is kept only if it predicts the
     held-out lines at least as well as its start; otherwise the start is
