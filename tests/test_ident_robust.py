@@ -125,7 +125,7 @@ def test_select_structure_finds_order_and_harmonics():
     with pytest.raises(ValueError, match='criterion'):
         ltp.select_structure(G, T, [2], [1], criterion='bic')
     with pytest.raises(ValueError, match='harmonics'):
-        ltp.select_structure(G, T, [2], [5])
+        ltp.select_structure(lifted_data(plant, 3, LINES, DT), T, [2], [5])
 
 
 def test_unusable_lines_dropped_and_skipped():

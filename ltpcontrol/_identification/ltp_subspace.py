@@ -581,12 +581,13 @@ def _identify(data, period, nstates, nharmonics=1, *, q=None, conversion='refit'
         nfev += res['nfev']
     sysc, converged, ml, Kr = res['sys'], res['converged'], res['ml'], res['Kr']
     real = res['realization']
-    if not_noise is not None and noise_var is not None:
+    if not_noise is not None and noise_var is not None and (
+            not held.any() or holdout_noise > _NOT_NOISE_SHARE * holdout_nrmse):
         # the free bins hold no noise: their level is no share of the held-out error
-        if not held.any() or holdout_noise > _NOT_NOISE_SHARE * holdout_nrmse:
-            warnings.warn(f"the DFT bins free of the response hold {not_noise}: their "
-                          "level is not used as the noise's share of the held-out error",
-                          UserWarning, stacklevel=2)
+        # (a small content changes that share by at most 5 %: kept as the level)
+        warnings.warn(f"the DFT bins free of the response hold {not_noise}: their "
+                      "level is not used as the noise's share of the held-out error",
+                      UserWarning, stacklevel=2)
         holdout_noise, noise_var = np.nan, None
     holdout_noise = _checked_noise(holdout_nrmse, holdout_noise)
     if not np.isfinite(holdout_noise):
