@@ -73,6 +73,7 @@ from ._analysis.output_feedback import ofstab, oflqr, OutputFeedbackResult
 from ._analysis.hinf import hinfnorm
 from ._analysis.finite_horizon import care_finite, lyap_finite, h2norm_finite
 from ._analysis.sylvester import sylvester, dsylvester
+from ._identification.validate import validate_ltp, LTPValidation
 
 __version__ = "0.1.0"
 
@@ -149,6 +150,8 @@ __all__ = [
     # periodic design beyond state feedback
     'ofstab', 'oflqr', 'OutputFeedbackResult', 'hinfnorm',
     'care_finite', 'lyap_finite', 'h2norm_finite', 'sylvester', 'dsylvester',
+    # validation of identified models on time records
+    'validate_ltp', 'LTPValidation',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

@@ -231,6 +231,7 @@ _RESULT_CLASSES |= {'HarmonicNyquistResponse', 'HarmonicMargins', 'MarginPoint'}
 _RESULT_CLASSES |= {'DelayMonodromy', 'StabilityChart'}
 _RESULT_CLASSES |= {'HarmonicModes'}
 _RESULT_CLASSES |= {'OutputFeedbackResult'}
+_RESULT_CLASSES |= {'LTPValidation'}
 
 DOC_DEFECTS = {}
 

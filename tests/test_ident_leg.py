@@ -83,3 +83,27 @@ def test_leg_noisy_refinement(records):
     assert pinfo.holdout_error < pinfo.holdout_nrmse
     assert fresh_nrmse(plain, plant) < 1e-2
     assert fresh_nrmse(refined, plant) < 1.5 * fresh_nrmse(plain, plant)
+
+
+@pytest.mark.slow
+def test_leg_lifted_data_path(records):
+    """The lifted-data path: data of K harmonics leave the model's outer ones free
+    (success=False with a warning, whatever the held-out error); data of 3K + 1
+    harmonics give a model that predicts fresh records (K = 3 within 1e-2:
+    examples/ident_leg_paths.py; K = 2 here, cheaper)."""
+    plant, t, u, y = records
+    G = ltp.lifted_frequency_response((t, u, y), T, 2, transient=P * T, input_hold='foh')
+    with pytest.warns(UserWarning, match=r"harmonics 3\.\.7 are neither fitted"):
+        model, info = ltp.identify_ltp(G, T, 3, 2, return_info=True)
+    assert not info.success and info.holdout_nrmse < 0.05
+    assert fresh_nrmse(model, plant) > 0.05                   # what the flag is for
+    G = ltp.lifted_frequency_response((t, u, y), T, 7, transient=P * T, input_hold='foh')
+    model, info = _identify_lifted(G, 2)
+    assert info.success and info.data_harmonics == 7
+    assert fresh_nrmse(model, plant) < 2e-2                   # measured 1.3e-2
+
+
+def _identify_lifted(G, K):
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        return ltp.identify_ltp(G, T, 3, K, return_info=True)

@@ -123,7 +123,8 @@ def test_thirty_random_mimo_plants():
     worst = np.zeros(2)
     for seed in range(30):
         info, cmp = _check(_mimo(seed), 3)
-        assert info.success
+        # lifted data of K harmonics leave the model's outer ones unvalidated
+        assert not info.success and 'neither fitted nor validated' in info.message
         worst = np.maximum(worst, [cmp.htf_error, cmp.exponent_error])
     assert worst[0] <= 1e-3 and worst[1] <= 1e-3
 
@@ -145,6 +146,6 @@ def test_ml_refinement_and_structure_selection_mimo():
     with pytest.raises(ltp.ControlDimension if hasattr(ltp, 'ControlDimension')
                        else ValueError, match='std'):
         ltp.refine_ltp(model, G, std=np.ones(3))
-    sel = ltp.select_structure(lifted_data(plant, 3, LINES, DT), T, [1, 2], [1, 3])
+    sel = ltp.select_structure(lifted_data(plant, 10, LINES, DT), T, [1, 2], [1, 3])
     assert sel.best == (2, 3)
     assert sel.validation_error[1, 1] < 1e-3 < sel.validation_error[0, 1]

@@ -117,7 +117,8 @@ class TestHybridOrbit:
     def test_time_switching_linearization(self):
         plant = self.plant()
         orbit = periodic_orbit(plant, T, [0.3, 0.0], 'up')
-        lin = linearize_orbit(plant, orbit)
+        with pytest.warns(UserWarning, match="freezes the orbit's 2 events"):
+            lin = linearize_orbit(plant, orbit)
         t_up = [t for t in np.linspace(0, T, 50, endpoint=False)
                 if orbit(t)[0] > 1e-3]
         t_down = [t for t in np.linspace(0, T, 50, endpoint=False) if orbit(t)[0] < -1e-3]
@@ -129,7 +130,8 @@ class TestHybridOrbit:
                                                                        0.0)))
         # the time-switching model ignores the saltation: its monodromy differs
         assert np.abs(lin.monodromy() - orbit.monodromy).max() > 1e-2
-        avg = linearize_orbit(plant, orbit, piecewise_constant=True)
+        with pytest.warns(UserWarning, match="multipliers"):
+            avg = linearize_orbit(plant, orbit, piecewise_constant=True)
         np.testing.assert_allclose(avg.monodromy(), lin.monodromy(), atol=1e-8)
 
 

@@ -54,8 +54,8 @@ class Excitation(NamedTuple):
         integer number of periods long.  Pass them to `estimate_htf`.
     signal : callable
         ``signal(t)`` evaluates the continuous-time input (shape like
-        `inputs` with the time axis replaced by ``t``); use it with
-        variable-step simulators.
+        `inputs` with the time axis replaced by the shape of ``t``, none
+        for a scalar ``t``); use it with variable-step simulators.
     frequencies : ndarray or None
         Excited frequencies in rad/s for sinusoidal designs (for
         `sine_experiments`, the line of every experiment), else None.
@@ -264,7 +264,7 @@ def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitud
     delays = np.arange(nexp) * period / nexp
 
     def single(t, shift=0.0):
-        t = np.asarray(t, dtype=float)
+        t = np.atleast_1d(np.asarray(t, dtype=float))
         # u_r(t) = Σ_l a cos(ω_l (t - τ_r) + φ_l + shift), accumulated line by
         # line so that memory stays (experiments x samples)
         shifted = t[None, :] - delays[:, None]
@@ -273,11 +273,40 @@ def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitud
             out += np.cos(w * shifted + phi + shift)
         return amplitude * out
 
-    signal = single if shifts is None else _joint(single, shifts)
+    signal = _scalar_time(single if shifts is None else _joint(single, shifts))
     nsamp = (settle + nperiods) * nper
     time = np.arange(nsamp) * dt
     segments = np.array([[settle * nper, nsamp]])
     return time, signal, segments
+
+
+def _scalar_time(signal):
+    """`signal` (time last) that also takes a scalar time, giving its value there
+    (for variable-step simulators)."""
+    def wrapped(t):
+        t = np.asarray(t, dtype=float)
+        out = signal(t.reshape(-1))
+        return out[..., 0] if t.ndim == 0 else out.reshape(out.shape[:-1] + t.shape)
+    return wrapped
+
+
+def _separable(bins, nperiods):
+    """The bins of `bins` (in order) whose output harmonics ``±l + m P`` do not meet
+    those of an earlier kept bin (P = `nperiods` bins per ω_p): one experiment then
+    gives the lifted response at every line (`lifted_frequency_response`).
+
+    >>> _separable(np.array([1, 3, 5, 7]), 4).tolist()
+    [1]
+    >>> _separable(np.array([b for b in range(1, 20) if b % 5]), 10).tolist()
+    [1, 2, 3, 4]
+    """
+    used, kept = {0}, []                       # residue 0: a periodic operating point
+    for b in bins:
+        res = {int(b) % nperiods, int(-b) % nperiods}
+        if not res & used:
+            used |= res
+            kept.append(b)
+    return np.asarray(kept, dtype=bins.dtype)
 
 
 def _check_seed(seed, name="seed"):
@@ -398,7 +427,7 @@ def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
         return amplitude * np.cos(omega[:, None] * t[None, :] + shift)
 
     shifts = _input_phases(ninputs)
-    signal = single if shifts is None else _joint(single, shifts)
+    signal = _scalar_time(single if shifts is None else _joint(single, shifts))
     lines = omega if shifts is None else np.repeat(omega, shifts.shape[0])
     time = np.arange((settle + nperiods) * nper) * dt
     segments = np.array([[settle * nper, time.size]])
@@ -421,7 +450,12 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=None, settle=0,
     ----------
     frequencies : array_like or tuple
         Line frequencies (rad/s), or ``('band', w0, w1)`` for every grid line
-        in ``[w0, w1]`` except multiples of ``ω_p/2``.
+        in ``[w0, w1]`` except multiples of ``ω_p/2``.  With one experiment
+        (the default `nexperiments`), only the lines whose output harmonics
+        ``Ω + nω_p`` do not meet those of a lower line are kept (at most
+        `nperiods`/2 lines), so that `lifted_frequency_response` and
+        `identify_ltp` can separate them; several time-shifted experiments
+        (for `estimate_htf`) keep every line.
     period : float
         System period T (s).
     dt : float
@@ -484,6 +518,8 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=None, settle=0,
         # drop lines at multiples of ω_p/2 (every nperiods/2 bins)
         keep = (2 * bins) % nperiods != 0
         bins = bins[keep]
+        if nexp == 1:
+            bins = _separable(bins, nperiods)
         if bins.size == 0:
             raise ValueError(f"frequencies: no grid line in [{w0}, {w1}] rad/s "
                              f"(resolution {step:.6g} rad/s)")

@@ -26,6 +26,7 @@ M)``: entry ``[j, n + K, :, w]`` is ``G_n(jΩ_w)`` of input j.
 """
 
 import numpy as np
+import scipy.linalg
 from tqdm.auto import tqdm
 
 from .._core.lifting import _real_basis
@@ -223,7 +224,9 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
         colnorm = np.linalg.norm(J, axis=0)
         colnorm = np.maximum(colnorm, 1e-8 * max(colnorm.max(), np.finfo(float).tiny))
         # one SVD per iteration: the damped step -V diag(s/(s²+μ)) U^T r for any μ
-        U, sv, Vt = np.linalg.svd(J / colnorm, full_matrices=False)
+        U, sv, Vt = _robust_svd(J / colnorm)
+        if U is None:
+            break                                 # a Jacobian the SVD cannot take: stop
         Utr = U.T @ r
         sv = np.where(sv > max(J.shape) * np.finfo(float).eps * sv[0], sv, 0.0)
         while True:
@@ -257,3 +260,18 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
                           PeriodicMatrix(Dc, period), period, states=sys.state_labels,
                           **labels)
     return model, float(np.sqrt(f)), converged, nfev
+
+
+def _robust_svd(J):
+    """Thin SVD of `J`; LAPACK's divide and conquer may not converge on badly
+    scaled Jacobians: then the slower QR iteration ('gesvd'), and ``(None, None,
+    None)`` if `J` is not finite or neither converges (the refit stops there)."""
+    if not np.all(np.isfinite(J)):
+        return None, None, None
+    try:
+        return np.linalg.svd(J, full_matrices=False)
+    except np.linalg.LinAlgError:
+        try:
+            return scipy.linalg.svd(J, full_matrices=False, lapack_driver='gesvd')
+        except (np.linalg.LinAlgError, ValueError):
+            return None, None, None

@@ -650,7 +650,9 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     period : float
         Known period T of the system.
     nharmonics : int
-        Number K of harmonics on each side (2K+1 components).
+        Number K of harmonics on each side (2K+1 components).  For
+        `identify_ltp` with K_m harmonics, ``3 K_m + 1`` (every output
+        harmonic its model produces), with `omega_limits` reaching them.
     segments : array_like of int, shape (nseg, 2), optional
         ``[start, stop)`` sample windows applied to every record, e.g. the
         ``segments`` of `chirp_replicas`; default is the whole record.  Each

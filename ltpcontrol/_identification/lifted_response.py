@@ -28,6 +28,7 @@ from tqdm.auto import tqdm
 from .._frequency.htf import HTF, HTFData
 from .._core.lifting import _harmonic_labels, _real_basis
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
+from .noise_check import _free_bin_check
 from .records import as_records, common_grid, refuse_ambiguous
 from .._core.validation import (check_period, check_positive, check_positive_int,
                           real_array, steps_per_period)
@@ -44,6 +45,12 @@ _LEAKAGE_RTOL = 1e-8
 _SEPARATION_RTOL = 1e-10
 _SEPARATION_WARN = 1e-4
 _HOLDS = (None, 'foh', 'zoh')
+#: the advice for records whose input depends on the output
+_CLOSED_LOOP = (". Closed-loop records (the input computed from the output by a "
+                "controller) hold the loop's response and noise in the input: this "
+                "open-loop method cannot use them; give the reference as the input "
+                "(records (t, r, y) identify the closed loop from r to y) or excite the "
+                "plant in open loop")
 
 
 def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
@@ -84,7 +91,10 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     period : float
         Period T of the system; ``N = T/Ts`` must be an integer.
     nharmonics : int
-        Number K of output harmonics kept (``2K+1 <= N``).
+        Number K of output harmonics kept (``2K+1 <= N``).  For
+        `identify_ltp` with K_m harmonics, ``3 K_m + 1``: every output
+        harmonic its model produces (fewer leave the model unvalidated,
+        ``success=False``).
     frequencies : array_like, optional
         Input lines in rad/s, shape ``(nexp,)`` (one line per experiment)
         or ``(nexp, nlines)``.  By default the lines are the DFT bins of
@@ -140,7 +150,11 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
         ninputs, M)`` on the M distinct lines ``Ω`` (increasing, rad/s);
         input j is the ``c0`` (``h0``) coordinate of input j.  Lines
         excited in several experiments are solved in the least-squares
-        sense (averaged, for one input).
+        sense (averaged, for one input).  From records whose free DFT bins
+        give a noise level at every entry (and pass the tests of noise of
+        `identify_ltp`), its attribute ``noise_std``
+        (shape of ``frdata``) holds the standard deviation of each entry;
+        `identify_ltp` uses it as its `std`.
 
     Raises
     ------
@@ -219,22 +233,41 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
            [1. , 2. ],
            [0.5, 0. ]])
     """
-    return _lifted_records(response, period, nharmonics, frequencies=frequencies,
-                           transient=transient, input_hold=input_hold, hold_step=hold_step,
-                           feedthrough=feedthrough, real=real, unusable=unusable,
-                           batch_size=batch_size, progress=progress, name=name)[0]
+    G, var, not_noise = _lifted_records(response, period, nharmonics, frequencies=frequencies,
+                                transient=transient, input_hold=input_hold,
+                                hold_step=hold_step, feedthrough=feedthrough, real=real,
+                                unusable=unusable, batch_size=batch_size, progress=progress,
+                                name=name)
+    if var is not None and not_noise is None and np.all(np.isfinite(var)):
+        G.noise_std = _entry_std(var, G, real)
+    return G
+
+
+def _entry_std(var, G, real):
+    """Standard deviation of every entry of the lifted response G (its frdata's
+    shape) from the variance ``(M, (2K+1) ny, nu)`` of the complex harmonics: for the
+    real coordinates ``V^H G`` the variances mix as ``|V|²``."""
+    if real:
+        ny = sum(1 for lab in G.output_labels if lab.endswith('_c0'))
+        H = G.noutputs // ny
+        K = (H - 1) // 2
+        V, _ = _real_basis(np.arange(-K, K + 1), 2 * K + 2)
+        W = np.kron(np.abs(V) ** 2, np.eye(ny))
+        var = np.einsum('ba,mbj->maj', W, var)
+    return np.sqrt(var.transpose(1, 2, 0))
 
 
 def _lifted_records(response, period, nharmonics, *, frequencies=None, transient=0.0,
                     input_hold=None, hold_step=None, feedthrough=None, real=True,
                     unusable='raise', batch_size=64, progress=False, name=None):
-    """`lifted_frequency_response` and the noise variance of the complex lifted
+    """`lifted_frequency_response`, the noise variance of the complex lifted
     response, ``(M, (2K+1) ny, nu)`` (rows harmonic-major; None for an HTF, NaN where
-    no DFT bin near an output frequency is free of the response; `_output_noise`)."""
+    no DFT bin near an output frequency is free of the response; `_output_noise`), and
+    why the free bins do not hold noise (None if they do; `_free_bin_check`)."""
     period = check_period(period)
     if isinstance(response, HTF):
         K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
-        return _htf_lifted(response, period, K, real, name), None
+        return _htf_lifted(response, period, K, real, name), None, None
     t, dt, u, y, ylabels, ulabels = _parse_response(response)
     N = steps_per_period(period, dt, 'the time step of timepts')
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
@@ -256,6 +289,7 @@ def _lifted_records(response, period, nharmonics, *, frequencies=None, transient
     window = tw.size * dt
     lines = _lines(uw, frequencies, window, dt, period, unusable == 'skip')
     var_y = _output_noise(yw, lines, N, K, dt)
+    not_noise = _free_bin_check(yw, lines, N, K, dt)
     direct = input_hold is not None and feedthrough is not None
     if direct:
         # y = y_dyn + D(t_k) u_k: analyse both parts, the direct one without the hold
@@ -272,7 +306,7 @@ def _lifted_records(response, period, nharmonics, *, frequencies=None, transient
         G = G + _solve_lines(omega, U, Y[:, :, 1].reshape(Y.shape[0], -1), window)[1]
     else:
         lines, G, var = _solve_lines(omega, U * hold, Y, window, var_y)
-    return _lifted_frd(G, lines, dt, K, N, real, ylabels, ulabels, name), var
+    return _lifted_frd(G, lines, dt, K, N, real, ylabels, ulabels, name), var, not_noise
 
 
 def _feedthrough(value, period, shape):
@@ -488,7 +522,7 @@ def _lines(uw, frequencies, window, dt, period, skip=False):
         if np.any(total - inline > _LEAKAGE_RTOL * total):
             raise ValueError("an input window is not a sum of sinusoids on the DFT grid "
                              "of the window (leakage), so its lines cannot be detected; "
-                             "choose the record length or pass frequencies=")
+                             "choose the record length or pass frequencies=" + _CLOSED_LOOP)
     else:
         f = real_array(frequencies, 'frequencies', ndim=(1, 2))
         if f.shape[0] != nexp:
@@ -526,7 +560,8 @@ def _lines(uw, frequencies, window, dt, period, skip=False):
             np.fill_diagonal(d, np.inf)
             if np.any(d < 0.49 * bin_):
                 raise ValueError(f"two lines of experiment {e} differ or sum to a "
-                                 "multiple of omega_p: their output harmonics overlap")
+                                 "multiple of omega_p: their output harmonics overlap"
+                                 + _CLOSED_LOOP)
     if skipped:
         warnings.warn(f"skipped the lines {np.round(np.unique(skipped), 6).tolist()} rad/s "
                       f"at multiples of omega_p/2 = {half:.6g} rad/s: the responses to +Ω "

@@ -22,29 +22,34 @@ multipliers ``e^{λ Ts}``, so inverse Tustin biases ``A`` by about
 """
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import control as ct
-from control.exception import ControlArgument
 
-from .._core.discretize import d2c
 from .fdsubspace import fdsubspace, FDSubspaceInfo
 from .floquet_fit import _harmonic_data, _harmonic_response
 from .._frequency.htf import HTF
-from .records import as_records, refuse_ambiguous
-from .lifted_response import _lifted_records, lifted_frequency_response
+from .lifted_response import lifted_frequency_response
 from .realization import FloquetRealization, floquet_realization
 from .refine import RefineInfo, _harmonics, refine_ltp
-from .refit import _refit
-from .holdout import (_checked_noise, _data_variance, _model_share, _noise_nrmse, _nrmse,
+from .refit import _refit, _to_continuous
+from .ident_data import (_assumed_hold, _check_lifted_data, _enough_lines, _from_excitation,
+                         _lifted_data)
+from .holdout import (_checked_noise, _model_share, _noise_nrmse, _nrmse, _produced_harmonics,
                       _quality)
-from .._core.validation import (check_period, check_positive, check_positive_int,
-                                steps_per_period)
+from .._core.validation import check_period, check_positive, check_positive_int
 
 __all__ = ['lifted_frequency_response', 'identify_ltp', 'LTPSubspaceInfo']
 
 _CONVERSIONS = ('refit', 'log', 'tustin')
+_HOLDS = ('auto', 'foh', 'zoh', None)
+#: a free-bin content that is not noise is reported when its level would have been
+#: this share of the held-out NRMSE (below, subtracting it would change nothing)
+_NOT_NOISE_SHARE = 0.3
+#: a valid model whose held-out share exceeds this many times the noise's (and a
+#: tenth of validation_tol) is reported as underfitting
+_UNDERFIT = 3.0
 
 
 @dataclass(frozen=True)
@@ -100,8 +105,9 @@ class LTPSubspaceInfo:
         `identify_ltp`); NaN when the noise is unknown.
     holdout_error : float
         The model's share of the held-out NRMSE, ``sqrt(holdout_nrmse² -
-        holdout_noise²)`` (``holdout_nrmse`` when the noise is unknown):
-        compared with ``validation_tol``.
+        holdout_noise²)`` (``holdout_nrmse`` when the noise is unknown; NaN
+        when the noise level exceeds ``holdout_nrmse``): compared with
+        ``validation_tol``.
     holdout_lines : ndarray
         The held-out lines (rad/s); empty without validation.
     data_harmonics : int
@@ -109,6 +115,9 @@ class LTPSubspaceInfo:
     refine_fallback : bool
         True when the ML refinement predicted the held-out lines worse than
         its start and the start was kept.
+    input_hold : str or None
+        The input hold of the records used (time records; None for lifted
+        data or an HTF).
 
     Examples
     --------
@@ -133,15 +142,16 @@ class LTPSubspaceInfo:
     holdout_lines: np.ndarray = None
     data_harmonics: int = 0
     refine_fallback: bool = False
+    input_hold: str = None
 
 
 def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
                  realization='direct', realization_options=None, refit_a=True,
                  refit_harmonics='auto', refine=None, refine_options=None,
-                 estimate_d=True, frequencies=None, transient=None, input_hold=None,
+                 estimate_d=True, frequencies=None, transient=None, input_hold='auto',
                  hold_step=None, batch_size=None, seed=None, holdout=4,
-                 validation_tol=0.05, std=None, progress=False, return_info=False,
-                 name=None):
+                 validation_tol=0.05, std=None, excitation=None, progress=False,
+                 return_info=False, name=None):
     r"""Identify a continuous-time LTP model from sine experiments (thesis §4.2).
 
     Runs the whole frequency-domain subspace pipeline: lifted frequency
@@ -222,13 +232,30 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         ``harmonics``, ...).
     estimate_d : bool, optional
         Estimate a feedthrough (default True); False forces ``D = 0``.
-    frequencies, transient, input_hold, hold_step, batch_size : optional
+    frequencies, transient : optional
         Time records only: passed to `lifted_frequency_response` (defaults
-        there: lines detected, no transient, no hold, ``Ts``, 64).  Lines at
-        multiples of ``ω_p/2`` are skipped with a warning.  With an
-        `input_hold` and 'refit', the data are recomputed with the fitted
-        ``D(t)`` as their `feedthrough` and refitted once, which removes
-        the hold's bias on the direct term.
+        there: lines detected, no transient).  Lines at multiples of
+        ``ω_p/2`` are skipped with a warning.
+    input_hold : {'auto', 'foh', 'zoh', None}, optional
+        Time records only: how the recorded input samples were applied to
+        the plant (`lifted_frequency_response`): 'foh' (linear
+        interpolation, as `ltpcontrol.forced_response` applies inputs),
+        'zoh' (held between samples) or None (samples of a continuous
+        input).  'auto' (default): 'foh', with a warning when a zero-order
+        hold would change the data by more than 1 % at the records' highest
+        input frequency (``|1 - e^{-jωTs/2}/sinc(ωTs/2π)| ≈ ωTs/2``).  The
+        hold cannot be inferred from the records: a hold's gain and
+        half-step delay look like plant dynamics, and a model fitted under
+        the wrong hold can fit them better than under the right one (a
+        modulated first-order plant from ZOH records: relative residual
+        1.2e-3 taken as 'foh', 3.6e-3 as 'zoh', yet fresh ZOH records
+        predicted with NRMSE 0.23 and 0.009).  With an `input_hold` and 'refit', the
+        data are recomputed with the fitted ``D(t)`` as their `feedthrough`
+        and refitted once, which removes the hold's bias on the direct
+        term.
+    hold_step, batch_size : optional
+        Time records only: passed to `lifted_frequency_response` (defaults
+        there: ``Ts``, 64).
     seed : int, optional
         Seed of the 'pso' realization search (reproducibility).
     holdout : int or None, optional
@@ -251,7 +278,14 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         errors of its entries, a scalar or an array that broadcasts to
         ``data.frdata.shape`` (lifted outputs, inputs, lines).  It sets the
         noise share of the held-out NRMSE; the noise of time records is
-        estimated from their DFT.
+        estimated from their DFT.  Default: the ``noise_std`` attribute of
+        data lifted from records by `lifted_frequency_response`, if any.
+    excitation : Excitation, optional
+        Time records only: the design (`sine_experiments`, `multisine`) the
+        records were made with.  Its analysis window gives the default
+        `transient` (the settling periods) and its lines the default
+        `frequencies`.  Chirp replicas are refused: estimate their HTF with
+        `estimate_htf` (``segments=exc.segments``) and identify from it.
     progress : bool, optional
         Show progress bars (experiment batches, realization, refit; default
         False).
@@ -291,7 +325,13 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     UserWarning
         If the model's share of its held-out error exceeds
         `validation_tol` (the warning names ``holdout_error`` and
-        ``holdout_nrmse``).  With
+        ``holdout_nrmse``); if the data (lifted response or HTF) hold fewer
+        output harmonics than the model produces; if the noise level exceeds
+        the held-out NRMSE (the model's share is then unknown, NaN); if the
+        free DFT bins of the records hold a transient or lines rather than
+        noise; if a valid model's share exceeds 3 times the noise's (and a
+        tenth of `validation_tol`: the structure underfits); with
+        ``input_hold='auto'`` when the assumed hold matters.  With
         'refit': if the returned model misses the data by more than
         the realization's ``fit_tol`` (default 0.05, relative residual less
         the noise's share) or the refit stops before converging without a
@@ -353,8 +393,15 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     prediction (on a plant with periodic A(t) its error can exceed the
     plant's own harmonic 100-fold).  Lifted data given as
     `control.FrequencyResponseData` are used with the harmonics they hold
-    (their output labels ``'<y>_c0'``, ``'<y>_c1'``, ... tell how many);
-    when these are fewer than the model produces, ``info.message`` says so.
+    (their output labels ``'<y>_c0'``, ``'<y>_c1'``, ... tell how many),
+    HTFs with the most harmonics known together on their grid.  When these
+    are fewer than the model produces, the model is not trustworthy
+    whatever its held-out error on the harmonics the data hold (on a hopper
+    leg with periodic stiffness, lifted data of K = 2 harmonics validate a
+    model at 4e-3 that predicts a fresh broadband record with NRMSE 0.1):
+    ``success`` is False, with a warning naming the missing harmonics.
+    Lift records with ``2K + H`` harmonics (``3K + 1`` for the default
+    'auto') for `identify_ltp` to fit and validate all of them.
 
     Validation.  ``holdout_nrmse = ‖Ĝ - G‖ / ‖G‖`` over the held-out
     lines, all inputs, outputs and harmonics ``|n| <= K_d`` of the data.
@@ -367,8 +414,10 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     Noise in the held-out data raises the NRMSE of a perfect model.  When
     the noise is known, ``holdout_noise = sqrt(Σ σ²) / ‖G‖`` is the NRMSE
     of the noise alone over the same entries and ``holdout_error =
-    sqrt(holdout_nrmse² - holdout_noise²)`` (0 if negative) the model's
-    share, which decides ``success``.  Time records give σ² themselves: in
+    sqrt(holdout_nrmse² - holdout_noise²)`` the model's share, which
+    decides ``success``; with the noise level above ``holdout_nrmse`` the
+    share is unknown (NaN, with a warning; never 0) and ``holdout_nrmse``,
+    which bounds it, decides.  Time records give σ² themselves: in
     the analysis window of P periods ω_p is P DFT bins and the response to
     a line at bin l occupies only the bins ``±l + mP`` (and ``mP``); the
     mean power of the nearest four free bins around each output frequency
@@ -378,9 +427,15 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     holdout_nrmse``.  The held-out noise was not fitted, so
     ``holdout_nrmse >= holdout_noise`` up to the spread of the estimate: a
     level above 1.5 times it is not noise (a transient left in the window,
-    or too large a `std`) and is not used, with a warning.  The relative
-    residual is compared with the realization's ``fit_tol`` the same way,
-    less the noise's share over all lines.
+    or too large a `std`) and is not used, with a warning.  The free bins
+    of time records must also hold noise: a content that is not stationary
+    over the window (a transient) or that has lines (nonlinear or event
+    distortion) is not used (module ``noise_check``; broadband stationary
+    distortion passes as noise: simulate the model on fresh records with
+    `validate_ltp`).  The relative residual is compared with the
+    realization's ``fit_tol`` the same way, less the noise's share over
+    all lines (a residual below the noise counts as 0 there: the fitted
+    lines absorb part of their noise).
 
     With ``refine='ml'`` the refined model is kept only if it predicts the
     held-out lines at least as well as its start; otherwise the start is
@@ -409,6 +464,52 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     >>> round(float((B[2] / B[1]).real), 4)
     0.25
     """
+    if input_hold not in _HOLDS:
+        raise ValueError(f"input_hold must be one of {_HOLDS}, got {input_hold!r}")
+    lifted = isinstance(data, (ct.FrequencyResponseData, HTF))
+    if excitation is not None:
+        if lifted:
+            raise TypeError("identify_ltp: excitation only applies to time records")
+        frequencies, transient = _from_excitation(excitation, frequencies, transient)
+    if not lifted:
+        args = dict(nharmonics=nharmonics, q=q, conversion=conversion,
+                    realization=realization, realization_options=realization_options,
+                    refit_a=refit_a, refit_harmonics=refit_harmonics, refine=refine,
+                    refine_options=refine_options, estimate_d=estimate_d,
+                    frequencies=frequencies, transient=transient, hold_step=hold_step,
+                    batch_size=batch_size, seed=seed, holdout=holdout,
+                    validation_tol=validation_tol, std=std, progress=progress, name=name)
+        return _identify_checked_hold(data, period, nstates, input_hold, return_info, args)
+    if input_hold not in (None, 'auto'):
+        raise TypeError("identify_ltp: ['input_hold'] only apply to time records, not to "
+                        "frequency-response data")
+    return _identify(data, period, nstates, input_hold=None, return_info=return_info,
+                     nharmonics=nharmonics, q=q, conversion=conversion,
+                     realization=realization, realization_options=realization_options,
+                     refit_a=refit_a, refit_harmonics=refit_harmonics, refine=refine,
+                     refine_options=refine_options, estimate_d=estimate_d,
+                     frequencies=frequencies, transient=transient, hold_step=hold_step,
+                     batch_size=batch_size, seed=seed, holdout=holdout,
+                     validation_tol=validation_tol, std=std, progress=progress, name=name)
+
+
+def _identify_checked_hold(data, period, nstates, input_hold, return_info, args):
+    """`_identify` on time records with the input hold given, or 'foh' for 'auto' with
+    a warning when the hold matters for these records."""
+    hold = _assumed_hold(data, input_hold, args['hold_step'])
+    sysc, info = _identify(data, period, nstates, input_hold=hold, return_info=True, **args)
+    info = replace(info, input_hold=hold)
+    return (sysc, info) if return_info else sysc
+
+
+def _identify(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
+              realization='direct', realization_options=None, refit_a=True,
+              refit_harmonics='auto', refine=None, refine_options=None,
+              estimate_d=True, frequencies=None, transient=None, input_hold=None,
+              hold_step=None, batch_size=None, seed=None, holdout=4,
+              validation_tol=0.05, std=None, progress=False, return_info=False,
+              name=None):
+    """`identify_ltp` with a given input hold."""
     period = check_period(period)
     nstates = check_positive_int(nstates, 'nstates')
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
@@ -429,7 +530,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         K if refit_harmonics == 'auto' else refit_harmonics)
     record_options = dict(frequencies=frequencies, transient=transient,
                           input_hold=input_hold, hold_step=hold_step, batch_size=batch_size)
-    G, noise_var = _lifted_data(data, period, 2 * K + Hb, progress, record_options, K, std)
+    G, noise_var, not_noise = _lifted_data(data, period, 2 * K + Hb, progress,
+                                           record_options, K, std)
     ny, N, Kd = _check_lifted_data(G, period, K, nstates, q)
     name = 'ltp_subspace' if name is None else name
     labels = dict(name=name, inputs=[lab.rsplit('_', 1)[0] for lab in G.input_labels],
@@ -479,12 +581,22 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         nfev += res['nfev']
     sysc, converged, ml, Kr = res['sys'], res['converged'], res['ml'], res['Kr']
     real = res['realization']
+    if not_noise is not None and noise_var is not None and (
+            not held.any() or holdout_noise > _NOT_NOISE_SHARE * holdout_nrmse):
+        # the free bins hold no noise: their level is no share of the held-out error
+        # (a small content changes that share by at most 5 %: kept as the level)
+        warnings.warn(f"the DFT bins free of the response hold {not_noise}: their "
+                      "level is not used as the noise's share of the held-out error",
+                      UserWarning, stacklevel=2)
+        holdout_noise, noise_var = np.nan, None
     holdout_noise = _checked_noise(holdout_nrmse, holdout_noise)
     if not np.isfinite(holdout_noise):
         noise_var = None
     holdout_error = _model_share(holdout_nrmse, holdout_noise)
-    # a refit that stopped early is doubtful unless the held-out lines validate it
-    validated = bool(held.any() and holdout_error <= validation_tol)
+    # a refit that stopped early is doubtful unless the held-out lines validate it;
+    # with the model's share unknown (NaN), the held-out NRMSE bounds it
+    validated = bool(held.any() and (holdout_nrmse if np.isnan(holdout_error)
+                                     else holdout_error) <= validation_tol)
     if conversion == 'refit' and not converged and not validated:
         warnings.warn("the least-squares refit did not converge", UserWarning, stacklevel=2)
     Gc = _harmonic_data(G.frdata, Kd, N, ny)
@@ -494,26 +606,47 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     noise = _noise_nrmse(noise_var, G, np.ones(M, bool), Kd, N, ny)
     success, message = _quality(real, Kr, K, conversion, relres, converged, ml,
                                 realization_options, validated, noise)
-    produced = 2 * K + max(K, sysc.B.nharmonics or 0)
+    produced = _produced_harmonics(sysc, K, conversion)
     if Kd < produced:
-        message += (f"; the data hold the output harmonics |n| <= {Kd}, the model produces "
-                    f"|n| <= {produced}: those above {Kd} are not fitted")
+        # harmonics the model produces but the data do not hold are free: neither
+        # fitted nor validated, yet they enter every prediction
+        success = False
+        missing = (f"the data hold the output harmonics |n| <= {Kd}, the model produces "
+                   f"|n| <= {produced}: the harmonics {Kd + 1}..{produced} are neither "
+                   "fitted nor validated")
+        message += "; " + missing
+        warnings.warn(f"{missing}; give data with {produced} harmonics "
+                      f"(lifted_frequency_response(..., {produced}) or estimate_htf(..., "
+                      f"{produced})), or the time records themselves", UserWarning,
+                      stacklevel=2)
     if fallback:
         message += ("; the ML refinement predicted the held-out lines worse than its "
                     "start, which is kept")
     if held.any():
         noise = (f", of which noise {holdout_noise:.3g}: model error {holdout_error:.3g}"
                  if np.isfinite(holdout_noise) else "")
+        if np.isnan(holdout_error):
+            noise = ": the model's share is unknown (noise estimate above it)"
         message += (f"; held-out NRMSE {holdout_nrmse:.3g}{noise} (validation_tol "
                     f"{validation_tol:g})")
         if not validated:
             success = False
             figure = (f"holdout_error {holdout_error:.3g} (holdout_nrmse "
                       f"{holdout_nrmse:.3g}, noise {holdout_noise:.3g})"
-                      if np.isfinite(holdout_noise) else f"holdout_nrmse {holdout_nrmse:.3g}")
+                      if np.isfinite(holdout_error) and np.isfinite(holdout_noise)
+                      else f"holdout_nrmse {holdout_nrmse:.3g}")
             warnings.warn(f"the identified model does not predict its held-out lines: "
                           f"{figure} > validation_tol {validation_tol:g}; try other "
                           "nstates, nharmonics or more data", UserWarning, stacklevel=2)
+    if success and np.isfinite(holdout_error) and np.isfinite(holdout_noise) and \
+            holdout_error > max(_UNDERFIT * holdout_noise, validation_tol / 10):
+        # valid, but the data determine more than the structure explains
+        message += "; the model error is far above the noise: the structure underfits"
+        warnings.warn(f"the model's share of its held-out error ({holdout_error:.3g}) is "
+                      f"{holdout_error / max(holdout_noise, 1e-300):.3g} times the noise's "
+                      f"({holdout_noise:.3g}): the data determine more than nstates="
+                      f"{nstates}, nharmonics={K} explain; a larger structure may predict "
+                      "better (select_structure)", UserWarning, stacklevel=2)
     if not sysc.is_stable():
         # steady-state responses exist only for a stable plant: an unstable fit is doubtful
         growth = float(np.max(np.linalg.eigvals(sysc.A(0.0)).real))
@@ -545,12 +678,6 @@ def _select_lines(G, lines, K, ny):
     """The lifted data of harmonics -K..K on the lines `lines` (bool mask)."""
     return ct.frd(G.frdata[:(2 * K + 1) * ny, :, lines], G.omega[lines], G.dt,
                   inputs=G.input_labels, outputs=G.output_labels[:(2 * K + 1) * ny])
-
-
-def _enough_lines(M, K, nstates, q):
-    """The subspace step of order (2K+1) n_p with `q` block rows can use M lines."""
-    order = (2 * K + 1) * nstates
-    return 2 * M >= 2 * order + 1 and (q is None or 2 * M >= q + order)
 
 
 def _identify_lines(G, lines, ctx, htf):
@@ -628,66 +755,6 @@ def _fit_cost(fit, Kd, N, ny):
     return float(np.linalg.norm(_harmonic_response(sysc, G.omega, Kd) - Gc))
 
 
-def _lifted_data(data, period, Kd, progress, options, K=0, std=None):
-    """Step 1: the real lifted response, given or computed from time records (with
-    the harmonics -Kd..Kd, at most (N-1)/2; from an HTF at least K), and the noise
-    variance of its entries ``(M, rows, inputs)`` (from `std` for lifted data, estimated
-    for time records, None when unknown)."""
-    given = {key: val for key, val in options.items() if val is not None}
-    if isinstance(data, (ct.FrequencyResponseData, HTF)):
-        if given:
-            raise TypeError(f"identify_ltp: {sorted(given)} only apply to time "
-                            "records, not to frequency-response data")
-        if isinstance(data, HTF):
-            if std is not None:
-                raise TypeError("identify_ltp: std applies to lifted frequency-response "
-                                "data; an HTF carries its own std")
-            # the most harmonics known together at some frequencies (band-limited
-            # chirps know few); the ML refinement fits all components of the HTF
-            for k in range(min(Kd, data.nharmonics), K, -1):
-                try:
-                    return lifted_frequency_response(data, period, k), None
-                except ValueError:
-                    continue
-            return lifted_frequency_response(data, period, K), None
-        return data, None if std is None else _data_variance(std, data)
-    if std is not None:
-        raise TypeError("identify_ltp: std applies to lifted frequency-response data; "
-                        "the noise of time records is estimated from them")
-    # time records: parsed once here, so that errors name this function's argument
-    refuse_ambiguous(data, 'data', 'identify_ltp')
-    dt = as_records(data, 'data')[0].dt
-    Kd = min(Kd, (int(round(period / dt)) - 1) // 2)
-    return _lifted_records(data, period, Kd, progress=progress, unusable='skip', **given)
-
-
-def _check_lifted_data(G, period, K, nstates, q):
-    """Validate the lifted data; return (outputs, steps per period, data harmonics)."""
-    H = 2 * K + 1
-    if not G.dt or G.dt is True:
-        raise ControlArgument("data must be discrete-time frequency-response data "
-                              "with a numeric sampling time (from "
-                              "lifted_frequency_response)")
-    # the labels '<y>_c0', '<y>_c1', ... of lifted_frequency_response tell the harmonics
-    ny = sum(1 for lab in G.output_labels if lab.endswith('_c0'))
-    if not (ny and G.noutputs % ny == 0 and (G.noutputs // ny) % 2 == 1
-            and G.noutputs // ny >= H):
-        if G.noutputs % H:
-            raise ValueError(f"data must have (2K+1) = {H} lifted outputs per system "
-                             f"output, got shape {G.frdata.shape[:2]}")
-        ny = G.noutputs // H
-    Kd = (G.noutputs // ny - 1) // 2
-    N = steps_per_period(period, float(G.dt), 'the sampling time of data')
-    order, M = H * nstates, G.omega.size
-    # fdsubspace needs 2M >= q + order with q > order: at least order + 1 lines.
-    if not _enough_lines(M, K, nstates, q):
-        raise ValueError(
-            f"too few frequencies: {M} lines for the lifted order (2K+1)*nstates = "
-            f"{order}{'' if q is None else f' and q={q}'}; need at least "
-            f"{order + 1 if q is None else -(-(q + order) // 2)} distinct lines")
-    return ny, N, Kd
-
-
 def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, progress,
              options, conversion, labels):
     """Steps 2-4: subspace model of order (2k+1) n_p, Floquet realization, continuous time.
@@ -700,7 +767,7 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
     Otherwise k = K, with k < K only when K has no realization.  Returns
     the candidates ``(lifted, info, realization, k, model)``, best first.
     """
-    candidates = []
+    candidates, real = [], None
     for k in range(K, -1, -1):
         Gk = G if k == K else ct.frd(G.frdata[:(2 * k + 1) * ny], G.omega, G.dt)
         order = (2 * k + 1) * nstates
@@ -713,7 +780,9 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
                                          return_info=True, **(options or {}))
         if sysd is None:
             continue
-        sysc = d2c(sysd, 'tustin' if conversion == 'tustin' else 'log', **labels)
+        sysc = _to_continuous(sysd, conversion, labels)
+        if sysc is None:
+            continue
         with np.errstate(all='ignore'):
             miss = np.linalg.norm(_harmonic_response(sysc, G.omega, K) - Gc)
         miss = miss if np.isfinite(miss) else np.inf
@@ -721,5 +790,7 @@ def _realize(G, Gc, period, K, N, nstates, ny, q, estimate_d, method, seed, prog
         if conversion != 'refit' or k <= K - 2:
             break
     if not candidates:
-        raise ValueError(f"the Floquet realization failed: {real.message}")
+        raise ValueError(f"the Floquet realization failed: {real.message}"
+                         if real is not None else "no realization could be converted "
+                         "to continuous time")
     return [c[1:] for c in sorted(candidates, key=lambda c: c[0])]

@@ -7,8 +7,11 @@ harmonics through the intermediate structures (each contains the one
 before, so the K-harmonic fit starts at the best (K-1)-harmonic model).
 """
 
+import warnings
+
 import numpy as np
 
+from .._core.discretize import d2c
 from .._core.ltpsys import LTPStateSpace
 from .._core.periodic_matrix import PeriodicMatrix
 from .floquet_fit import _harmonic_response, fit_floquet
@@ -88,3 +91,22 @@ def _visibility(model, omega, K):
     G = _harmonic_response(extra, omega, K + 1)
     return np.linalg.norm(G[:, [0, -1]]) / max(np.linalg.norm(G[:, 1:-1]),
                                                 np.finfo(float).tiny)
+
+
+def _to_continuous(sysd, conversion, labels):
+    """The continuous-time model of the realization `sysd` ('tustin', else 'log'); a
+    multiplier on the negative real axis has no real logarithm: then the inverse
+    Tustin map, with a warning (None if that fails too)."""
+    method = 'tustin' if conversion == 'tustin' else 'log'
+    try:
+        return d2c(sysd, method, **labels)
+    except (ValueError, np.linalg.LinAlgError) as err:
+        if method == 'tustin':
+            return None
+        warnings.warn(f"the realized multipliers have no real logarithm ({err}); the "
+                      "continuous model starts from the inverse Tustin map instead",
+                      UserWarning, stacklevel=4)
+    try:
+        return d2c(sysd, 'tustin', **labels)
+    except (ValueError, np.linalg.LinAlgError):
+        return None

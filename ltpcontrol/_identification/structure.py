@@ -31,10 +31,17 @@ from tqdm.auto import tqdm
 
 from .._core.lifting import _real_basis
 from .floquet_fit import _harmonic_data, _harmonic_response
+from .._frequency.htf import HTF
+from .lifted_response import lifted_frequency_response
+from .holdout import _produced_harmonics
 from .ltp_subspace import identify_ltp
+from .records import as_records, refuse_ambiguous
 from .._core.validation import check_period, check_positive_int, steps_per_period
 
 __all__ = ['select_structure', 'StructureSelection']
+
+#: held-out errors below this count as equal when ranking by validation
+_TIE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -117,14 +124,21 @@ class StructureSelection:
 
 
 def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion='validation',
-                     q=None, progress=False):
+                     q=None, transient=0.0, input_hold='foh', progress=False):
     """Choose the order n_p and the harmonics K of an LTP model from data.
 
     Parameters
     ----------
-    data : control.FrequencyResponseData
+    data : control.FrequencyResponseData, HTFData or time records
         Real lifted response (`lifted_frequency_response`) with at least
-        ``max(nharmonics)`` harmonics, one column per input.
+        ``max(nharmonics)`` harmonics, one column per input; or a data HTF
+        (`estimate_htf`) or the sine records themselves, which are lifted
+        here with every output harmonic the largest candidate produces,
+        ``3 max(nharmonics) + 1`` (as far as the HTF holds them or the
+        sampling allows).  A candidate producing output harmonics beyond
+        those of the data is not scored (NaN, with a warning): its
+        unfitted harmonics enter every prediction, yet its held-out error
+        does not see them.
     period : float
         Period T of the system.
     nstates, nharmonics : array_like of int
@@ -134,9 +148,12 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
         validation (default 4; `identify_ltp` with this `holdout`).
     criterion : {'validation', 'aic'}, optional
         Score that picks `best` (default the held-out error; ties within
-        10 % go to the smaller model).
+        10 % or below 1e-3 go to the smaller model).
     q : int, optional
         Block rows of the subspace step (`identify_ltp`).
+    transient, input_hold : optional
+        Time records only: as in `lifted_frequency_response` (defaults no
+        transient and 'foh', the hold of `ltpcontrol.forced_response`).
     progress : bool, optional
         Show a progress bar over the candidates (default False).
 
@@ -149,7 +166,7 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
     Raises
     ------
     ControlArgument
-        If `data` is not discrete-time frequency-response data.
+        If `data` is frequency-response data that is not discrete-time.
     ValueError
         If the data have fewer than ``max(nharmonics)`` harmonics, a
         candidate list is empty, or `criterion` is unknown.
@@ -163,15 +180,35 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
     >>> w = np.pi / 2 * np.array([k for k in range(1, 48) if k % 4])
     >>> exc = ltp.sine_experiments(w, 0.5, dt=0.0125, nperiods=8, settle=12)
     >>> resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
-    >>> G = ltp.lifted_frequency_response(resp, 0.5, 2, transient=6.0, input_hold='foh')
-    >>> sel = ltp.select_structure(G, 0.5, [1, 2], [0, 1, 2])
+    >>> sel = ltp.select_structure(resp, 0.5, [1, 2], [0, 1, 2], transient=6.0)
     >>> sel.best
     (1, 1)
+
+    Lifted data with fewer harmonics than a candidate produces leave it
+    unscored:
+
+    >>> G = ltp.lifted_frequency_response(resp, 0.5, 2, transient=6.0, input_hold='foh')
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as w:
+    ...     warnings.simplefilter('always')
+    ...     sel = ltp.select_structure(G, 0.5, [1], [0, 1, 2])
+    >>> sel.validation_error.round(3)
+    array([[0.354,   nan,   nan]])
     """
-    if not isinstance(data, ct.FrequencyResponseData) or not data.dt or data.dt is True:
+    period = check_period(period)
+    Kmax0 = max(check_positive_int(k, 'nharmonics', minimum=0)
+                for k in np.atleast_1d(nharmonics)) if np.size(nharmonics) else 0
+    if isinstance(data, HTF):
+        data = _htf_lifted_most(data, period, 3 * Kmax0 + 1, Kmax0)
+    elif not isinstance(data, ct.FrequencyResponseData):
+        refuse_ambiguous(data, 'data', 'select_structure')
+        dt = as_records(data, 'data')[0].dt
+        Kd = min(3 * Kmax0 + 1, (int(round(period / dt)) - 1) // 2)
+        data = lifted_frequency_response(data, period, Kd, transient=transient,
+                                         input_hold=input_hold, unusable='skip')
+    if not data.dt or data.dt is True:
         raise ControlArgument("data must be discrete-time lifted frequency-response data "
                               "(from lifted_frequency_response)")
-    period = check_period(period)
     ns = np.unique([check_positive_int(n, 'nstates') for n in np.atleast_1d(nstates)])
     Ks = np.unique([check_positive_int(k, 'nharmonics', minimum=0)
                     for k in np.atleast_1d(nharmonics)])
@@ -183,8 +220,14 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
     N = steps_per_period(period, float(data.dt), 'the sampling time of data')
     Kmax = int(Ks.max())
     rows = data.noutputs
-    ny = rows // (2 * Kmax + 1) if rows % (2 * Kmax + 1) == 0 else 0
-    Kdata = next((k for k in range(N) if (2 * k + 1) * ny == rows), None) if ny else None
+    # the labels '<y>_c0', '<y>_c1', ... of lifted_frequency_response tell the outputs
+    ny = sum(1 for lab in data.output_labels if lab.endswith('_c0'))
+    Kdata = None
+    if ny and rows % ny == 0 and (rows // ny) % 2 == 1 and rows // ny >= 2 * Kmax + 1:
+        Kdata = (rows // ny - 1) // 2
+    if Kdata is None:
+        ny = rows // (2 * Kmax + 1) if rows % (2 * Kmax + 1) == 0 else 0
+        Kdata = next((k for k in range(N) if (2 * k + 1) * ny == rows), None) if ny else None
     if Kdata is None:
         # the data hold (2K_d+1) p rows for some K_d >= Kmax
         Kdata = next((k for k in range(Kmax, N // 2 + 1)
@@ -206,7 +249,7 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
     val = np.full((ns.size, Ks.size), np.nan)
     aic = np.full((ns.size, Ks.size), np.nan)
     bar = tqdm(total=val.size, desc="structures", disable=not progress, leave=False)
-    sv = None
+    sv, unscored = None, []
     for i, n in enumerate(ns):
         for j, K in enumerate(Ks):
             bar.set_postfix(n_p=int(n), K=int(K))
@@ -220,8 +263,12 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
                 continue
             if n == ns[-1] and K == Ks[-1]:
                 sv = info.subspace.singular_values
-            # time-domain NRMSE of the model identified without the held-out lines
-            val[i, j] = info.holdout_nrmse
+            # time-domain NRMSE of the model identified without the held-out lines,
+            # scored only when the data hold every harmonic the model produces
+            if _produced_harmonics(model, int(K), 'refit') > Kdata:
+                unscored.append((int(n), int(K)))
+            else:
+                val[i, j] = info.holdout_nrmse
             err = _harmonic_response(model, data.omega, Kdata) - Gc
             sse = np.sum(np.abs(err) ** 2)
             mr = 2 * err.size
@@ -230,14 +277,31 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
             aic[i, j] = mr * np.log(max(sse, np.finfo(float).tiny) / mr) + 2 * d
             bar.update(1)
     bar.close()
+    if unscored:
+        warnings.warn(f"the candidates (n_p, K) {unscored} produce output harmonics beyond "
+                      f"the |n| <= {Kdata} of the data and are not scored; give data with "
+                      f"{3 * Kmax + 1} harmonics (or the records)", UserWarning, stacklevel=2)
+    aic[np.isnan(val)] = np.nan
     score = val if criterion == 'validation' else aic
     if np.all(np.isnan(score)):
         raise ValueError("no candidate structure could be identified from the data")
     if criterion == 'validation':
-        # smallest model (n_p first, then K) within 10 % of the best error
-        ok = score <= 1.1 * np.nanmin(score)
+        # smallest model (n_p first, then K) within 10 % of the best error, or below
+        # _TIE (errors a hold's or the data's own imperfection can make)
+        ok = score <= max(1.1 * np.nanmin(score), _TIE)
     else:
         ok = score == np.nanmin(score)
     i, j = np.argwhere(ok)[0]
     return StructureSelection(ns, Ks, val, aic, np.asarray(sv if sv is not None else []),
                               (int(ns[i]), int(Ks[j])), criterion)
+
+
+def _htf_lifted_most(H, period, Kd, K):
+    """The lifted response of the data HTF `H` with the most harmonics (at most `Kd`,
+    at least `K`) known together on its grid."""
+    for k in range(min(Kd, H.nharmonics), K, -1):
+        try:
+            return lifted_frequency_response(H, period, k)
+        except ValueError:
+            continue
+    return lifted_frequency_response(H, period, K)

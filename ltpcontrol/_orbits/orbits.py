@@ -610,7 +610,9 @@ def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, na
     The time-switching model ignores the state dependence of the switching
     instants and the reset maps; its monodromy matrix therefore differs from
     the exact return-map Jacobian `PeriodicOrbit.monodromy` when events
-    have jumps or discontinuous vector fields.
+    have jumps or discontinuous vector fields.  A warning then names both
+    sets of multipliers (relative difference above 1e-4): e.g. an impacting
+    hopper's frozen-event model can be unstable while its orbit is stable.
 
     Parameters
     ----------
@@ -683,7 +685,39 @@ def linearize_orbit(plant, orbit, *, piecewise_constant=False, jacobian=None, na
                     lambda t, tab=tab: tab(np.mod(t, T)), T, shapes[key], check=False)
             else:
                 mats[key] = PeriodicMatrix.switching(tabs, times, T)
-    return ltpss(mats['A'], mats['B'], mats['C'], mats['D'], T,
-                 name=name if name is not None else f'{hp.name}$lin',
-                 inputs=hp.input_labels, outputs=hp.output_labels, states=hp.state_labels)
+    lin = ltpss(mats['A'], mats['B'], mats['C'], mats['D'], T,
+                name=name if name is not None else f'{hp.name}$lin',
+                inputs=hp.input_labels, outputs=hp.output_labels, states=hp.state_labels)
+    if len(orbit.switching_times):
+        _check_frozen_events(lin, orbit)
+    return lin
+
+
+#: relative difference of the multipliers (sorted by modulus) above which the frozen-event
+#: model of a hybrid orbit is reported
+_FROZEN_RTOL = 1e-4
+
+
+def _check_frozen_events(lin, orbit):
+    """Warn when the multipliers of the frozen-event model `lin` differ from the
+    orbit's (its events have resets or state-dependent switching)."""
+    try:
+        model = np.asarray(lin.floquet_multipliers())
+    except (ValueError, np.linalg.LinAlgError):
+        return
+    exact = np.asarray(orbit.multipliers)
+    a = model[np.argsort(-np.abs(model))]
+    b = exact[np.argsort(-np.abs(exact))]
+    if a.size != b.size:
+        return
+    if np.max(np.abs(a - b) / np.maximum(1.0, np.abs(b))) > _FROZEN_RTOL:
+        fmt = ', '.join
+        warnings.warn(
+            f"the linearised model freezes the orbit's {len(orbit.switching_times)} events "
+            f"at their times: its multipliers [{fmt(f'{m:.3g}' for m in a)}] differ from "
+            f"the orbit's [{fmt(f'{m:.3g}' for m in b)}] (the saltation of the resets and "
+            "of the state-dependent switching is not in a time-switching model); its "
+            "stability and designs on it do not carry over to the plant: use the orbit's "
+            "monodromy (PeriodicOrbit.monodromy) or a model with the saltations",
+            UserWarning, stacklevel=3)
 

@@ -60,7 +60,7 @@ def test_periodic_a_model_predicts_in_time_domain():
         errors[K] = cmp.time_nrmse
     assert errors[2] <= 1e-2 and errors[3] <= 2 * errors[2]
     partial, info = _identify(plant, 3, 3)
-    assert 'not fitted' in info.message
+    assert 'neither fitted nor validated' in info.message
     assert ltp.compare_ltp(partial, plant, LINES[:20], signal='noise').time_nrmse > errors[3]
 
 
