@@ -132,8 +132,9 @@ def identify(data, transient, lines):
     data = (t, np.asarray(u)[np.newaxis], np.asarray(y)[np.newaxis])  # experiments of one channel
     with warnings.catch_warnings():
         warnings.filterwarnings('ignore', message='.*refit did not converge')
+        # the records sample a continuous input: first-order hold between samples
         return ltp.identify_ltp(data, PERIOD, NSTATES, NHARMONICS, transient=transient,
-                                return_info=True,
+                                input_hold='foh', return_info=True,
                                 frequencies=lines, estimate_d=False, refine='ml',
                                 refine_options={'harmonics': (NHARMONICS, NHARMONICS, 0)},
                                 name='vhop_identified')

@@ -296,7 +296,8 @@ def ltp_models(exc, u, y, f1, nharmonics):
 
     The ML data are the unregularised 21-component estimate (α = 0: its
     errors are independent with the reported std).  `select_structure`
-    picks the order n_p on its lifted response with `nharmonics` harmonics;
+    picks the order n_p on it among the candidates whose produced harmonics
+    the HTF holds; the model keeps the `nharmonics` significant harmonics;
     `identify_ltp` gives the subspace model, `refine_ltp` the ML model on
     all 21 components.
     """
@@ -304,11 +305,14 @@ def ltp_models(exc, u, y, f1, nharmonics):
         # components beyond |k| = 10 alias (see step 5); the noisy refit misses fit_tol
         warnings.simplefilter('ignore')
         H = identify(exc, y, 21, f1, u=u, alpha=0.0)
-        sel = ltp.select_structure(ltp.lifted_frequency_response(H, PERIOD, nharmonics),
-                                   PERIOD, LTP_STATES, nharmonics)
-        sub = ltp.identify_ltp(H, PERIOD, *sel.best, estimate_d=False, name='subspace')
+        # the order n_p from the candidates the HTF validates (every harmonic they
+        # produce, 3K + 1, within its components); the model keeps the K significant
+        # harmonics of the estimate
+        sel = ltp.select_structure(H, PERIOD, LTP_STATES, range(1, nharmonics + 1))
+        sub = ltp.identify_ltp(H, PERIOD, sel.best[0], nharmonics, estimate_d=False,
+                               name='subspace')
     ml, info = ltp.refine_ltp(sub, H, return_info=True, name='ML')
-    return sel.best, sub, ml, info
+    return (sel.best[0], nharmonics), sub, ml, info
 
 
 def model_prediction(model, t, u, nharmonics=PREDICT_HARMONICS):

@@ -104,9 +104,14 @@ def test_identify_ltp_returns_the_refinement():
     H = ltp.HTFData(G + noise, w, true.period, std=H.std)
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')
-        model, info = ltp.identify_ltp(H, true.period, 2, 1, refine='ml', return_info=True)
+        # without held-out lines the refinement is always kept
+        model, info = ltp.identify_ltp(H, true.period, 2, 1, refine='ml', holdout=None,
+                                       return_info=True)
         _, plain = ltp.identify_ltp(H, true.period, 2, 1, return_info=True)
+        _, held = ltp.identify_ltp(H, true.period, 2, 1, refine='ml', return_info=True)
     assert plain.refinement is None
+    # with held-out lines it is kept unless it predicts them worse than its start
+    assert (held.refinement is None) == held.refine_fallback
     ml = info.refinement
     assert isinstance(ml, ltp.RefineInfo) and ml.cov.shape == (ml.x.size,) * 2
     assert np.allclose(coefficients(ml.realize(ml.x)), coefficients(model))

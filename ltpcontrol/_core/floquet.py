@@ -442,6 +442,8 @@ def _log_multipliers(sys, nsteps, grid=None, factors=None):
     """``log|μ_i|`` and ``arg μ_i`` from the periodic Schur form, sorted."""
     if factors is None:
         sys = as_ltp(sys)
+        if nsteps is not None:
+            nsteps = check_positive_int(nsteps, 'nsteps')     # also where A is constant
         mean = None if sys.dt or sys.nstates == 0 else constant_value(fast_form(sys.A))
         if mean is not None:
             # constant to the precision of its data: μ = e^{λT}, λ the eigenvalues of Ā
