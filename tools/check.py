@@ -2,7 +2,8 @@
 
 The checks are independent commands (the test suite, the documentation
 build, ...); they run in parallel, at most as many at a time as the
-machine has cores, longest first.  Each check's output is printed whole
+machine has cores, longest first; the test suite itself is spread over the
+cores by pytest-xdist when it is installed (it is in the ``test`` extra).  Each check's output is printed whole
 when it ends, and the script exits non-zero when any check fails.
 
     python tools/check.py            # every check
@@ -19,14 +20,6 @@ from concurrent.futures import ThreadPoolExecutor, as_completed
 PYTHON = sys.executable
 BIN = os.path.dirname(PYTHON)
 
-#: name -> command (started in this order)
-CHECKS = {
-    'imports': [PYTHON, 'tools/import_graph.py'],
-    'tests': [PYTHON, '-m', 'pytest'],
-    'docs': [os.path.join(BIN, 'sphinx-build'), '-W', '-q', '-b', 'html', 'docs',
-             'docs/_build/html'],
-}
-
 
 def cores():
     """Cores this process may run on."""
@@ -34,6 +27,30 @@ def cores():
         return len(os.sched_getaffinity(0))
     except AttributeError:                                  # not on Linux
         return os.cpu_count() or 1
+
+
+def test_command():
+    """pytest, spread over the cores by pytest-xdist when it is installed.
+
+    Test files are kept whole on one worker (``--dist loadfile``), so that a
+    module's fixtures are computed once; the documentation build shares the
+    cores with the workers.
+    """
+    command = [PYTHON, '-m', 'pytest']
+    try:
+        import xdist  # noqa: F401
+    except ImportError:
+        return command
+    return command + ['-n', str(cores()), '--dist', 'loadfile']
+
+
+#: name -> command (started in this order)
+CHECKS = {
+    'imports': [PYTHON, 'tools/import_graph.py'],
+    'tests': test_command(),
+    'docs': [os.path.join(BIN, 'sphinx-build'), '-W', '-q', '-b', 'html', 'docs',
+             'docs/_build/html'],
+}
 
 
 #: one BLAS thread per check: checks already run side by side on the cores
