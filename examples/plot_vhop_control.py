@@ -140,23 +140,29 @@ def identify(data, transient, lines):
                                 name='vhop_identified')
 
 
+def records(progress=False):
+    """Plant, orbit and the noise-free records of step 1: ``(plant, orbit, (t, u, y),
+    transient, lines)``, the lines one row per band."""
+    plant = vhop_plant()
+    orbit = vhop_orbit(plant)
+    wp = 2 * np.pi / PERIOD
+    excs = [ltp.multisine(('band', b * wp / 2, (b + 1) * wp / 2), PERIOD,
+                          dt=PERIOD / NSAMPLES, **MULTISINE) for b in range(NBANDS)]
+    data = record_experiments(plant, orbit, excs, progress=progress)
+    lines = np.array([exc.frequencies for exc in excs])
+    return plant, orbit, data, MULTISINE['settle'] * PERIOD, lines
+
+
 def run(progress=False):
     """The chain; returns the figures printed by the example."""
     start = time.perf_counter()
-    plant = vhop_plant()
-    orbit = vhop_orbit(plant)
+    plant, orbit, (t, u, y), transient, lines = records(progress)
     dt = PERIOD / NSAMPLES
-    wp = 2 * np.pi / PERIOD
-    excs = [ltp.multisine(('band', b * wp / 2, (b + 1) * wp / 2), PERIOD, dt=dt, **MULTISINE)
-            for b in range(NBANDS)]
-    t, u, y = record_experiments(plant, orbit, excs, progress=progress)
     noisy = with_noise(u, y)
-    transient = MULTISINE['settle'] * PERIOD
     out = {'open': float(np.abs(orbit.multipliers).max()),
            'open multipliers': orbit.multipliers[:2]}
 
     true = ltp.linearize_orbit(plant, orbit)
-    lines = np.array([exc.frequencies for exc in excs])
     models = {}
     for label, data in (('identified', (t, u, y)), ('identified, SNR 12.5', (t, *noisy))):
         models[label], info = identify(data, transient, lines)
@@ -184,8 +190,45 @@ def run(progress=False):
     return out, orbit, (opened, closed), t_push
 
 
+def check(out):
+    """The claims this example shows, on the figures of `run`; raises AssertionError.
+
+    The documentation build runs the example (quick mode), so these claims
+    are checked there.
+    """
+    failed = []
+
+    def claim(ok, text):
+        if not ok:
+            failed.append(text)
+
+    # open loop: the exact return map of the hybrid limit cycle
+    claim(abs(out['open'] - 0.848) <= 1e-3, 'open-loop multiplier 0.848')
+    # the model identified from data has the plant's open-loop multipliers
+    claim(np.allclose(np.sort_complex(out['identified model']),
+                      np.sort_complex(out['open multipliers']), atol=0.01),
+          "the identified model's multipliers are the orbit's within 0.01")
+    # verified on the hybrid plant: LQG on the noise-free model and the band-limited
+    # LQG on both models meet the target and reach at least 80 % of the reduction
+    # of LQG on the true linearization
+    best = out['open'] - out['LQG', 'true linearization']
+    for key in (('LQG', 'identified'), ('band-limited LQG', 'identified'),
+                ('band-limited LQG', 'identified, SNR 12.5')):
+        claim(out[key] <= 0.3 and out['open'] - out[key] >= 0.8 * best,
+              f'{key[0]} on the {key[1]} model meets 0.3 and 80 % of the best reduction')
+    # without the band limit the noisy model's design is far from the target
+    claim(out['LQG', 'identified, SNR 12.5'] > 0.5, 'LQG on the noisy model misses the target')
+    # push recovery is faster in closed loop, with the stated effort bound
+    claim(out['strides closed'] is not None and out['strides open'] is not None
+          and out['strides closed'] < out['strides open'], 'faster push recovery')
+    claim(out['effort'] <= EFFORT_BOUND, f'effort within {EFFORT_BOUND} N')
+    if failed:
+        raise AssertionError('VHOP control claims not met: ' + '; '.join(failed))
+
+
 def main():
     out, orbit, (opened, closed), t_push = run(progress=True)
+    check(out)
     labels = ('identified', 'identified, SNR 12.5', 'true linearization')
     best_true = out['open'] - out['LQG', 'true linearization']
     print(f"dominant Floquet multiplier of the hopping orbit (|μ|), T = {PERIOD} s")
