@@ -12,6 +12,7 @@ import pathlib
 
 import numpy as np
 import pytest
+from scipy.linalg import block_diag
 
 import ltpcontrol as ltp
 from examples.rotor_models import turbine_A, turbine_descriptions, write_lin
@@ -405,24 +406,68 @@ def test_campbell_accepts_averaged_models():
     assert len(pairs) == len(set(pairs))
 
 
-def test_aerodyn_states_blade_by_blade_grouped(tmp_path):
-    # first-order AeroDyn states written blade by blade after the structure:
-    # uncoupled lags of rate 5 1/s become -5 (collective) and -5 ± jΩ (cyclic)
-    Omega, desc = 0.9, turbine_descriptions()
-    ad = [f'AD UA x{j} blade {b}, node 2, rad' for b in (1, 2, 3) for j in (1, 2)]
-    for k in range(6):
-        psi = 2 * np.pi * k / 6
-        A = np.zeros((22, 22))
-        A[:16, :16] = turbine_A(psi / Omega, Omega)
-        A[16:, 16:] = np.diag([-5.0, -7.0] * 3)
-        write_lin(tmp_path / f'ad.{k + 1}.lin', A, Omega, psi, 8.0, desc + ad,
-                  ['blade' in d for d in desc + ad], [2] * 16 + [1] * 6, digits=16)
-    lin = ltp.read_lin(tmp_path)
-    nr, _ = ltp.mbc(lin, 3)
-    assert [nr.state_labels[i].rsplit('_', 1)[1] for i in (16, 18, 20)] == ['0', 'c1', 's1']
-    ev = np.linalg.eigvals(nr.average(method='samples').A)
-    for lam in (-5, -5 + 0.9j, -5 - 0.9j, -7, -7 + 0.9j, -7 - 0.9j):
-        assert np.abs(ev - lam).min() < 1e-10
+# State descriptions as OpenFAST writes them (tests/data/README.md names the sources):
+# AeroDyn's unsteady-aero states (UA model 6, r-test Fake5MW_AeroLin_B3_UA6.1.lin) and its
+# dynamic-inflow states (DBEMT model 3, second order, r-test
+# Fake5MW_AeroLin_B1_UA4_DBEMT3.1.lin), ServoDyn's blade structural controls (OpenFAST
+# ServoDyn SrvD_Init_Jacobian_x, as the nacelle's in r-test StC_test_OC4Semi_Linear_Nac.1.lin)
+UA6 = [f'AD x4 blade {b}, node {j}, -' for b in (1, 2, 3) for j in (2, 3, 4)]
+DBEMT = [f'AD vind ({d}) at blade {b}, node {j}, m/s' for b in (1, 2, 3) for j in (1, 2)
+         for d in ('axial', 'tangential')]
+DBEMT_RATES = [f'AD First time derivative of vind ({d}) at blade {b}, node {j}, m/s/s'
+               for b in (1, 2, 3) for j in (1, 2) for d in ('axial', 'tangential')]
+BSTC = [f'SrvD Blade {b} StC 1 local displacement state {c}' for b in (1, 2, 3)
+        for c in ('X  m', 'Y  m', 'Z  m', 'dX/dt  m/s', 'dY/dt  m/s', 'dZ/dt  m/s')]
+
+
+def _blade_modules(Omega, psi):
+    """Turbine, AeroDyn and ServoDyn blade states: descriptions, orders, blocks of A."""
+    lag = np.diag(-np.tile([5.0, 6.0, 7.0], 3))                     # UA: per node
+    k = np.tile([4.0, 4.0, 9.0, 9.0], 3)                              # DBEMT: per node
+    inflow = np.block([[np.zeros((12, 12)), np.eye(12)],
+                       [-np.diag(k), -0.4 * np.eye(12)]])
+    stc = np.zeros((18, 18))
+    for b in range(3):
+        q = slice(6 * b, 6 * b + 3)
+        r = slice(6 * b + 3, 6 * b + 6)
+        stc[q, r] = np.eye(3)
+        stc[r, q] = -np.diag([2.25, 6.25, 16.0])
+        stc[r, r] = -0.3 * np.eye(3)
+    return [(turbine_descriptions(), [2] * 16, turbine_A(psi / Omega, Omega)),
+            (UA6, [1] * 9, lag), (DBEMT + DBEMT_RATES, [2] * 24, inflow),
+            (BSTC, [2] * 18, stc)]
+
+
+def test_aerodyn_and_servodyn_blade_states_grouped_in_any_module_order(tmp_path):
+    # uncoupled isotropic blade states of eigenvalue μ (blade frame) have μ and μ ± jΩ in
+    # multi-blade coordinates; the turbine's are those of its hand-made multi-blade model
+    Omega, nazimuths = 0.9, 6
+    one_blade = [np.array([-5.0, -6.0, -7.0]),
+                 np.linalg.eigvals(np.block([[np.zeros((4, 4)), np.eye(4)],
+                                             [-np.diag([4.0, 4.0, 9.0, 9.0]), -0.4 * np.eye(4)]])),
+                 np.linalg.eigvals(np.block([[np.zeros((3, 3)), np.eye(3)],
+                                             [-np.diag([2.25, 6.25, 16.0]), -0.3 * np.eye(3)]]))]
+    truth = np.concatenate([np.linalg.eigvals(mbc_turbine(Omega))]
+                           + [mu + 1j * Omega * k for mu in one_blade for k in (-1, 0, 1)])
+    for name, order in (('a', (0, 1, 2, 3)), ('b', (3, 2, 1, 0))):
+        for s in range(nazimuths):
+            psi = 2 * np.pi * s / nazimuths
+            parts = [_blade_modules(Omega, psi)[m] for m in order]
+            desc = sum((p[0] for p in parts), [])
+            write_lin(tmp_path / f'{name}.{s + 1}.lin', block_diag(*[p[2] for p in parts]),
+                      Omega, psi, 8.0, desc, ['blade' in d.lower() for d in desc],
+                      sum((p[1] for p in parts), []), digits=16)
+        lin = ltp.read_lin(str(tmp_path / f'{name}.*.lin'))
+        nr, _ = ltp.mbc(lin, 3)
+        labels = dict(zip(lin.state_descriptions, nr.state_labels))
+        # every blade state is one coordinate of a triplet named after blade 1's state
+        for d in UA6 + DBEMT + DBEMT_RATES + BSTC:
+            b = int(d.split('lade ')[1][0])
+            assert labels[d].endswith(('_0', '_c1', '_s1')[b - 1]), (d, labels[d])
+        ev = np.linalg.eigvals(nr.average(method='samples').A)
+        assert len(ev) == len(truth) == 67
+        assert max(np.abs(truth - lam).min() for lam in ev) < 1e-9
+        assert max(np.abs(ev - lam).min() for lam in truth) < 1e-9
 
 
 def test_tower_azimuths_dropped_and_operating_point_speeds():
