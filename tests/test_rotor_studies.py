@@ -2,9 +2,10 @@
 
 Independent truths: eigenvalues of multi-blade models by numpy (the
 closed form ``√(k - c²/4) ± Ω`` for uncoupled blades), a multi-blade
-transform written out here for three blades, openfast_toolbox's expected
-frequencies, damping ratios and `IdentifyModes` labels on its own files
-(tests/data/README.md), and files written here in OpenFAST's format.
+transform written out by hand for three blades (examples/rotor_models.py),
+openfast_toolbox's expected frequencies, damping ratios and `IdentifyModes`
+labels on its own files (tests/data/README.md), and files written in
+OpenFAST's format.
 """
 
 import csv
@@ -16,7 +17,8 @@ import pytest
 from scipy.linalg import block_diag
 
 import ltpcontrol as ltp
-from examples.rotor_models import turbine_A, turbine_descriptions, write_lin
+from examples.rotor_models import (turbine_A, turbine_descriptions, turbine_mbc_A, write_lin,
+                                   write_turbine_study)
 
 DATA = pathlib.Path(__file__).parent / 'data'
 AB = np.array([[0.0, 1.0], [-4.0, -0.2]])            # one blade's lag: 1.9975 rad/s
@@ -25,28 +27,6 @@ AB = np.array([[0.0, 1.0], [-4.0, -0.2]])            # one blade's lag: 1.9975 r
 def uncoupled_blades():
     return ltp.ltpss(np.kron(AB, np.eye(3)), np.zeros((6, 0)), np.zeros((0, 6)), 0,
                      period=2 * np.pi)
-
-
-def coleman3(psi):
-    """Multi-blade transform of three blades, written out."""
-    b = psi + 2 * np.pi * np.arange(3) / 3
-    return np.column_stack([np.ones(3), np.cos(b), np.sin(b)])
-
-
-def mbc_turbine(Omega, t=0.0):
-    """Multi-blade model of the 16-state turbine, transformed here by hand."""
-    psi = Omega * t
-    T0, T1, T2 = coleman3(psi), np.zeros((3, 3)), np.zeros((3, 3))
-    b = psi + 2 * np.pi * np.arange(3) / 3
-    T1[:, 1:] = np.column_stack([-np.sin(b), np.cos(b)])
-    T2[:, 1:] = np.column_stack([-np.cos(b), -np.sin(b)])
-    P, dP = np.eye(16), np.zeros((16, 16))
-    for q, r in ((slice(2, 5), slice(10, 13)), (slice(5, 8), slice(13, 16))):
-        P[q, q] = P[r, r] = T0
-        P[r, q] = Omega * T1
-        dP[q, q] = dP[r, r] = Omega * T1
-        dP[r, q] = Omega ** 2 * T2
-    return np.linalg.solve(P, turbine_A(t, Omega) @ P - dP)
 
 
 #
@@ -85,7 +65,7 @@ def test_periodic_rotor_repeated_multipliers_split_by_harmonic_content():
     Pinv = ltp.PeriodicMatrix.from_function(lambda t: np.linalg.inv(P(t)), P.period,
                                             (16, 16))
     modes = ltp.floquet_modes(rot, frame=Pinv)
-    truth = np.linalg.eigvals(mbc_turbine(Omega))
+    truth = np.linalg.eigvals(turbine_mbc_A(Omega))
     gap = [np.abs(truth - lam).min() for lam in modes.exponents]
     assert max(gap) < 1e-8 * np.abs(truth).max()
     assert np.all(modes.participation.max(axis=1) > 1 - 1e-8)
@@ -120,7 +100,7 @@ def test_constant_path_detects_time_invariance_to_data_precision(tmp_path):
     assert not nr.A.is_constant                       # rounding: not exactly constant
     modes = ltp.floquet_modes(nr)
     assert np.all(modes.participation.max(axis=1) == pytest.approx(1, abs=1e-12))
-    truth = np.linalg.eigvals(mbc_turbine(Omega))
+    truth = np.linalg.eigvals(turbine_mbc_A(Omega))
     assert max(np.abs(truth - lam).min() for lam in modes.exponents) < 1e-7
 
 
@@ -150,7 +130,7 @@ def test_isotropic_turbine_flap_tracks_keep_their_shape():
     for j in range(16):
         assert len({labels[k][cd.indices[k, j]] for k in range(len(speeds))}) == 1
     for k, Om in enumerate(speeds):
-        truth = np.linalg.eigvals(mbc_turbine(Om))
+        truth = np.linalg.eigvals(turbine_mbc_A(Om))
         assert max(np.abs(truth - lam).min() for lam in cd.exponents[k]) < 1e-9
     names = {labels[0][cd.indices[0, j]] for j in flap}
     assert names == {'1st flap BW', '1st flap collective', '1st flap FW'}
@@ -232,7 +212,7 @@ def test_any_module_order_gives_the_same_multiblade_model(tmp_path):
     b = ltp.mbc(ltp.read_lin(str(tmp_path / 'b.*.lin')), 3)[0]
     ea = np.linalg.eigvals(a.average(method='samples').A)
     eb = np.linalg.eigvals(b.average(method='samples').A)
-    truth = np.linalg.eigvals(mbc_turbine(Omega))
+    truth = np.linalg.eigvals(turbine_mbc_A(Omega))
     assert max(np.abs(ea - lam).min() for lam in eb) < 1e-10
     assert max(np.abs(truth - lam).min() for lam in ea) < 1e-9
 
@@ -383,29 +363,17 @@ def test_mode_labels_equal_identify_modes_of_the_toolbox():
     assert agree == 31                                   # of 37 labelled by both
 
 
-def write_study(root, speeds, winds, nazimuths=36):
-    """A folder per operating point of the 16-state turbine, one file per azimuth."""
-    desc = turbine_descriptions()
-    for Omega, wind in zip(speeds, winds):
-        folder = root / f'ws{wind:04.1f}'
-        folder.mkdir()
-        for k in range(nazimuths):
-            psi = 2 * np.pi * k / nazimuths
-            write_lin(folder / f'Main.{k + 1}.lin', turbine_A(psi / Omega, Omega), Omega,
-                      psi, wind, desc, ['blade' in d for d in desc], [2] * 16)
-
-
 def test_campbell_of_a_folder_tree_exported_and_reloaded(tmp_path):
     speeds = np.array([1.2, 0.6, 0.8, 1.0, 1.3, 1.25])       # rpm 5.7 .. 12.4
     winds = np.array([11.0, 4.0, 6.0, 8.0, 14.0, 12.5])
-    write_study(tmp_path, speeds, winds)
+    write_turbine_study(tmp_path, speeds, winds)
     cd = ltp.campbell_lin(tmp_path, x='rotor_speed')
     order = np.argsort(speeds)
     assert np.allclose(cd.values, speeds[order]) and np.allclose(cd.wind_speed, winds[order])
     assert cd.frame == 'multiblade'
     # frequencies: the hand-made multi-blade model's eigenvalues
     for k, Om in enumerate(cd.values):
-        truth = np.linalg.eigvals(mbc_turbine(Om))
+        truth = np.linalg.eigvals(turbine_mbc_A(Om))
         assert max(np.abs(truth - lam).min() for lam in cd.exponents[k]) < 1e-7
     upper = [k for k in range(16) if np.mean(cd.damped_frequency[:, k] >= 0) >= 0.5]
     assert {cd.labels[j] for j in upper} == {
@@ -449,14 +417,14 @@ def test_campbell_of_a_folder_tree_exported_and_reloaded(tmp_path):
 
 
 def test_campbell_of_files_by_floquet_equals_averaging(tmp_path):
-    write_study(tmp_path, [0.7, 1.1], [5.0, 9.0])
+    write_turbine_study(tmp_path, [0.7, 1.1], [5.0, 9.0])
     avg = ltp.campbell_lin(tmp_path)
     flo = ltp.campbell_lin(tmp_path, method='floquet')
     assert avg.xlabel == 'wind speed [m/s]'
     for k in range(2):
         assert max(np.abs(avg.exponents[k] - lam).min() for lam in flo.exponents[k]) < 1e-7
     with pytest.raises(ValueError, match="same rotor_speed"):
-        ltp.campbell_lin([sorted((tmp_path / 'ws05.0').glob('*.lin'))] * 2,
+        ltp.campbell_lin([sorted(next(tmp_path.glob('ws05.0*')).glob('*.lin'))] * 2,
                          x='rotor_speed')
 
 
@@ -517,7 +485,7 @@ def test_aerodyn_and_servodyn_blade_states_grouped_in_any_module_order(tmp_path)
                                              [-np.diag([4.0, 4.0, 9.0, 9.0]), -0.4 * np.eye(4)]])),
                  np.linalg.eigvals(np.block([[np.zeros((3, 3)), np.eye(3)],
                                              [-np.diag([2.25, 6.25, 16.0]), -0.3 * np.eye(3)]]))]
-    truth = np.concatenate([np.linalg.eigvals(mbc_turbine(Omega))]
+    truth = np.concatenate([np.linalg.eigvals(turbine_mbc_A(Omega))]
                            + [mu + 1j * Omega * k for mu in one_blade for k in (-1, 0, 1)])
     for name, order in (('a', (0, 1, 2, 3)), ('b', (3, 2, 1, 0))):
         for s in range(nazimuths):
