@@ -23,7 +23,7 @@ import numpy as np
 __all__ = ['blade_key', 'infer_blade_groups', 'check_groups', 'derivative_orders']
 
 # where a description names its blade (the first pattern that matches)
-_BLADE = [re.compile(p) for p in (r'[Bb]lade\s*(\d+)', r'\bBD_(\d+)\b', r'\bB(\d+)N\d',
+_BLADE = [re.compile(p) for p in (r'[Bb]lade\s*(\d+)', r'\bBD_(\d+)\b', r'\bA?B(\d+)N\d',
                                   r'\bBld(\d+)', r'\bBStC(\d+)', r'PitchBearing(\d+)',
                                   r'\bB(\d+)(?=[A-Z_ ])', r'(\d)(?=\D*$)')]
 _INTERNAL = re.compile(r'\s*\(internal DOF index = [^()]*(?:\([^()]*\))?[^()]*\)')
@@ -55,6 +55,10 @@ def blade_key(text, loose=True):
     >>> blade_key('BD_3 First time derivative of finite element node 2 rotational '
     ...           'displacement in X, rad/s')
     ('d/dt BD_# finite element node 2 rotational displacement in X', 3)
+    >>> blade_key('AD AB2N001UA_Flag, (-)')                # an AeroDyn output
+    ('AD AB#N001UA_Flag', 2)
+    >>> blade_key('SrvD Blade 3 StC 1 local displacement state dY/dt  m/s')
+    ('d/dt SrvD Blade # StC 1 local displacement state Y', 3)
     """
     rate, text = _rate_free(_INTERNAL.sub('', text))
     text = _UNIT.sub('', text).strip()
