@@ -32,7 +32,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import ltpcontrol as ltp  # noqa: E402
-from rotor_models import turbine_A, turbine_descriptions, write_lin  # noqa: E402
+from rotor_models import write_turbine_study  # noqa: E402
 
 QUICK = os.environ.get('LTP_EXAMPLES_QUICK') == '1'
 
@@ -41,16 +41,7 @@ QUICK = os.environ.get('LTP_EXAMPLES_QUICK') == '1'
 # wind), 36 azimuths each.
 winds = np.array([5.0, 6.5, 8.0, 9.5, 11.0, 12.5])
 speeds = np.round(np.linspace(6.0, 12.0, len(winds)) * np.pi / 30, 4)   # rad/s
-desc = turbine_descriptions()
-rotating = ['blade' in d for d in desc]
-root = pathlib.Path(tempfile.mkdtemp())
-for wind, Omega in zip(winds, speeds):
-    folder = root / f'ws{wind:04.1f}'
-    folder.mkdir()
-    for k in range(36):
-        psi = 2 * np.pi * k / 36
-        write_lin(folder / f'Turbine.{k + 1}.lin', turbine_A(psi / Omega, Omega), Omega, psi,
-                  wind, desc, rotating, [2] * 16)
+root = write_turbine_study(pathlib.Path(tempfile.mkdtemp()), speeds, winds)
 print(f"{len(list(root.rglob('*.lin')))} files in {len(winds)} folders")
 
 # %%

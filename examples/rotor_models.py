@@ -98,6 +98,46 @@ def turbine_A(t, Omega, data=TURBINE):
                      [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
 
 
+def turbine_mbc_A(Omega, t=0.0, data=TURBINE):
+    """The turbine's state matrix in multi-blade coordinates, transformed by hand.
+
+    ``x = P(ψ) z`` with the three-blade transform ``[1, cos ψ_b, sin ψ_b]``
+    written out (and its derivatives ``Ω T1``, ``Ω² T2`` for the rates):
+    ``A_NR = P⁻¹ (A P - Ṗ)``; constant in time for this isotropic rotor.
+    """
+    psi = Omega * t + 2 * np.pi * np.arange(3) / 3
+    T0 = np.column_stack([np.ones(3), np.cos(psi), np.sin(psi)])
+    T1 = np.column_stack([np.zeros(3), -np.sin(psi), np.cos(psi)])
+    T2 = np.column_stack([np.zeros(3), -np.cos(psi), -np.sin(psi)])
+    P, dP = np.eye(16), np.zeros((16, 16))
+    for q, r in ((slice(2, 5), slice(10, 13)), (slice(5, 8), slice(13, 16))):
+        P[q, q] = P[r, r] = T0
+        P[r, q] = Omega * T1
+        dP[q, q] = dP[r, r] = Omega * T1
+        dP[r, q] = Omega ** 2 * T2
+    return np.linalg.solve(P, turbine_A(t, Omega, data) @ P - dP)
+
+
+def write_turbine_study(root, speeds, winds=None, nazimuths=36, digits=10):
+    """The turbine's ``.lin`` files: a folder per operating point, a file per azimuth.
+
+    Folder ``wsWW.W_rpmRR.RR`` for rotor speed Ω (rad/s) and wind speed
+    (8 m/s when `winds` is None), files ``Main.1.lin`` ... at azimuths
+    ``2πk/nazimuths``, printed with `digits` significant digits.
+    """
+    desc = turbine_descriptions()
+    rotating = ['blade' in d for d in desc]
+    winds = np.full(len(speeds), 8.0) if winds is None else winds
+    for Omega, wind in zip(speeds, winds):
+        folder = root / f'ws{wind:04.1f}_rpm{Omega * 30 / np.pi:05.2f}'
+        folder.mkdir()
+        for k in range(nazimuths):
+            psi = 2 * np.pi * k / nazimuths
+            write_lin(folder / f'Main.{k + 1}.lin', turbine_A(psi / Omega, Omega), Omega, psi,
+                      wind, desc, rotating, [2] * 16, digits=digits)
+    return root
+
+
 def write_lin(path, A, rotor_speed, azimuth, wind_speed, descriptions, rotating, orders,
               digits=10):
     """Write a state matrix as an OpenFAST ``.lin`` file (no inputs or outputs)."""

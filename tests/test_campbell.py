@@ -44,7 +44,7 @@ def test_tracks_follow_mode_shapes_through_a_crossing():
 @pytest.mark.slow
 def test_hammond_campbell_sweep_in_parallel():
     speeds = np.linspace(5.0, 40.0, 31)
-    cd = ltp.campbell(hammond_mbc_model, speeds, n_jobs=2, per_rev=(1,))
+    cd = ltp.campbell(hammond_mbc_model, speeds, n_jobs=1, per_rev=(1,))
     step = speeds[1] - speeds[0]
     for k, Omega in enumerate(speeds):
         lti = np.linalg.eigvals(mbc_by_hand(Omega, 0.0))
@@ -68,9 +68,11 @@ def test_hammond_campbell_sweep_in_parallel():
             return np.abs(lam) - n * Omega
         exact = brentq(g, speeds[k], speeds[k + 1], xtol=1e-10)
         assert abs(exact - value) <= step
-    # serial and parallel sweeps agree
-    serial = ltp.campbell(hammond_mbc_model, speeds[:4], n_jobs=1)
-    assert np.allclose(serial.frequency, cd.frequency[:4])
+    # parallel workers (loky processes; starting them dominates the cost) give the
+    # serial sweep's tracks
+    parallel = ltp.campbell(hammond_mbc_model, speeds[:4], n_jobs=2, per_rev=(1,))
+    assert np.allclose(parallel.frequency, cd.frequency[:4])
+    assert np.array_equal(parallel.indices, cd.indices[:4])
 
 
 def test_campbell_rejects_bad_input():

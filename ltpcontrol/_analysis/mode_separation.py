@@ -216,7 +216,32 @@ def separate_clusters(strip, on_samples, left, coeffs, harmonics, groups):
 
 
 def warn_ambiguous(ambiguous, strip, stacklevel=3):
-    """One warning naming the clusters the harmonic content cannot split."""
+    """One warning naming the clusters the harmonic content cannot split.
+
+    Parameters
+    ----------
+    ambiguous : list of (list of int, ndarray)
+        The clusters `separate_clusters` could not split: the indices of
+        their modes and the modes' mean harmonics.
+    strip : ndarray of complex
+        Exponents of all modes (the cluster's first one is printed).
+    stacklevel : int
+        Of the warning (the caller of the public function).
+
+    Examples
+    --------
+    >>> import warnings
+    >>> from ltpcontrol._analysis.mode_separation import warn_ambiguous
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter('always')
+    ...     warn_ambiguous([([0, 1], np.array([0.49, 0.51]))], np.array([-0.1 + 2j, -0.1 + 2j]))
+    >>> message = str(caught[0].message)
+    >>> message.startswith('repeated multipliers whose modes cannot be separated')
+    True
+    >>> message.split('content: ')[1].split(')')[0]
+    '2 modes at exponent -0.1+2j (mean harmonics [0.49, 0.51]'
+    >>> warn_ambiguous([], np.array([]))          # nothing to report: no warning
+    """
     if not ambiguous:
         return
     parts = [f"{len(modes)} modes at exponent {strip[modes[0]]:.4g} (mean harmonics "

@@ -4,13 +4,16 @@ OpenFAST names every blade quantity with its blade number, in a form that
 depends on the module: ElastoDyn ``1st flapwise bending-mode DOF of blade 2
 (internal DOF index = DOF_BF(2,1)), m``, BeamDyn ``BD_2 finite element node
 3 ... translational displacement in X, m``, AeroDyn's blade-node states
-``... blade 2, node 5 ...`` or ``B2N005...``, ServoDyn's blade structural
-controls ``... blade 2 ...``.  Descriptions that agree once the blade
-number is removed form one group of N blades, ordered by blade number
-whatever the order of the modules and of their states.  A second-order
-degree of freedom appears twice: its displacement and its rate, whose
-description is ``First time derivative of`` the displacement's (the unit
-gets ``/s``); rates are paired with their displacements by description.
+``AD x4 blade 2, node 3, -`` (unsteady aerodynamics), ``AD vind (axial) at
+blade 2, node 1, m/s`` (dynamic inflow) or ``B2N005...``, ServoDyn's blade
+structural controls ``SrvD Blade 2 StC 1 local displacement state X  m``.
+Descriptions that agree once the blade number is removed form one group of
+N blades, ordered by blade number whatever the order of the modules and of
+their states.  A second-order degree of freedom appears twice: its
+displacement and its rate, whose description is ``First time derivative
+of`` the displacement's (the unit gets ``/s``), or for ServoDyn's
+structural controls the displacement's with ``dX/dt`` for ``X``; rates are
+paired with their displacements by description.
 """
 
 import re
@@ -20,12 +23,19 @@ import numpy as np
 __all__ = ['blade_key', 'infer_blade_groups', 'check_groups', 'derivative_orders']
 
 # where a description names its blade (the first pattern that matches)
-_BLADE = [re.compile(p) for p in (r'[Bb]lade\s*(\d+)', r'\bBD_(\d+)\b', r'\bB(\d+)N\d',
+_BLADE = [re.compile(p) for p in (r'[Bb]lade\s*(\d+)', r'\bBD_(\d+)\b', r'\bA?B(\d+)N\d',
                                   r'\bBld(\d+)', r'\bBStC(\d+)', r'PitchBearing(\d+)',
                                   r'\bB(\d+)(?=[A-Z_ ])', r'(\d)(?=\D*$)')]
 _INTERNAL = re.compile(r'\s*\(internal DOF index = [^()]*(?:\([^()]*\))?[^()]*\)')
 _RATE = re.compile(r'First time derivative of\s+', re.I)
-_UNIT = re.compile(r',\s*[^,]*$')
+_STC_RATE = re.compile(r'\bd([XYZ])/dt\b')        # ServoDyn StC: 'state dX/dt  m/s'
+_UNIT = re.compile(r'(?:,\s*[^,]*|\s{2,}\S+)$')     # ', m' or (StC) '  m'
+
+
+def _rate_free(text):
+    """``(is_rate, text)``: the description of the displacement a rate is of."""
+    rate = bool(_RATE.search(text)) or bool(_STC_RATE.search(text))
+    return rate, _STC_RATE.sub(r'\1', _RATE.sub('', text))
 
 
 def blade_key(text, loose=True):
@@ -45,10 +55,13 @@ def blade_key(text, loose=True):
     >>> blade_key('BD_3 First time derivative of finite element node 2 rotational '
     ...           'displacement in X, rad/s')
     ('d/dt BD_# finite element node 2 rotational displacement in X', 3)
+    >>> blade_key('AD AB2N001UA_Flag, (-)')                # an AeroDyn output
+    ('AD AB#N001UA_Flag', 2)
+    >>> blade_key('SrvD Blade 3 StC 1 local displacement state dY/dt  m/s')
+    ('d/dt SrvD Blade # StC 1 local displacement state Y', 3)
     """
-    text = _INTERNAL.sub('', text)
-    rate = bool(_RATE.search(text))
-    text = _UNIT.sub('', _RATE.sub('', text)).strip()
+    rate, text = _rate_free(_INTERNAL.sub('', text))
+    text = _UNIT.sub('', text).strip()
     for pattern in _BLADE if loose else _BLADE[:-1]:
         m = pattern.search(text)
         if m:
@@ -150,8 +163,8 @@ def derivative_orders(descriptions):
     >>> derivative_orders(['ED tower, m', 'HD x1', 'ED First time derivative of tower, m/s'])
     array([2, 1, 2])
     """
-    keys = [(bool(_RATE.search(d)), _UNIT.sub('', _RATE.sub('', _INTERNAL.sub('', d))).strip())
-            for d in descriptions]
+    keys = [(r, _UNIT.sub('', t).strip())
+            for r, t in (_rate_free(_INTERNAL.sub('', d)) for d in descriptions)]
     rates = {k for r, k in keys if r}
     disps = {k for r, k in keys if not r}
     return np.array([2 if (k in rates and k in disps) else 1 for _, k in keys], int)

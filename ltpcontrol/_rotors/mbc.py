@@ -224,6 +224,10 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
     speed = _speed(rotor_speed, T)
 
     w = _coleman_weights(N)
+    # index blocks of every group, built once: (g, g), and for rates (r, r), (r, g)
+    blocks = [(np.ix_(g, g), None if r is None else (np.ix_(r, r), np.ix_(r, g)))
+              for g, r in zip(groups, rate_groups)]
+    in_blocks, out_blocks = [np.ix_(g, g) for g in in_groups], [np.ix_(g, g) for g in out_groups]
 
     def state_transform(omega, domega, psi):
         """𝒯, 𝒯⁻¹ and 𝒯̇ at one instant (T⁻¹ = diag(w) Tᵀ)."""
@@ -231,23 +235,24 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
         T0 = coleman_matrix(psi, N)
         T0inv = w[:, None] * T0.T
         T1, T2 = coleman_matrix(psi, N, 1), coleman_matrix(psi, N, 2)
-        for g, r in zip(groups, rate_groups):
-            P[np.ix_(g, g)], Pinv[np.ix_(g, g)] = T0, T0inv
-            dP[np.ix_(g, g)] = omega * T1
-            if r is not None:
-                # [[T, 0], [Ω T', T]]⁻¹ = [[T⁻¹, 0], [-Ω T⁻¹ T' T⁻¹, T⁻¹]]
-                P[np.ix_(r, r)], Pinv[np.ix_(r, r)] = T0, T0inv
-                P[np.ix_(r, g)] = omega * T1
-                Pinv[np.ix_(r, g)] = -omega * T0inv @ T1 @ T0inv
-                dP[np.ix_(r, r)] = omega * T1
-                dP[np.ix_(r, g)] = omega ** 2 * T2 + domega * T1
+        # [[T, 0], [Ω T', T]]⁻¹ = [[T⁻¹, 0], [-Ω T⁻¹ T' T⁻¹, T⁻¹]]
+        lower, lower_inv = omega * T1, -omega * T0inv @ T1 @ T0inv
+        second = omega ** 2 * T2 + domega * T1
+        for gg, rates_ in blocks:
+            P[gg], Pinv[gg], dP[gg] = T0, T0inv, lower
+            if rates_ is not None:
+                rr, rg = rates_
+                P[rr], Pinv[rr], dP[rr] = T0, T0inv, lower
+                P[rg], Pinv[rg], dP[rg] = lower, lower_inv, second
         return P, Pinv, dP
 
-    def signal_transform(size, sgroups, psi):
+    def signal_transform(size, sblocks, psi):
         P, Pinv = np.eye(size), np.eye(size)
-        T0 = coleman_matrix(psi, N)
-        for g in sgroups:
-            P[np.ix_(g, g)], Pinv[np.ix_(g, g)] = T0, w[:, None] * T0.T
+        if sblocks:
+            T0 = coleman_matrix(psi, N)
+            T0inv = w[:, None] * T0.T
+            for gg in sblocks:
+                P[gg], Pinv[gg] = T0, T0inv
         return P, Pinv
 
     def transformed(t, mats, which=(0, 1, 2, 3), at_speed=None):
@@ -256,8 +261,8 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
         if at_speed is not None:
             omega, domega = at_speed
         P, Pinv, dP = state_transform(omega, domega, psi)
-        (Pu, Puinv), (Py, Pyinv) = signal_transform(m, in_groups, psi), \
-            signal_transform(p, out_groups, psi)
+        (Pu, Puinv), (Py, Pyinv) = signal_transform(m, in_blocks, psi), \
+            signal_transform(p, out_blocks, psi)
         if inverse:
             # z = 𝒯⁻¹ x: the forward formulas with 𝒯⁻¹, d(𝒯⁻¹)/dt = -𝒯⁻¹ 𝒯̇ 𝒯⁻¹
             P, Pinv, dP = Pinv, P, -Pinv @ dP @ Pinv
@@ -290,8 +295,9 @@ def mbc(sys, rotating=None, nblades=3, *, rates=None, rotating_inputs=None,
         # (at 33 irregular instants: a trigonometric polynomial of degree <= 16
         # that takes one value at all of them is constant)
         probe = T * np.mod(0.1234 + 0.6180339887 * np.arange(33), 1.0)
+        at_probe = [transformed(t, (sys.A, sys.B, sys.C, sys.D)) for t in probe]
         for j, M in enumerate(mats):
-            vals = np.array([M(t) for t in probe])
+            vals = np.array([out[j] for out in at_probe])
             if np.all(np.abs(vals - vals[0]) <= 1e-13 * max(1.0, np.abs(vals).max(initial=0.0))):
                 mats[j] = PeriodicMatrix.constant(vals[0], T)
     samples = None

@@ -13,6 +13,23 @@ share, otherwise a whirl, *forward* (FW) when the cyclic pair
 ``(a_c, a_s)`` of a mode ``e^{λt}`` with ``Im λ > 0`` turns with the rotor
 (``a_s = -j a_c``), *backward* (BW) when against it (``a_s = j a_c``), and
 *cyclic* when it does not turn (a standing mode, e.g. at standstill).
+
+Compared with openfast_toolbox's ``IdentifyModes``: that routine looks at
+the magnitudes of the displacement and first-order entries of unit-norm
+eigenvectors, takes for each state the mode where its magnitude peaks,
+names a mode after such a state (in the order of its list of names when
+several peak there, each name once), and guesses from the largest entries
+when no state peaks at a mode; cyclic modes are "regressive" and
+"progressive" in order of frequency.  Where a single state clearly
+dominates both rules agree (31 of the 37 modes it names on its test files
+Standstill_ForID_ED, StandstillSemi_ForID_EDHD and the rotating NREL 5 MW
+files, with BW/FW for its regressive/progressive).  They differ on purpose
+where its measure misleads: eigenvector magnitudes depend on the states'
+units and favour low frequencies (a HydroDyn radiation mode is named a
+flap mode, tower modes flap and edge modes), and list order or a guess
+decides (a drivetrain mode is named edge-collective and the reverse).
+There the participation factors name the degree of freedom whose stiffness
+the frequency depends on most.
 """
 
 import re

@@ -277,7 +277,7 @@ def _parse(path, overflow):
     shapes = {'A': (n, n), 'B': (n, nu), 'C': (ny, n), 'D': (ny, nu)}
     # relative precision of the printed entries (half a unit of the last digit)
     digits = [len(re.sub(r'\D', '', t.split('E')[0].split('e')[0]).lstrip('0') or '0')
-              for t in text_digits(lines, 40)]
+              for t in _text_digits(lines, 40)]
     out['precision'] = 0.5 * 10.0 ** (1 - max(1, min(digits))) if digits else np.nan
     for key, shape in shapes.items():
         M = mats.get(key, np.zeros(shape))
@@ -329,7 +329,7 @@ def _orders(rows):
     return order
 
 
-def text_digits(lines, count):
+def _text_digits(lines, count):
     """Up to `count` mantissa strings of nonzero entries of the matrix A."""
     out = []
     for i, ln in enumerate(lines):
