@@ -36,9 +36,8 @@ import warnings
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from .loop import LoopHTF, as_loop, fold, open_loop_exponents
+from .loop import LoopHTF, as_loop, fold, loop_exponents, open_loop_exponents
 from .nyquist import track
-from .._core.floquet import is_stable
 from .._core.ltpsys import feedback, series
 from .._core.validation import check_positive_int
 from .._core.wellposed import ill_posed_gains
@@ -203,10 +202,12 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
         Warn when the outermost harmonic blocks of ``L̂_N`` reach this
         magnitude: crossings beyond the truncation may be missed.
     check : bool
-        When the closed loop is stable, verify the gain margins by the
-        Floquet multipliers of the closed loops with the gains 0.1 % inside
-        (stable) and outside (unstable) them, and warn otherwise (a
-        crossing between grid points missed: raise `omega_num`).
+        Verify the gain margins by the Floquet exponents of the closed
+        loops with the gains 0.1 % beyond them (one Floquet computation
+        per finite margin): the exponents in the right half plane must be
+        those that crossed the axis at the margin's frequency; otherwise,
+        if the closed loop itself is stable (one more computation), warn
+        (a crossing between grid points missed: raise `omega_num`).
     floquet_steps : int, optional
         Steps per period of every Floquet computation (`monodromy`'s
         `nsteps`; default: its own choice).
@@ -311,7 +312,7 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     disk = peak._replace(value=alpha)
     dgain, dphase = _disk_gain_phase(alpha, skew)
     if check:
-        _verify(L, upper.value, lower.value, k_lo, k_hi, nsteps=nsteps)
+        _verify(L, upper, lower, k_lo, k_hi, nsteps=nsteps)
     return HarmonicMargins(gain_upper=upper, gain_lower=lower, phase=phase,
                            stability=stability, disk=disk, disk_gain=dgain,
                            disk_phase=dphase, gain_crossings=gains,
@@ -499,31 +500,54 @@ def _disk_gain_phase(alpha, skew):
 
 
 def _verify(L, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3, nsteps=None):
-    """Floquet check of the gain margins of a loop whose closed loop is stable
-    (not beyond a margin set by an ill-posed gain)."""
-    eye = np.eye(L.ninputs)
+    """Floquet check of the gain margins (MarginPoints `upper`, `lower`).
 
-    def stable(k):
+    Just beyond a margin k (gain ``k(1 ± δ)``) the closed loop's exponents in
+    the right half plane must be the ones that crossed the axis at the
+    margin's frequency ω (modulo ω_p, and -ω for the conjugate): none means
+    no crossing there, others an exponent that crossed at a smaller gain
+    (a crossing missed between grid points).  A margin set by an ill-posed
+    gain is checked from inside (no exponent in the right half plane).  So
+    each finite margin costs one Floquet computation; only when a check
+    fails is the closed loop itself computed, and the warning given when it
+    is stable (the margins of an unstable closed loop are not margins).
+    """
+    eye = np.eye(L.ninputs)
+    wp = L.omega_p
+    atol = 1e-9 * wp
+
+    def unstable(k):
         with warnings.catch_warnings():
             # only the verdict is used, 0.1 % away from the boundary
             warnings.filterwarnings('ignore', message='product_eigenvalues')
-            return is_stable(feedback(series(L, k * eye), eye), nsteps=nsteps)
-    if not stable(1.0):
-        return
+            lam = loop_exponents(feedback(series(L, k * eye), eye), nsteps)
+        return lam[lam.real > atol]
+
+    def explained(lam, w):
+        # within the motion of the crossing exponent over the gain step δ
+        tol = 1e-2 * wp + 100 * lam.real
+        return np.minimum(np.abs(fold(lam.imag - w, wp)),
+                          np.abs(fold(lam.imag + w, wp))) <= tol
+
     bad = []
-    if np.isfinite(upper):
-        pairs = ((upper * (1 - delta), True),) + (
-            ((upper * (1 + delta), False),) if upper < k_hi else ())
-        bad += [k for k, want in pairs if stable(k) != want]
-    if lower > 0:
-        pairs = ((lower * (1 + delta), True),) + (
-            ((lower * (1 - delta), False),) if lower > k_lo else ())
-        bad += [k for k, want in pairs if stable(k) != want]
-    if bad:
-        warnings.warn(f"harmonic_margins: the Floquet multipliers of the closed loop with "
-                      f"the gains {bad} contradict the gain margins ({lower:.6g}, "
-                      f"{upper:.6g}): a crossing was missed between grid points; increase "
-                      "omega_num", UserWarning, stacklevel=3)
+    for m, step in ((upper, 1 + delta), (lower, 1 - delta)):
+        if not (np.isfinite(m.value) and m.value > 0):
+            continue
+        beyond = m.value * step
+        if m.frequency == np.inf or not k_lo < beyond < k_hi:
+            # a margin set by an ill-posed gain: just inside must be stable
+            k = m.value / step
+            if unstable(k).size:
+                bad.append(k)
+            continue
+        lam = unstable(beyond)
+        if not lam.size or not np.all(explained(lam, m.omega)):
+            bad.append(beyond)
+    if bad and not unstable(1.0).size:
+        warnings.warn(f"harmonic_margins: the Floquet exponents of the closed loop with "
+                      f"the gains {bad} contradict the gain margins ({lower.value:.6g}, "
+                      f"{upper.value:.6g}): a crossing was missed between grid points; "
+                      "increase omega_num", UserWarning, stacklevel=3)
 
 
 def _check_edge(loop, Lh, tol):
