@@ -298,14 +298,15 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     if k_lo > lower.value:
         lower = MarginPoint(k_lo, float('nan'), 0, float('inf'))
     phase = min(phases, key=lambda p: abs(p.value)) if phases else _NONE
+    eye = np.eye(loop.size)
     stability = _extremum(loop, w, Lh, lambda M: np.linalg.svd(
-        np.eye(len(M)) + M, compute_uv=False)[-1], 'min')
+        eye + M, compute_uv=False)[..., -1], 'min')
     offset = 0.5 * (skew - 1)
 
     def balanced(M):
-        # σ_max of S + (σ - 1)/2 I with S = (I + L̂)^{-1}
-        S = np.linalg.inv(np.eye(len(M)) + M)
-        return np.linalg.svd(S + offset * np.eye(len(M)), compute_uv=False)[0]
+        # σ_max of S + (σ - 1)/2 I with S = (I + L̂)^{-1}, at a stack of points
+        S = np.linalg.inv(eye + M)
+        return np.linalg.svd(S + offset * eye, compute_uv=False)[..., 0]
 
     peak = _extremum(loop, w, Lh, balanced, 'max')
     alpha = 1 / peak.value
@@ -468,9 +469,10 @@ def _unique(points, wp):
 
 
 def _extremum(loop, w, Lh, fun, kind):
-    """Refined min (or max) of fun(L̂(jω)) over the grid, as a MarginPoint."""
+    """Refined min (or max) of fun(L̂(jω)) over the grid, as a MarginPoint
+    (`fun` maps a stack of matrices to their values)."""
     sign = 1.0 if kind == 'min' else -1.0
-    vals = np.array([fun(M) for M in Lh])
+    vals = fun(Lh)
     i = int(np.argmin(sign * vals))
     lo, hi = w[max(i - 1, 0)], w[min(i + 1, len(w) - 1)]
     res = minimize_scalar(lambda x: sign * fun(loop(1j * x)[0]), bounds=(lo, hi),
