@@ -313,7 +313,7 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     disk = peak._replace(value=alpha)
     dgain, dphase = _disk_gain_phase(alpha, skew)
     if check:
-        _verify(L, upper, lower, k_lo, k_hi, nsteps=nsteps)
+        _verify(L, loop, upper, lower, k_lo, k_hi, nsteps=nsteps)
     return HarmonicMargins(gain_upper=upper, gain_lower=lower, phase=phase,
                            stability=stability, disk=disk, disk_gain=dgain,
                            disk_phase=dphase, gain_crossings=gains,
@@ -501,18 +501,22 @@ def _disk_gain_phase(alpha, skew):
     return (float(gmin), float(gmax)), phase
 
 
-def _verify(L, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3, nsteps=None):
+def _verify(L, loop, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3, nsteps=None):
     """Floquet check of the gain margins (MarginPoints `upper`, `lower`).
 
-    Just beyond a margin k (gain ``k(1 ± δ)``) the closed loop's exponents in
-    the right half plane must be the ones that crossed the axis at the
-    margin's frequency ω (modulo ω_p, and -ω for the conjugate): none means
-    no crossing there, others an exponent that crossed at a smaller gain
-    (a crossing missed between grid points).  A margin set by an ill-posed
-    gain is checked from inside (no exponent in the right half plane).  So
-    each finite margin costs one Floquet computation; only when a check
-    fails is the closed loop itself computed, and the warning given when it
-    is stable (the margins of an unstable closed loop are not margins).
+    At a margin k the closed loop has an exponent at jω where ``-1/k`` is an
+    eigenvalue μ of ``L̂(jω)``; along the branch ``μ'(s) ds = dk / k²``, so
+    the gain ``k(1 ± δ)`` just beyond the margin moves it to
+    ``jω + ds``, ``ds = ±δ / (k μ'(jω))``.  The closed loop with that gain
+    must have its exponents in the right half plane there (within
+    ``0.9 |ds|``, modulo jω_p and with the conjugate) and nowhere else: no
+    such exponent means no crossing at the margin, another one an exponent
+    that crossed at a gain nearer 1 (a crossing missed between grid
+    points).  A margin set by an ill-posed gain is checked from inside (no
+    exponent in the right half plane).  So each finite margin costs one
+    Floquet computation; only when a check fails is the closed loop itself
+    computed, and the warning given when it is stable (the margins of an
+    unstable closed loop are not margins).
     """
     eye = np.eye(L.ninputs)
     wp = L.omega_p
@@ -525,11 +529,24 @@ def _verify(L, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3, nsteps=None):
             lam = loop_exponents(feedback(series(L, k * eye), eye), nsteps)
         return lam[lam.real > atol]
 
-    def explained(lam, w):
-        # within the motion of the crossing exponent over the gain step δ
-        tol = 1e-2 * wp + 100 * lam.real
-        return np.minimum(np.abs(fold(lam.imag - w, wp)),
-                          np.abs(fold(lam.imag + w, wp))) <= tol
+    def predicted(m, step):
+        # ds = (k' - k) / (k² μ'(jω)), μ' = dμ/ds by central differences
+        h = 1e-6 * wp
+        mu = -1 / m.value
+        ends = []
+        for w in (m.omega - h, m.omega + h):
+            ev = np.linalg.eigvals(loop(1j * w)[0])
+            ends.append(ev[np.argmin(np.abs(ev - mu))])
+        dmu = (ends[1] - ends[0]) / (2j * h)
+        return 1j * m.omega + (step - 1) / (m.value * dmu)
+
+    def explained(lam, m, target):
+        ds = abs(target - 1j * m.omega)
+        out = np.zeros(len(lam), bool)
+        for c in (target, target.conjugate()):
+            gap = lam - c
+            out |= np.abs(gap.real + 1j * fold(gap.imag, wp)) <= 0.9 * ds
+        return out
 
     bad = []
     for m, step in ((upper, 1 + delta), (lower, 1 - delta)):
@@ -543,7 +560,7 @@ def _verify(L, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3, nsteps=None):
                 bad.append(k)
             continue
         lam = unstable(beyond)
-        if not lam.size or not np.all(explained(lam, m.omega)):
+        if not lam.size or not np.all(explained(lam, m, predicted(m, step))):
             bad.append(beyond)
     if bad and not unstable(1.0).size:
         warnings.warn(f"harmonic_margins: the Floquet exponents of the closed loop with "
