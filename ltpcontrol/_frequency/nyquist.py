@@ -234,11 +234,11 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
         Truncation N >= 1 of the loop HTF.
     omega : array_like, optional
         Initial frequencies of the contour in ``[-ω_p/2, ω_p/2]`` (default
-        201 uniform points, with more around every open- and closed-loop
-        exponent near the axis, spaced by its distance to it); the contour
-        is refined wherever the phase of the determinant turns by more than
-        π/4, or its modulus changes by more than a factor e^0.5, between
-        points.
+        201 uniform points); points are added around every open- and
+        closed-loop exponent near the axis, spaced by its distance to it,
+        and the contour is refined wherever the phase of the determinant
+        turns by more than π/4, or its modulus changes by more than a
+        factor e^0.5, between points.
     period : float, optional
         Period of an LTI loop.
     indent_radius : float, optional
@@ -438,7 +438,6 @@ def track(eig):
 def _initial_grid(omega, wp, axis_w, r, exponents=()):
     if omega is None:
         w = np.linspace(-wp / 2, wp / 2, _INITIAL_POINTS)
-        w = np.concatenate([w, _near_exponents(exponents, wp)])
     else:
         w = np.unique(real_array(omega, 'omega', ndim=1))
         if w.size < 2 or w[0] < -wp / 2 * (1 + 1e-12) or w[-1] > wp / 2 * (1 + 1e-12):
@@ -447,7 +446,7 @@ def _initial_grid(omega, wp, axis_w, r, exponents=()):
         w = np.unique(np.concatenate([[-wp / 2], w, [wp / 2]]))
     theta = np.sin(np.linspace(-np.pi / 2, np.pi / 2, 41))
     extra = [c + r * theta for wk in axis_w for c in (wk - wp, wk, wk + wp)]
-    w = np.concatenate([w] + extra)
+    w = np.concatenate([w, _near_exponents(exponents, wp)] + extra)
     return np.unique(w[(w >= -wp / 2) & (w <= wp / 2)])
 
 
