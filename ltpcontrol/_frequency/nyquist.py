@@ -446,20 +446,21 @@ def _initial_grid(omega, wp, axis_w, r, exponents=()):
         w = np.unique(np.concatenate([[-wp / 2], w, [wp / 2]]))
     theta = np.sin(np.linspace(-np.pi / 2, np.pi / 2, 41))
     extra = [c + r * theta for wk in axis_w for c in (wk - wp, wk, wk + wp)]
-    w = np.concatenate([w, _near_exponents(exponents, wp)] + extra)
+    w = np.concatenate([w, _near_exponents(exponents, wp, np.diff(w).max())] + extra)
     return np.unique(w[(w >= -wp / 2) & (w <= wp / 2)])
 
 
-def _near_exponents(exponents, wp):
-    """Strip frequencies around every exponent within ω_p/2 of the axis,
-    spaced by its distance to the axis (where f may turn fast)."""
+def _near_exponents(exponents, wp, spacing):
+    """Strip frequencies around every exponent closer to the axis than four
+    grid spacings, spaced by its distance to the axis: there f may turn
+    within less than a grid step (the grid resolves the others)."""
     pts = []
     for lam in exponents:
         if lam is None:
             continue
         lam = np.asarray(lam)
         d = np.abs(lam.real)
-        near = (d > 0) & (d < wp / 2)
+        near = (d > 0) & (d < 4 * spacing)
         if near.any():
             c = fold(lam[near].imag, wp)
             pts.append((c[:, None] + d[near][:, None] * _NEAR[None, :]).ravel())
