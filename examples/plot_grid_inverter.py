@@ -71,35 +71,38 @@ def radius(Lg):
 # %%
 # Verdicts side by side
 # ---------------------
-# The generalized Nyquist count (N = 10 harmonics) and the Floquet
-# multipliers agree; the closure gap of the curve on the axis alone is
-# large (biproper loop) and means nothing here: the horizontal edges carry
-# the missing part of a turn.  The current loop's dynamics reach the
-# kilohertz range, so the loop HTF is not small at harmonic ±10; the
-# crossings that matter are at low harmonics, and the Floquet check is
-# made here, independently, hence the truncation-edge remark is silenced.
+# The generalized Nyquist count (N = 10 harmonics), the closed loop's
+# Floquet exponents computed by the call (its cross-check) and the
+# independent multipliers agree; the closure gap of the curve on the axis
+# alone is large (biproper loop) and means nothing here: the horizontal
+# edges carry the missing part of a turn.  The current loop's dynamics
+# reach the kilohertz range, so the loop HTF is not small at harmonic ±10;
+# the crossings that matter are at low harmonics, and the margins' Floquet
+# check below confirms them, hence the truncation-edge remark is silenced.
 
 warnings.filterwarnings('ignore', message='.*truncation edge')
 N = 10
-print(f"{'L_g [mH]':>9} {'Nyquist Z':>10} {'edge turns':>11} {'closure gap':>12} "
-      f"{'Floquet radius':>15}")
+print(f"{'L_g [mH]':>9} {'Nyquist Z':>10} {'Floquet Z':>10} {'edge turns':>11} "
+      f"{'closure gap':>12} {'solve_ivp radius':>17}")
 responses = {}
 for Lg in (Lg0, 50e-3):
-    resp = responses[Lg] = ltp.nyquist_htf(loop(Lg), N, check=False, floquet_steps=32)
+    resp = responses[Lg] = ltp.nyquist_htf(loop(Lg), N)
     rho = radius(Lg)
-    print(f"{Lg * 1e3:9.1f} {resp.closed_loop_unstable:10d} {resp.edge_turns:11.2f} "
-          f"{resp.closure_gap:12.2f} {rho:15.4f}")
-    assert resp.stable == (rho < 1)
+    print(f"{Lg * 1e3:9.1f} {resp.closed_loop_unstable:10d} {resp.floquet_unstable:10d} "
+          f"{resp.edge_turns:11.2f} {resp.closure_gap:12.2f} {rho:17.4f}")
+    assert resp.stable == (rho < 1) and resp.floquet_unstable == resp.closed_loop_unstable
 
 # %%
 # Margin in grid inductance
 # -------------------------
 # With ``Z_g = sL_g`` the loop is linear in L_g, so the upper gain margin
-# of the nominal loop is the factor by which the grid inductance may grow.
-# Frequencies are reported in Hz when asked; a phase margin's sign carries
-# no meaning for such a periodic loop (see the guide).
+# of the nominal loop is the factor by which the grid inductance may grow;
+# the call checks it with the Floquet exponents of the closed loop just
+# beyond it (one more monodromy).  Frequencies are reported in Hz when
+# asked; a phase margin's sign carries no meaning for such a periodic loop
+# (see the guide).
 
-m = ltp.harmonic_margins(loop(Lg0), N, check=False, floquet_steps=32, omega_num=401)
+m = ltp.harmonic_margins(loop(Lg0), N, omega_num=401)
 Lg_crit = m.gain_upper.value * Lg0
 print(f"gain margin {m.gain_upper.value:.6f}: critical L_g = {Lg_crit * 1e3:.5f} mH, "
       f"at {m.gain_upper.frequency / (2 * np.pi):.2f} Hz (harmonic {m.gain_upper.harmonic})")

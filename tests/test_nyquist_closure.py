@@ -84,7 +84,10 @@ def test_lti_loops_written_as_periodic_count_as_python_control(poles, num, d):
     assume(theirs == Z - int(np.count_nonzero(ct.poles(G).real > 0)))   # theirs resolved
     L = ltp.ltpss(G, period=1.0)                               # ω_p = 2π
     for N in (1, 2, 3, 4, 6):
-        resp = ltp.nyquist_htf(L, N, omega=np.linspace(-np.pi, np.pi, 101))
+        # a coarse given contour, or the default one (coarse, refined, with points
+        # around the exponents near the axis)
+        omega = np.linspace(-np.pi, np.pi, 101) if N % 2 else None
+        resp = ltp.nyquist_htf(L, N, omega=omega)
         assert resp.closed_loop_unstable == Z, (N, resp)
         assert resp.count == theirs
 
@@ -96,3 +99,20 @@ def test_margin_report_in_hz():
     row = next(r for r in m.report(hz=True).splitlines() if r.startswith('gain upper'))
     assert abs(float(row.split()[-1]) - wpc / (2 * np.pi)) < 1e-5
     assert "[rad/s]" in m.report()
+
+
+@pytest.mark.parametrize("check", [True, False])
+def test_turn_within_a_narrow_band_is_counted(check):
+    # L = -4δ s/(s² + 2δ s + δ² + ω0²): 1 + L is all-pass, |f| = 1 on the axis, and
+    # its two turns lie within a few δ of ±ω0 (open-loop poles -δ ± jω0, closed-loop
+    # poles +δ ± jω0); a uniform contour misses them, the points placed around
+    # the exponents near the axis see them
+    d, w0 = 1e-5, 1.3
+    G = ct.tf([-4 * d, 0], [1, 2 * d, d ** 2 + w0 ** 2])
+    Z = int(np.count_nonzero(ct.poles(ct.feedback(G, 1)).real > 0))
+    assert Z == 2
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        resp = ltp.nyquist_htf(ltp.ltpss(G, period=1.0), 3, check=check)
+    assert resp.closed_loop_unstable == Z
+    assert np.allclose(np.abs(resp.det), 1.0, atol=1e-9)          # all-pass: |f| = 1

@@ -111,13 +111,33 @@ class LoopHTF:
         return int(np.argmax(blocks.sum(axis=1))) - self.N
 
 
-def open_loop_exponents(L, atol=None, nsteps=None):
+def loop_exponents(L, nsteps=None):
+    """Characteristic exponents of the system L (eigenvalues of a constant A).
+
+    One Floquet computation (`nsteps`: steps per period, see `monodromy`;
+    default its own choice, with sub-steps set by the integrator's error).
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.loop import loop_exponents
+    >>> loop_exponents(ltp.ltpss(ct.tf([1], [1, 2]), period=1.0))
+    array([-2.+0.j])
+    """
+    if not L.nstates:
+        return np.zeros(0, complex)
+    if L.A.is_constant:
+        return np.linalg.eigvals(L.A(0.0)).astype(complex)    # constant A: its eigenvalues
+    return np.atleast_1d(floquet_exponents(L, nsteps)).astype(complex)
+
+
+def open_loop_exponents(L, atol=None, nsteps=None, lam=None):
     """(P, axis) of the open loop: count of exponents with positive real part
     and the strip frequencies of those on the imaginary axis.
 
     An exponent with ``|Re λ| <= atol`` (default ``1e-9 ω_p``) counts as on
-    the axis (`nsteps`: Floquet steps, see `monodromy`); the Nyquist contour indents to its right, so it is not counted
-    in P, as python-control does.
+    the axis (`nsteps`: Floquet steps, see `monodromy`); the Nyquist contour
+    indents to its right, so it is not counted in P, as python-control
+    does.  `lam`: the exponents when already computed (`loop_exponents`).
 
     Examples
     --------
@@ -128,12 +148,8 @@ def open_loop_exponents(L, atol=None, nsteps=None):
     """
     wp = L.omega_p
     atol = 1e-9 * wp if atol is None else atol
-    if not L.nstates:
-        lam = np.zeros(0, complex)
-    elif L.A.is_constant:
-        lam = np.linalg.eigvals(L.A(0.0))           # constant A: its eigenvalues
-    else:
-        lam = np.atleast_1d(floquet_exponents(L, nsteps))
+    if lam is None:
+        lam = loop_exponents(L, nsteps)
     on_axis = np.abs(lam.real) <= atol
     P = int(np.count_nonzero(lam.real > atol))
     w = fold(lam[on_axis].imag, wp)

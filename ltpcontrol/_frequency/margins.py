@@ -36,9 +36,8 @@ import warnings
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from .loop import LoopHTF, as_loop, fold, open_loop_exponents
+from .loop import LoopHTF, as_loop, fold, loop_exponents, open_loop_exponents
 from .nyquist import track
-from .._core.floquet import is_stable
 from .._core.ltpsys import feedback, series
 from .._core.validation import check_positive_int
 from .._core.wellposed import ill_posed_gains
@@ -203,10 +202,12 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
         Warn when the outermost harmonic blocks of ``L̂_N`` reach this
         magnitude: crossings beyond the truncation may be missed.
     check : bool
-        When the closed loop is stable, verify the gain margins by the
-        Floquet multipliers of the closed loops with the gains 0.1 % inside
-        (stable) and outside (unstable) them, and warn otherwise (a
-        crossing between grid points missed: raise `omega_num`).
+        Verify the gain margins by the Floquet exponents of the closed
+        loops with the gains 0.1 % beyond them (one Floquet computation
+        per finite margin): the exponents in the right half plane must be
+        those that crossed the axis at the margin's frequency; otherwise,
+        if the closed loop itself is stable (one more computation), warn
+        (a crossing between grid points missed: raise `omega_num`).
     floquet_steps : int, optional
         Steps per period of every Floquet computation (`monodromy`'s
         `nsteps`; default: its own choice).
@@ -297,21 +298,22 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     if k_lo > lower.value:
         lower = MarginPoint(k_lo, float('nan'), 0, float('inf'))
     phase = min(phases, key=lambda p: abs(p.value)) if phases else _NONE
+    eye = np.eye(loop.size)
     stability = _extremum(loop, w, Lh, lambda M: np.linalg.svd(
-        np.eye(len(M)) + M, compute_uv=False)[-1], 'min')
+        eye + M, compute_uv=False)[..., -1], 'min')
     offset = 0.5 * (skew - 1)
 
     def balanced(M):
-        # σ_max of S + (σ - 1)/2 I with S = (I + L̂)^{-1}
-        S = np.linalg.inv(np.eye(len(M)) + M)
-        return np.linalg.svd(S + offset * np.eye(len(M)), compute_uv=False)[0]
+        # σ_max of S + (σ - 1)/2 I with S = (I + L̂)^{-1}, at a stack of points
+        S = np.linalg.inv(eye + M)
+        return np.linalg.svd(S + offset * eye, compute_uv=False)[..., 0]
 
     peak = _extremum(loop, w, Lh, balanced, 'max')
     alpha = 1 / peak.value
     disk = peak._replace(value=alpha)
     dgain, dphase = _disk_gain_phase(alpha, skew)
     if check:
-        _verify(L, upper.value, lower.value, k_lo, k_hi, nsteps=nsteps)
+        _verify(L, loop, upper, lower, k_lo, k_hi, nsteps=nsteps)
     return HarmonicMargins(gain_upper=upper, gain_lower=lower, phase=phase,
                            stability=stability, disk=disk, disk_gain=dgain,
                            disk_phase=dphase, gain_crossings=gains,
@@ -467,9 +469,10 @@ def _unique(points, wp):
 
 
 def _extremum(loop, w, Lh, fun, kind):
-    """Refined min (or max) of fun(L̂(jω)) over the grid, as a MarginPoint."""
+    """Refined min (or max) of fun(L̂(jω)) over the grid, as a MarginPoint
+    (`fun` maps a stack of matrices to their values)."""
     sign = 1.0 if kind == 'min' else -1.0
-    vals = np.array([fun(M) for M in Lh])
+    vals = fun(Lh)
     i = int(np.argmin(sign * vals))
     lo, hi = w[max(i - 1, 0)], w[min(i + 1, len(w) - 1)]
     res = minimize_scalar(lambda x: sign * fun(loop(1j * x)[0]), bounds=(lo, hi),
@@ -498,32 +501,72 @@ def _disk_gain_phase(alpha, skew):
     return (float(gmin), float(gmax)), phase
 
 
-def _verify(L, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3, nsteps=None):
-    """Floquet check of the gain margins of a loop whose closed loop is stable
-    (not beyond a margin set by an ill-posed gain)."""
-    eye = np.eye(L.ninputs)
+def _verify(L, loop, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3, nsteps=None):
+    """Floquet check of the gain margins (MarginPoints `upper`, `lower`).
 
-    def stable(k):
+    At a margin k the closed loop has an exponent at jω where ``-1/k`` is an
+    eigenvalue μ of ``L̂(jω)``; along the branch ``μ'(s) ds = dk / k²``, so
+    the gain ``k(1 ± δ)`` just beyond the margin moves it to
+    ``jω + ds``, ``ds = ±δ / (k μ'(jω))``.  The closed loop with that gain
+    must have its exponents in the right half plane there (within
+    ``0.9 |ds|``, modulo jω_p and with the conjugate) and nowhere else: no
+    such exponent means no crossing at the margin, another one an exponent
+    that crossed at a gain nearer 1 (a crossing missed between grid
+    points).  A margin set by an ill-posed gain is checked from inside (no
+    exponent in the right half plane).  So each finite margin costs one
+    Floquet computation; only when a check fails is the closed loop itself
+    computed, and the warning given when it is stable (the margins of an
+    unstable closed loop are not margins).
+    """
+    eye = np.eye(L.ninputs)
+    wp = L.omega_p
+    atol = 1e-9 * wp
+
+    def unstable(k):
         with warnings.catch_warnings():
             # only the verdict is used, 0.1 % away from the boundary
             warnings.filterwarnings('ignore', message='product_eigenvalues')
-            return is_stable(feedback(series(L, k * eye), eye), nsteps=nsteps)
-    if not stable(1.0):
-        return
+            lam = loop_exponents(feedback(series(L, k * eye), eye), nsteps)
+        return lam[lam.real > atol]
+
+    def predicted(m, step):
+        # ds = (k' - k) / (k² μ'(jω)), μ' = dμ/ds by central differences
+        h = 1e-6 * wp
+        mu = -1 / m.value
+        ends = []
+        for w in (m.omega - h, m.omega + h):
+            ev = np.linalg.eigvals(loop(1j * w)[0])
+            ends.append(ev[np.argmin(np.abs(ev - mu))])
+        dmu = (ends[1] - ends[0]) / (2j * h)
+        return 1j * m.omega + (step - 1) / (m.value * dmu)
+
+    def explained(lam, m, target):
+        ds = abs(target - 1j * m.omega)
+        out = np.zeros(len(lam), bool)
+        for c in (target, target.conjugate()):
+            gap = lam - c
+            out |= np.abs(gap.real + 1j * fold(gap.imag, wp)) <= 0.9 * ds
+        return out
+
     bad = []
-    if np.isfinite(upper):
-        pairs = ((upper * (1 - delta), True),) + (
-            ((upper * (1 + delta), False),) if upper < k_hi else ())
-        bad += [k for k, want in pairs if stable(k) != want]
-    if lower > 0:
-        pairs = ((lower * (1 + delta), True),) + (
-            ((lower * (1 - delta), False),) if lower > k_lo else ())
-        bad += [k for k, want in pairs if stable(k) != want]
-    if bad:
-        warnings.warn(f"harmonic_margins: the Floquet multipliers of the closed loop with "
-                      f"the gains {bad} contradict the gain margins ({lower:.6g}, "
-                      f"{upper:.6g}): a crossing was missed between grid points; increase "
-                      "omega_num", UserWarning, stacklevel=3)
+    for m, step in ((upper, 1 + delta), (lower, 1 - delta)):
+        if not (np.isfinite(m.value) and m.value > 0):
+            continue
+        beyond = m.value * step
+        if m.frequency == np.inf or not k_lo < beyond < k_hi:
+            # a margin set by an ill-posed gain: just inside must be stable
+            k = m.value / step
+            if unstable(k).size:
+                bad.append(k)
+            continue
+        lam = unstable(beyond)
+        if not lam.size or not np.all(explained(lam, m, predicted(m, step))):
+            bad.append(beyond)
+    if bad and not unstable(1.0).size:
+        warnings.warn(f"harmonic_margins: the Floquet exponents of the closed loop with "
+                      f"the gains {bad} contradict the gain margins ({lower.value:.6g}, "
+                      f"{upper.value:.6g}): a crossing was missed between grid points; "
+                      "increase omega_num", UserWarning, stacklevel=3)
 
 
 def _check_edge(loop, Lh, tol):

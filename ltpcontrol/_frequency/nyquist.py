@@ -39,7 +39,7 @@ import matplotlib.pyplot as plt
 from scipy.optimize import linear_sum_assignment
 
 from .contour import EDGE_OFFSET, abscissa_bound, path_phase, strip_closure
-from .loop import LoopHTF, as_loop, open_loop_exponents
+from .loop import LoopHTF, as_loop, fold, loop_exponents, open_loop_exponents
 from .._core.ltpsys import feedback
 from .._core.validation import check_positive, check_positive_int, real_array
 
@@ -49,6 +49,10 @@ __all__ = ['nyquist_htf', 'HarmonicNyquistResponse']
 _MAX_TURN = np.pi / 4
 # bound on the number of contour points after refinement
 _MAX_POINTS = 50_000
+# uniform points of the default initial contour (refined where f turns fast)
+_INITIAL_POINTS = 201
+# extra points around each exponent near the axis, in units of its distance to it
+_NEAR = np.array([-8.0, -4.0, -2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 2.0, 4.0, 8.0])
 # check='auto' verifies the count by the closed loop's Floquet exponents up to this size
 _CHECK_STATES = 60
 
@@ -230,9 +234,11 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
         Truncation N >= 1 of the loop HTF.
     omega : array_like, optional
         Initial frequencies of the contour in ``[-ω_p/2, ω_p/2]`` (default
-        401 uniform points); the contour is refined wherever the phase of
-        the determinant turns by more than π/4, or its modulus changes by
-        more than a factor e^0.5, between points.
+        201 uniform points); points are added around every open- and
+        closed-loop exponent near the axis, spaced by its distance to it,
+        and the contour is refined wherever the phase of the determinant
+        turns by more than π/4, or its modulus changes by more than a
+        factor e^0.5, between points.
     period : float, optional
         Period of an LTI loop.
     indent_radius : float, optional
@@ -247,11 +253,14 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
         Truncation of the harmonic state space (see `htf`).
     check : bool or 'auto'
         Cross-check the verdict by the Floquet exponents of the closed
-        loop (one more monodromy).  'auto' (default) checks loops with a
-        constant A or at most 60 states.
+        loop (one more monodromy, whose exponents also place points of
+        the contour).  'auto' (default) checks loops with a constant A or
+        at most 60 states.
     floquet_steps : int, optional
         Steps per period of the Floquet computations (`monodromy`'s
-        `nsteps`; default: its own choice).
+        `nsteps`; default: its own choice, each step integrated with the
+        sub-steps its error estimate asks).  Each system's exponents are
+        computed once per call.
 
     Returns
     -------
@@ -308,10 +317,14 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     closure_tol = check_positive(closure_tol, 'closure_tol')
     nsteps = _floquet_steps(floquet_steps)
     do_check = _check_flag(check, L)
-    P, axis_w = open_loop_exponents(L, nsteps=nsteps)
-    w = _initial_grid(omega, wp, axis_w, r)
+    # each system's exponents once: the open loop's give P, the indentations and
+    # points of the contour; the closed loop's the cross-check and more points
+    lam_open = loop_exponents(L, nsteps)
+    P, axis_w = open_loop_exponents(L, lam=lam_open)
+    lam_closed = closed_loop_exponents(L, nsteps) if do_check else None
+    w = _initial_grid(omega, wp, axis_w, r, (lam_open, lam_closed))
 
-    w, s, logabs, phase, eig, edge = _refined_contour(loop, w, axis_w, r)
+    w, s, logabs, phase, eig, edge, smin = _refined_contour(loop, w, axis_w, r)
     axis_turn = float(_wrap(np.diff(phase)).sum())
     closing = _wrap(phase[0] - phase[-1])
     with np.errstate(over='ignore', under='ignore'):
@@ -321,10 +334,8 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     total = (axis_turn + edge_turn) / (2 * np.pi)
     encirclements = int(np.round(total))
     resolved &= abs(total - encirclements) < 0.05
-    I = np.eye(loop.size)
-    sv = np.linalg.svd(I + loop(s[::max(1, len(s) // 2000)]), compute_uv=False)
-    dist = float(sv[:, -1].min())
-    Zf = closed_loop_unstable_count(L, nsteps) if do_check else None
+    dist = float(smin.min())
+    Zf = None if lam_closed is None else closed_loop_unstable_count(L, lam=lam_closed)
     if Zf is not None and Zf != P - encirclements:
         warnings.warn(f"nyquist_htf: the count of the loop HTF truncated to nharmonics="
                       f"{loop.N} (Z = {P - encirclements}) contradicts the closed loop's "
@@ -348,8 +359,27 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
         edge_turns=float(edge_turn / (2 * np.pi)), floquet_unstable=Zf)
 
 
-def closed_loop_unstable_count(L, nsteps=None):
+def closed_loop_exponents(L, nsteps=None):
+    """Characteristic exponents of ``feedback(L, I)`` (one Floquet computation).
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.nyquist import closed_loop_exponents
+    >>> closed_loop_exponents(ltp.ltpss(ct.tf([3], [1, 1]), period=1.0))
+    array([-4.+0.j])
+    """
+    with warnings.catch_warnings():
+        # a cross-check: only the count is used, and a wrong one shows as a
+        # contradiction with the Nyquist count
+        warnings.filterwarnings('ignore', message='product_eigenvalues')
+        return loop_exponents(feedback(L, np.eye(L.ninputs)), nsteps)
+
+
+def closed_loop_unstable_count(L, nsteps=None, lam=None):
     """Closed-loop exponents with positive real part of ``feedback(L, I)``.
+
+    `lam`: those exponents when already computed (`closed_loop_exponents`);
+    exponents within ``1e-9 ω_p`` of the axis are not counted.
 
     Examples
     --------
@@ -359,9 +389,10 @@ def closed_loop_unstable_count(L, nsteps=None):
     >>> closed_loop_unstable_count(ltp.ltpss(ct.tf([-3], [1, 1]), period=1.0))
     1
     """
-    cl = feedback(L, np.eye(L.ninputs))
-    P, _ = open_loop_exponents(cl, nsteps=nsteps)
-    return P
+    if lam is None:
+        lam = closed_loop_exponents(L, nsteps)
+    lam = np.asarray(lam)
+    return int(np.count_nonzero(lam.real > 1e-9 * L.omega_p))
 
 
 def contour_points(w, axis_w, r, wp):
@@ -404,9 +435,9 @@ def track(eig):
 # Helpers
 #
 
-def _initial_grid(omega, wp, axis_w, r):
+def _initial_grid(omega, wp, axis_w, r, exponents=()):
     if omega is None:
-        w = np.linspace(-wp / 2, wp / 2, 401)
+        w = np.linspace(-wp / 2, wp / 2, _INITIAL_POINTS)
     else:
         w = np.unique(real_array(omega, 'omega', ndim=1))
         if w.size < 2 or w[0] < -wp / 2 * (1 + 1e-12) or w[-1] > wp / 2 * (1 + 1e-12):
@@ -415,16 +446,38 @@ def _initial_grid(omega, wp, axis_w, r):
         w = np.unique(np.concatenate([[-wp / 2], w, [wp / 2]]))
     theta = np.sin(np.linspace(-np.pi / 2, np.pi / 2, 41))
     extra = [c + r * theta for wk in axis_w for c in (wk - wp, wk, wk + wp)]
-    if extra:
-        w = np.concatenate([w] + extra)
-        w = np.unique(w[(w >= -wp / 2) & (w <= wp / 2)])
-    return w
+    w = np.concatenate([w, _near_exponents(exponents, wp, np.diff(w).max())] + extra)
+    return np.unique(w[(w >= -wp / 2) & (w <= wp / 2)])
+
+
+def _near_exponents(exponents, wp, spacing):
+    """Strip frequencies around every exponent closer to the axis than four
+    grid spacings, spaced by its distance to the axis: there f may turn
+    within less than a grid step (the grid resolves the others)."""
+    pts = []
+    for lam in exponents:
+        if lam is None:
+            continue
+        lam = np.asarray(lam)
+        d = np.abs(lam.real)
+        near = (d > 0) & (d < 4 * spacing)
+        if near.any():
+            c = fold(lam[near].imag, wp)
+            pts.append((c[:, None] + d[near][:, None] * _NEAR[None, :]).ravel())
+    if not pts:
+        return np.zeros(0)
+    w = np.concatenate(pts)
+    return w[np.abs(w) <= wp / 2]
 
 
 def _evaluate(loop, s):
+    """log|f|, arg f, eigenvalues of L̂_N, the truncation edge and the smallest
+    singular value of I + L̂_N at the points s, from one evaluation of L̂_N."""
     Lh = loop(s)
-    sign, logabs = np.linalg.slogdet(np.eye(loop.size) + Lh)
-    return logabs, np.angle(sign), np.linalg.eigvals(Lh), _edge(loop, Lh)
+    IL = np.eye(loop.size) + Lh
+    sign, logabs = np.linalg.slogdet(IL)
+    smin = np.linalg.svd(IL, compute_uv=False)[:, -1]
+    return logabs, np.angle(sign), np.linalg.eigvals(Lh), _edge(loop, Lh), smin
 
 
 def _edge(loop, Lh):
@@ -439,7 +492,7 @@ def _edge(loop, Lh):
 def _refined_contour(loop, w, axis_w, r):
     wp = loop.omega_p
     s = contour_points(w, axis_w, r, wp)
-    logabs, phase, eig, edge = _evaluate(loop, s)
+    logabs, phase, eig, edge, smin = _evaluate(loop, s)
     while True:
         # a fast turn of the phase, or a fast change of the modulus (a lightly
         # damped exponent nearby, where the phase may turn between samples)
@@ -449,17 +502,18 @@ def _refined_contour(loop, w, axis_w, r):
             break
         wn = 0.5 * (w[:-1][bad] + w[1:][bad])
         sn = contour_points(wn, axis_w, r, wp)
-        la, ph, ev, _ = _evaluate(loop, sn)
+        la, ph, ev, _, sm = _evaluate(loop, sn)
         order = np.argsort(np.concatenate([w, wn]), kind='stable')
         w = np.concatenate([w, wn])[order]
         s = np.concatenate([s, sn])[order]
         logabs = np.concatenate([logabs, la])[order]
         phase = np.concatenate([phase, ph])[order]
         eig = np.concatenate([eig, ev])[order]
+        smin = np.concatenate([smin, sm])[order]
     if np.any(np.isinf(logabs)):
         warnings.warn("nyquist_htf: det(I + L̂_N) vanishes on the contour: the loop is "
                       "at a stability boundary", UserWarning, stacklevel=3)
-    return w, s, logabs, phase, eig, edge
+    return w, s, logabs, phase, eig, edge, smin
 
 
 def _close_strip(loop, axis_w, r):
