@@ -132,7 +132,21 @@ class DelayLoop:
         return int(np.argmax(blocks.sum(axis=1))) - self.N
 
     def sigma_bound(self):
-        """An abscissa σ beyond which f has neither zeros nor poles (module notes)."""
+        """An abscissa σ beyond which f has neither zeros nor poles (module notes).
+
+        Examples
+        --------
+        ``1 + 2 e^{-0.3 s}/(s + 1)`` (K = 1) has no zero right of σ:
+
+        >>> from ltpcontrol._delays.loop import DelayLoop, as_delayed_loop
+        >>> L, _ = as_delayed_loop((ltp.ltpss(ct.tf([2.0], [1.0, 1.0]), period=1.0),
+        ...                         ltp.delay(0.3)))
+        >>> loop = DelayLoop(L, 1)
+        >>> sigma = loop.sigma_bound()
+        >>> s = sigma + 1j * np.linspace(-50, 50, 201)
+        >>> bool(np.all(np.abs(1 + 2 * np.exp(-0.3 * s) / (s + 1)) > 0.5))
+        True
+        """
         norms = {k: [(a, np.linalg.norm(T, 2) if T.size else 0.0) for a, T in ops]
                  for k, ops in self.H._ops.items()}
         D0 = next(T for a, T in self.H._ops['D'] if a == 0)[self._keep][:, self._keep]
@@ -200,6 +214,16 @@ def closed_loop_unstable(cl):
 
 
 def check_steps(floquet_steps):
-    """Refuse `floquet_steps` for a delayed loop (TypeError)."""
+    """Refuse `floquet_steps` for a delayed loop (TypeError).
+
+    Examples
+    --------
+    >>> from ltpcontrol._delays.loop import check_steps
+    >>> check_steps(None)
+    >>> check_steps(100)
+    Traceback (most recent call last):
+    ...
+    TypeError: floquet_steps does not apply to a loop with delays (its multipliers come from the spectral-element discretization of delay_monodromy)
+    """
     if floquet_steps is not None:
         raise TypeError(_NO_STEPS)
