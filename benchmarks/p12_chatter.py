@@ -171,6 +171,26 @@ def _noop(factory):
     return None
 
 
+def _burn(n):
+    s = 0
+    for i in range(n):
+        s += i * i
+    return s
+
+
+def _control_speedup(backend, n, tasks=8):
+    """Speed-up of two workers on pure-Python tasks of equal size: what the machine allows."""
+    import joblib
+    t0 = time.perf_counter()
+    for _ in range(tasks):
+        _burn(n)
+    serial = time.perf_counter() - t0
+    with joblib.parallel_config(backend=backend, n_jobs=2):
+        t0 = time.perf_counter()
+        joblib.Parallel()(joblib.delayed(_burn)(n) for _ in range(tasks))
+    return serial / (time.perf_counter() - t0)
+
+
 def _parallel_row(speeds, ref, cfg, quick, log):
     """P12b: two workers against one, wall clock; the pool's start-up and per-task cost.
 
@@ -178,7 +198,9 @@ def _parallel_row(speeds, ref, cfg, quick, log):
     pickled once per chunk); loky's pool is started by the first parallel
     call and reused by the next ones, so the start-up is reported apart
     from the warm speed-up.  The per-task overhead is the round trip of an
-    empty task carrying the factory, on the warm pool.
+    empty task carrying the factory, on the warm pool; the speed-up of
+    pure-Python tasks of equal size on the same pool tells what the machine
+    allows (on a machine loaded by other sessions it can be near 1).
     """
     import joblib
     backend = 'threading' if quick else 'loky'   # quick: no worker start-up in the smoke run
@@ -198,6 +220,7 @@ def _parallel_row(speeds, ref, cfg, quick, log):
         t0 = time.perf_counter()
         joblib.Parallel()(joblib.delayed(_noop)(model) for _ in range(ntask))
         per_task = (time.perf_counter() - t0) / ntask
+    control = _control_speedup(backend, 20_000 if quick else 2_000_000)
     err2 = max(_rel(lobes2, ref), _rel(lobes_cold, ref))
     load = os.getloadavg()[0]
     return row(
@@ -207,7 +230,8 @@ def _parallel_row(speeds, ref, cfg, quick, log):
         value=wall1 / wall2, err_ours=err2, err_peer=_rel(lobes1, ref), tol=cfg['acc'],
         checks={'ours <= tol': err2 <= cfg['acc']}, matched=True,
         notes=(f'wall clock; first parallel call (pool start-up included) {cold:.2f} s '
-               f'= {wall1 / cold:.2f}x; per-task overhead {1e3 * per_task:.1f} ms; load '
-               f'average {load:.1f} on {os.cpu_count()} cores'),
+               f'= {wall1 / cold:.2f}x; per-task overhead {1e3 * per_task:.1f} ms; '
+               f'pure-Python control tasks {control:.2f}x; load average {load:.1f} on '
+               f'{os.cpu_count()} cores'),
         extra=dict(wall_serial=wall1, wall_parallel_warm=wall2, wall_parallel_cold=cold,
-                   per_task_overhead=per_task, load_average=load))
+                   per_task_overhead=per_task, control_speedup=control, load_average=load))
