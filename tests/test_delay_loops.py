@@ -125,3 +125,15 @@ def test_bad_input_of_delayed_loops():
         ltp.nyquist_htf(wide, 3)
     with pytest.raises(ValueError, match="nharmonics"):
         ltp.harmonic_margins(L, 0)
+
+
+@pytest.mark.parametrize("tau", [0.1, 1.0])
+def test_nyquist_of_mimo_delayed_loop_equals_pade_and_closed_loop(tau):
+    G = ct.ss(ct.tf([[[1.0], [0.5]], [[0.2], [2.0]]],
+                    [[[1.0, 1.0], [1.0, 2.0]], [[1.0, 3.0], [1.0, 1.0]]]))
+    P = ltp.ltpss(2 * G, 1.0)
+    resp = ltp.nyquist_htf((P, ltp.delay(tau)), 2, check=False, closure_tol=1.0)
+    assert resp.stable == ltp.is_stable(ltp.feedback(ltp.series(ltp.delay(tau), P), np.eye(2)))
+    pade = ct.ss(ct.tf(*ct.pade(tau, 12)))
+    cl = ct.feedback(2 * G * ct.append(pade, pade), np.eye(2))
+    assert resp.closed_loop_unstable == int(np.count_nonzero(ct.poles(cl).real > 1e-9))
