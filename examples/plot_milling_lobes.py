@@ -29,40 +29,8 @@ import numpy as np  # noqa: E402
 
 import ltpcontrol as ltp  # noqa: E402
 
-N, KT, KN, FN, ZETA, MASS, AD = 2, 6e8, 2e8, 922.0, 0.011, 0.03993, 0.05
-WN = 2 * np.pi * FN
-
-
-def milling(rpm, depth_mm):
-    """The milling model at `rpm` and axial depth in mm."""
-    ap = depth_mm * 1e-3
-    T = 60.0 / (N * rpm)
-    ws = 2 * np.pi * rpm / 60
-    t_ex = np.arccos(1 - 2 * AD) / ws            # the tooth leaves the cut
-
-    def h(t):
-        t = np.mod(np.asarray(t, float), T)
-        phi = ws * t
-        return np.where(t < t_ex, np.sin(phi) * (KT * np.cos(phi) + KN * np.sin(phi)), 0.0)
-
-    def A(t):
-        hv = np.asarray(h(t))
-        out = np.zeros(hv.shape + (2, 2))
-        out[..., 0, 1] = 1.0
-        out[..., 1, 0] = -WN**2 - ap * hv / MASS
-        out[..., 1, 1] = -2 * ZETA * WN
-        return out
-
-    def Ad(t):
-        out = np.zeros(np.shape(t) + (2, 2))
-        out[..., 1, 0] = ap * h(t) / MASS
-        return out
-    bps = [0.0, t_ex]
-    return ltp.ltpdss(
-        ltp.PeriodicMatrix.from_function(A, T, (2, 2), breakpoints=bps, check=False),
-        [[0.0], [1.0]], [[1.0, 0.0]], 0, period=T,
-        delays=[(T, ltp.PeriodicMatrix.from_function(Ad, T, (2, 2), breakpoints=bps,
-                                                     check=False))])
+# The model (``examples/milling_models.py``, shared with benchmark P12):
+from milling_models import milling_mm as milling  # noqa: E402
 
 
 # %%

@@ -83,6 +83,7 @@ from ._delays import analysis as _delay_analysis  # noqa: F401  (registers the o
 from ._delays.htf import DelayHTF
 from ._delays.connect import Delay, delay
 from ._delays.margins import delay_margin
+from ._delays import nyquist as _delay_nyquist  # noqa: F401  (registers the overrides)
 from ._delays import timeresp as _delay_timeresp  # noqa: F401  (registers the overrides)
 from ._delays.chart import stability_chart, StabilityChart, StabilityChartError
 

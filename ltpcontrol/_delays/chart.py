@@ -7,8 +7,10 @@ located by Brent's method on ``log ρ`` to a tolerance, so the chart carries
 the stability boundary itself, not only a grid contour.  For a delayed
 system the sweep uses a fixed discretization degree and every boundary
 point is checked at a refined degree (recomputed there when the two
-disagree).  The columns (one value of x each) are independent tasks run by
-joblib (any of its backends, Dask's with a ``dask.distributed`` client).
+disagree).  The columns (one value of x each) are independent; in
+parallel they are run in a few chunks per worker by joblib (any of its
+backends, Dask's with a ``dask.distributed`` client), so that the factory
+is sent once per chunk and the pool's workers start once.
 A factory that raises at some points does not lose the others: the
 finished points are kept and the failures reported.
 """
@@ -29,6 +31,9 @@ from .ltpdsys import LTPDelayStateSpace
 from .monodromy import _ORDER, _REFINE, _Problem, _change
 
 __all__ = ['stability_chart', 'StabilityChart', 'StabilityChartError']
+
+# parallel tasks per worker (each a chunk of columns): balances the load, few round trips
+_CHUNKS_PER_WORKER = 4
 
 
 class StabilityChartError(RuntimeError):
@@ -278,17 +283,24 @@ def stability_chart(factory, x_values, y_values, *, tol=1e-8, refine=True, order
     opts = dict(tol=float(tol), refine=bool(refine), order=int(order or _ORDER))
     jobs = _jobs(n_jobs, len(xs))
     show = len(xs) > 20 if progress is None else bool(progress)
-    tasks = ((factory, x, ys, opts) for x in xs)
     if jobs == 1 and backend is None:
-        results = [_column(*t) for t in tqdm(list(tasks), desc="stability chart",
-                                             unit="column", disable=not show, leave=False)]
+        results = [_column(factory, x, ys, opts)
+                   for x in tqdm(xs, desc="stability chart", unit="column", disable=not show,
+                                 leave=False)]
     else:
         import joblib
-        with joblib.parallel_config(backend=backend or 'loky', n_jobs=jobs):
-            gen = joblib.Parallel(return_as='generator')(joblib.delayed(_column)(*t)
-                                                         for t in tasks)
-            results = list(tqdm(gen, total=len(xs), desc="stability chart", unit="column",
-                                disable=not show, leave=False))
+        # a few chunks of columns per worker: the factory is pickled once per chunk and
+        # the pool (loky's, reused between calls) starts its workers once
+        chunks = np.array_split(xs, min(len(xs), _CHUNKS_PER_WORKER * jobs))
+        results = []
+        with joblib.parallel_config(backend=backend or 'loky', n_jobs=jobs), \
+                tqdm(total=len(xs), desc="stability chart", unit="column",
+                     disable=not show, leave=False) as bar:
+            gen = joblib.Parallel(return_as='generator')(
+                joblib.delayed(_columns)(factory, c, ys, opts) for c in chunks)
+            for part in gen:
+                results += part
+                bar.update(len(part))
     radius = np.column_stack([r[0] for r in results])
     bnd = [pt for r in results for pt in r[1]]
     failures = [f for r in results for f in r[2]]
@@ -349,6 +361,11 @@ class _Radius:
                 return float(np.abs(mu[0])) if mu.size else 0.0
         mu = floquet_multipliers(sys)
         return float(np.max(np.abs(mu), initial=0.0))
+
+
+def _columns(factory, xs, ys, opts):
+    """`_column` over a chunk of columns (one parallel task)."""
+    return [_column(factory, x, ys, opts) for x in xs]
 
 
 def _column(factory, x, ys, opts):

@@ -69,31 +69,49 @@ class DelayHTF(HTF):
                      for k in 'ABCD'}
 
     def _operator(self, which, s):
+        """The harmonic operator of block `which` at the points `s`: (len(s), rows, cols)."""
         Ki = self._Ki
         l = np.arange(-Ki, Ki + 1)
         out = 0
         for a, Top in self._ops[which]:
             if a == 0:
-                out = out + Top
+                out = out + Top[None]
             else:
                 cols = Top.shape[1] // (2 * Ki + 1)
-                phase = np.repeat(np.exp(-(s + 1j * l * self.omega_p) * a), cols)
-                out = out + Top * phase[None, :]
-        return out
+                phase = np.repeat(np.exp(-(s[:, None] + 1j * l[None, :] * self.omega_p) * a),
+                                  cols, axis=1)
+                out = out + Top[None] * phase[:, None, :]
+        return np.broadcast_to(out, (len(s),) + self._shape(which)) if np.ndim(out) == 3 \
+            else np.zeros((len(s),) + self._shape(which), complex)
+
+    def _shape(self, which):
+        Ki, n = self._Ki, self._n
+        rows = {'A': n, 'B': n, 'C': self.noutputs, 'D': self.noutputs}[which]
+        cols = {'A': n, 'B': self.ninputs, 'C': n, 'D': self.ninputs}[which]
+        return ((2 * Ki + 1) * rows, (2 * Ki + 1) * cols)
 
     def _evaluate(self, s, progress):
         Ki, K, n = self._Ki, self.nharmonics, self._n
         ny, nu = self.noutputs, self.ninputs
+        s = np.atleast_1d(np.asarray(s, complex))
         ks = np.arange(-Ki, Ki + 1)
         keep_y = ((ks[:, None] + Ki)[np.abs(ks) <= K] * ny + np.arange(ny)).ravel()
         keep_u = ((ks[:, None] + Ki)[np.abs(ks) <= K] * nu + np.arange(nu)).ravel()
         out = np.empty((len(s), (2 * K + 1) * ny, (2 * K + 1) * nu), complex)
-        for i, si in enumerate(s):
-            A, B = self._operator('A', si), self._operator('B', si)
-            C, D = self._operator('C', si), self._operator('D', si)
-            Nm = np.diag(np.repeat(si + 1j * ks * self.omega_p, n))
-            H = C @ np.linalg.solve(Nm - A, B) + D if n else D
-            out[i] = H[np.ix_(keep_y, keep_u)]
+        size = (2 * Ki + 1) * max(n, ny, nu, 1)
+        chunk = max(1, int(2 ** 22 // size ** 2))          # ~64 MB of complex operators
+        diag = np.repeat(1j * ks * self.omega_p, n)
+        for i in range(0, len(s), chunk):
+            si = s[i:i + chunk]
+            C = self._operator('C', si)[:, keep_y, :]
+            H = self._operator('D', si)[:, keep_y][:, :, keep_u]
+            if n:
+                A = -self._operator('A', si)
+                idx = np.arange(A.shape[1])
+                A[:, idx, idx] += si[:, None] + diag[None, :]
+                B = self._operator('B', si)[:, :, keep_u]
+                H = H + C @ np.linalg.solve(A, B)
+            out[i:i + chunk] = H
         return out
 
     def _components_on(self, omega, ks, progress=None):

@@ -366,7 +366,20 @@ def _delay_list(delays):
 
 
 def as_delayed(obj, period=None, width=None):
-    """`obj` as an `LTPDelayStateSpace` (LTP, LTI, gain or delayed system)."""
+    """`obj` as an `LTPDelayStateSpace` (LTP, LTI, gain or delayed system).
+
+    `period` is the period given to an LTI system or a gain; `width` the
+    size of the identity that a scalar gain stands for.
+
+    Examples
+    --------
+    >>> from ltpcontrol._delays.ltpdsys import as_delayed
+    >>> as_delayed(ct.tf([1.0], [1.0, 1.0]), period=2.0).period
+    2.0
+    >>> g = as_delayed(0.5, period=1.0, width=2)
+    >>> g.nstates, g.D(0.0).tolist()
+    (0, [[0.5, 0.0], [0.0, 0.5]])
+    """
     if isinstance(obj, LTPDelayStateSpace):
         return obj
     if isinstance(obj, LTPStateSpace):

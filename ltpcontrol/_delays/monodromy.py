@@ -166,11 +166,6 @@ def delay_monodromy(sys, *, tol=1e-10, order=None, max_order=48):
                           elements=prob.elements, converged=converged)
 
 
-def spectral_radius(sys, order=_ORDER):
-    """Largest multiplier modulus at a fixed degree (no refinement): for sweeps."""
-    return float(np.abs(_Problem(sys).multipliers(order)[:1]).max(initial=0.0))
-
-
 def _eig(U):
     if U.size == 0:
         return np.zeros(0, complex)

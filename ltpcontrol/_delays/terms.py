@@ -73,12 +73,29 @@ def shift(P, a):
 
 
 def clean(terms):
-    """`terms` without identically zero delayed terms (the undelayed one is kept)."""
+    """`terms` without identically zero delayed terms (the undelayed one is kept).
+
+    Examples
+    --------
+    >>> from ltpcontrol._delays.terms import clean
+    >>> Z = ltp.PeriodicMatrix.constant(np.zeros((1, 1)), 1.0)
+    >>> sorted(clean({0.0: Z, 0.5: Z, 1.0: Z + 1}))
+    [0.0, 1.0]
+    """
     return {a: P for a, P in terms.items() if a == 0 or not is_zero(P)}
 
 
 def add(X, Y):
-    """Sum of two delay polynomials."""
+    """Sum of two delay polynomials (terms of equal delay added).
+
+    Examples
+    --------
+    >>> from ltpcontrol._delays.terms import add
+    >>> P = lambda v: ltp.PeriodicMatrix.constant(np.array([[v]]), 1.0)
+    >>> S = add({0.0: P(1.0), 0.5: P(2.0)}, {0.1 + 0.4: P(3.0)})
+    >>> {a: float(M(0.0)[0, 0]) for a, M in S.items()}
+    {0.0: 1.0, 0.5: 5.0}
+    """
     out = dict(X)
     for b, N in Y.items():
         k = key(b, out)
@@ -87,7 +104,19 @@ def add(X, Y):
 
 
 def matmul(X, Y):
-    """Product ``X Y`` of two delay polynomials (the right factor shifted in time)."""
+    """Product ``X Y`` of two delay polynomials (the right factor shifted in time).
+
+    Examples
+    --------
+    ``(σ^a M)(N(t) σ^b) = M N(t - a) σ^{a+b}``:
+
+    >>> from ltpcontrol._delays.terms import matmul
+    >>> M = ltp.PeriodicMatrix.constant(np.array([[2.0]]), 2 * np.pi)
+    >>> N = ltp.PeriodicMatrix.from_function(lambda t: np.array([[np.cos(t)]]), 2 * np.pi)
+    >>> prod = matmul({0.5: M}, {0.25: N})
+    >>> list(prod), bool(np.isclose(prod[0.75](1.0)[0, 0], 2 * np.cos(0.5)))
+    ([0.75], True)
+    """
     out = {}
     for a, M in X.items():
         for b, N in Y.items():
@@ -98,14 +127,31 @@ def matmul(X, Y):
 
 
 def scale(X, c):
-    """``c X`` for a scalar or a constant/periodic matrix `c` on the left."""
+    """``c X`` for a scalar or a constant/periodic matrix `c` on the left.
+
+    Examples
+    --------
+    >>> from ltpcontrol._delays.terms import scale
+    >>> X = {0.0: ltp.PeriodicMatrix.constant(np.eye(2), 1.0)}
+    >>> scale(X, -2.0)[0.0](0.0).tolist(), scale(X, np.ones((1, 2)))[0.0](0.0).tolist()
+    ([[-2.0, -0.0], [-0.0, -2.0]], [[1.0, 1.0]])
+    """
     if np.ndim(c) == 0 and not isinstance(c, PeriodicMatrix):
         return {a: M * float(c) for a, M in X.items()}
     return {a: c @ M for a, M in X.items()}
 
 
 def block(rows, period):
-    """Block polynomial from a nested list of polynomials (dicts) or matrices."""
+    """Block polynomial from a nested list of polynomials (dicts) or matrices.
+
+    Examples
+    --------
+    >>> from ltpcontrol._delays.terms import block
+    >>> d = {0.3: ltp.PeriodicMatrix.constant(np.array([[4.0]]), 1.0)}
+    >>> B = block([[d, np.array([[1.0]])]], 1.0)
+    >>> {a: M(0.0).tolist() for a, M in B.items()}
+    {0.0: [[0.0, 1.0]], 0.3: [[4.0, 0.0]]}
+    """
     rows = [[P if isinstance(P, dict) else {0.0: as_periodic(P, period, 'block')}
              for P in row] for row in rows]
     keys = []
@@ -132,10 +178,25 @@ def _at(P, k, shape, period):
 
 
 def undelayed(X, shape, period):
-    """The undelayed term of `X` (zero of `shape` when absent)."""
+    """The undelayed term of `X` (zero of `shape` when absent).
+
+    Examples
+    --------
+    >>> from ltpcontrol._delays.terms import undelayed
+    >>> undelayed({0.5: ltp.PeriodicMatrix.constant(np.eye(1), 1.0)}, (1, 2), 1.0)(0.0)
+    array([[0., 0.]])
+    """
     return X.get(0.0, PeriodicMatrix.constant(np.zeros(shape), period))
 
 
 def delayed(X):
-    """The delayed terms of `X` as a sorted list of ``(a, M_a)``."""
+    """The delayed terms of `X` as a sorted list of ``(a, M_a)``.
+
+    Examples
+    --------
+    >>> from ltpcontrol._delays.terms import delayed
+    >>> P = ltp.PeriodicMatrix.constant(np.eye(1), 1.0)
+    >>> [a for a, _ in delayed({0.0: P, 0.7: P, 0.2: P})]
+    [0.2, 0.7]
+    """
     return sorted((a, M) for a, M in X.items() if a > 0)

@@ -34,7 +34,7 @@ __all__ = []
 _ORDER = 12
 
 
-def simulate(sys, t, u, x0, history, hold, order):
+def _simulate(sys, t, u, x0, history, hold, order):
     """States at `t` and outputs: arrays (n, ntr, L) and (p, ntr, L)."""
     n, ntr = sys.nstates, u.shape[1]
     t0, T = t[0], sys.period
@@ -210,8 +210,8 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *, method=
     x0 = _initial_state(sys, initial_state, ntr)
     taus = [a for a, _ in sys.state_delays]
     hist = _check_history(history, t[0], max(taus) if taus else 0.0)
-    x, y = simulate(sys, t, u, x0, hist, input_hold, _ORDER)
-    _, y2 = simulate(sys, t, u, x0, hist, input_hold, _ORDER + 4)
+    x, y = _simulate(sys, t, u, x0, hist, input_hold, _ORDER)
+    _, y2 = _simulate(sys, t, u, x0, hist, input_hold, _ORDER + 4)
     err = float(np.max(np.abs(y - y2), initial=0.0))
     big = max(float(np.max(np.abs(y2), initial=0.0)), 1e-300)
     if err > max(rtol, 1e-10) * big:

@@ -39,6 +39,7 @@ from scipy.optimize import brentq, minimize_scalar
 from .loop import LoopHTF, as_loop, fold, loop_exponents, open_loop_exponents
 from .nyquist import track
 from .._core.ltpsys import feedback, series
+from .._core.registry import overridden
 from .._core.validation import check_positive_int
 from .._core.wellposed import ill_posed_gains
 
@@ -241,6 +242,12 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     >>> bool(np.isclose(m.gain_upper.frequency, wpc))
     True
     """
+    # -- loops with delays: their own margins and delay margin (ltpcontrol._delays.margins) --
+    if (own := overridden('harmonic_margins', *(L if isinstance(L, (list, tuple)) else [L]))):
+        return own(L, nharmonics, period=period, omega_num=omega_num, skew=skew,
+                   internal_harmonics=internal_harmonics, edge_tol=edge_tol, check=check,
+                   floquet_steps=floquet_steps)
+    # --
     L = as_loop(L, 'L', period, 'harmonic_margins')
     loop = LoopHTF(L, nharmonics, internal_harmonics)
     num = check_positive_int(omega_num, 'omega_num', minimum=16)

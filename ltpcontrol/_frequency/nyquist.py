@@ -41,6 +41,7 @@ from scipy.optimize import linear_sum_assignment
 from .contour import EDGE_OFFSET, abscissa_bound, path_phase, strip_closure
 from .loop import LoopHTF, as_loop, fold, loop_exponents, open_loop_exponents
 from .._core.ltpsys import feedback
+from .._core.registry import overridden
 from .._core.validation import check_positive, check_positive_int, real_array
 
 __all__ = ['nyquist_htf', 'HarmonicNyquistResponse']
@@ -309,6 +310,12 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     >>> ct.nyquist_response(ct.tf([2], [1, -1])).count == resp.count
     True
     """
+    # -- loops with delays: their own count (ltpcontrol._delays.nyquist) --
+    if (own := overridden('nyquist_htf', *(L if isinstance(L, (list, tuple)) else [L]))):
+        return own(L, nharmonics, omega, period=period, indent_radius=indent_radius,
+                   closure_tol=closure_tol, internal_harmonics=internal_harmonics,
+                   check=check, floquet_steps=floquet_steps)
+    # --
     L = as_loop(L, 'L', period, 'nyquist_htf')
     loop = LoopHTF(L, nharmonics, internal_harmonics)
     wp = L.omega_p
