@@ -9,6 +9,7 @@ closed-loop simulation.
 import numpy as np
 import control as ct
 import pytest
+import scipy.signal
 from control.exception import ControlDimension
 from hypothesis import given, settings, strategies as st
 
@@ -303,17 +304,69 @@ def test_minreal_lti_written_as_periodic_equals_python_control():
         assert red.nstates == want.nstates == 2
         got = np.sort_complex(np.linalg.eigvals(red.A(0.0)))
         np.testing.assert_allclose(got, np.sort_complex(np.linalg.eigvals(want.A)), rtol=1e-8)
+
+
+def _pole_zero_pair(c):
+    """(s+1)(s+c)/((s+2)(s²+s+1)) as a 3-state (controllable canonical) realization."""
+    num = np.polymul([1.0, 1.0], [1.0, c])
+    den = np.polymul([1.0, 2.0], [1.0, 1.0, 1.0])
+    return ct.ss(*scipy.signal.tf2ss(num, den))
+
+
+def _in_periodic_basis(G, N, seed):
+    """The discrete LTI system G in the state basis x_k = T_k z_k (N steps)."""
+    rng = np.random.default_rng(seed)
+    n = G.nstates
+    T = [np.linalg.qr(rng.standard_normal((n, n)))[0] @ np.diag(rng.uniform(0.5, 2.0, n))
+         for _ in range(N)]
+    A = [np.linalg.solve(T[(k + 1) % N], G.A @ T[k]) for k in range(N)]
+    B = [np.linalg.solve(T[(k + 1) % N], G.B) for k in range(N)]
+    return ltp.dltpss(A, B, [G.C @ T[k] for k in range(N)], [G.D], G.dt)
+
+
+@pytest.mark.parametrize('c', [2.00000000001, 2.0])
+def test_minreal_near_cancellation_as_python_control(c):
+    # python-control's near-cancellation test (xferfcn_test.test_minreal,
+    # minreal_test.testMinrealtf): TransferFunction.minreal cancels the pole -2
+    # against the zero -c with its default tolerance 1000 sqrt(eps)|z|
     s = ct.tf('s')
-    h = (s + 1) * (s + 2.00000000001) / (s + 2) / (s ** 2 + s + 1)
-    assert ct.minreal(h, verbose=False).den[0][0].size - 1 == 2
-    for sys in (ct.ss(h), ct.c2d(ct.ss(h), 0.1)):
-        P = ltp.ltpss(sys, period=0.2) if sys.dt == 0 else \
-            ltp.ltpss(sys.A, sys.B, sys.C, sys.D, period=0.2, dt=0.1)
-        # python-control's tolerance: the same order as ct.minreal of the state space
-        assert ltp.minreal(P).nstates == ct.minreal(sys, verbose=False).nstates
-        # a tolerance above the 1e-11 separation cancels the pair, as ct.minreal(h) does
-        assert ltp.minreal(P, tol=1e-9).nstates == ct.minreal(sys, tol=1e-9,
-                                                              verbose=False).nstates == 2
+    h = (s + 1) * (s + c) / (s + 2) / (s ** 2 + s + 1)
+    hm = ct.minreal(h, verbose=False)
+    hr = (s + 1) / (s ** 2 + s + 1)
+    np.testing.assert_array_almost_equal(hm.num[0][0], hr.num[0][0])
+    np.testing.assert_array_almost_equal(hm.den[0][0], hr.den[0][0])
+    G = _pole_zero_pair(c)
+    assert G.nstates == 3
+    # continuous, constant matrices: the same cancellation, the same reduced tf
+    red = ltp.minreal(ltp.ltpss(G, period=0.2))
+    assert red.nstates == 2
+    got = ct.tf(red.to_ss())
+    lead = got.den[0][0][0]
+    np.testing.assert_array_almost_equal(got.num[0][0][-2:] / lead, hr.num[0][0])
+    np.testing.assert_array_almost_equal(got.den[0][0] / lead, hr.den[0][0])
+    # discrete, through the periodic staircase: the sampled system in a random
+    # periodic basis (3 steps) against the sampled python-control result
+    Gd = ct.c2d(G, 0.1)
+    hd = ct.minreal(ct.tf(Gd), verbose=False)
+    assert hd.den[0][0].size - 1 == 2
+    P = _in_periodic_basis(Gd, 3, seed=1)
+    assert ltp.minreal(ltp.ltpss(Gd.A, Gd.B, Gd.C, Gd.D, period=0.3, dt=0.1)).nstates == 2
+    redd = ltp.minreal(P)
+    assert redd.nstates == (2, 2, 2)
+    L = ltp.lift(redd, method='time')
+    Lw = ltp.lift(ltp.ltpss(ct.ss(hd), period=0.3), method='time')
+    for z in (0.3 + 0.2j, np.exp(0.7j), 2.0):
+        np.testing.assert_allclose(L(z), Lw(z), rtol=1e-9, atol=1e-9)
+
+
+def test_minreal_keeps_a_pair_python_control_keeps():
+    # a pole-zero pair 1e-3 apart is no cancellation for python-control
+    s = ct.tf('s')
+    h = (s + 1) * (s + 2.001) / (s + 2) / (s ** 2 + s + 1)
+    assert ct.minreal(h, verbose=False).den[0][0].size - 1 == 3
+    G = _pole_zero_pair(2.001)
+    assert ltp.minreal(ltp.ltpss(G, period=0.2)).nstates == 3
+    assert ltp.minreal(_in_periodic_basis(ct.c2d(G, 0.1), 3, seed=2)).nstates == (3, 3, 3)
 
 
 def test_tv_balred_bound_and_hsv():

@@ -20,6 +20,15 @@ Reachable then observable gives a minimal periodic realization (Kalman's
 decomposition, step by step; stability is not needed).  Ranks are decided
 by singular values above ``tol`` times the norm of the step's data.
 
+Default tolerance.  python-control cancels a pole p against a zero z of a
+transfer function when ``|z - p| < 1000 sqrt(eps) |z|``
+(``TransferFunction.minreal``, the path of its near-cancellation test
+``(s+1)(s+2.00000000001)/((s+2)(s²+s+1))``).  A pole-zero pair at a
+relative distance δ leaves a staircase singular value of order δ relative
+to the step's data, so the same relative tolerance ``MINREAL_TOL = 1000
+sqrt(eps)`` (about 1.5e-5) is the default here: in the LTI limit the pairs
+python-control cancels are removed, and a pair 1e-3 apart is kept.
+
 Balanced truncation with time-varying dimensions: the periodic gramians of
 `tv_dlyap`, per-step square-root balancing ``W_k = Σ_r^{-1/2}U_rᵀR_kᵀ``,
 ``V_k = S_kV_rΣ_r^{-1/2}`` (Cholesky-free square roots from eigenvalue
@@ -35,9 +44,14 @@ from .tvdesign import tv_gram
 
 __all__ = []
 
+#: Default relative rank tolerance (module notes).
+MINREAL_TOL = 1000 * np.sqrt(np.finfo(float).eps)
 
-def periodic_minreal(sys, tol):
+
+def periodic_minreal(sys, tol=None):
     """Minimal realization of a `DiscreteLTPSystem` (module notes).
+
+    `tol` is the relative rank tolerance (default `MINREAL_TOL`).
 
     Examples
     --------
@@ -47,6 +61,7 @@ def periodic_minreal(sys, tol):
     >>> periodic_minreal(sys, 1e-10).nstates
     (1, 1)
     """
+    tol = MINREAL_TOL if tol is None else tol
     red = _observable_part(_reachable_part(sys, tol), tol)
     red.name = sys.name + '$minreal'
     return red
