@@ -154,3 +154,21 @@ def test_dlyap_dims_53341_positive_form():
         assert np.linalg.norm(A[k].T @ Qo[k1] @ A[k] - Qo[k] + C[k].T @ C[k]) < 1e-12
         assert np.linalg.eigvalsh(P[k]).min() > -1e-12
         assert np.linalg.eigvalsh(Qo[k]).min() > -1e-12
+
+
+def test_public_floquet_functions_take_time_varying_dimensions():
+    # the same dispatch as every other system class: monodromy, exponents, stability
+    sys = _pole_two()
+    np.testing.assert_array_equal(ltp.monodromy(sys), sys.A[2] @ sys.A[1] @ sys.A[0])
+    np.testing.assert_allclose(ltp.floquet_exponents(sys), [2.0, 0.0], atol=1e-14)
+    verdicts = []
+    for scale in (0.4, 0.6):                       # core multipliers 0.512 and 1.728
+        scaled = ltp.dltpss([scale * a for a in sys.A], sys.B, sys.C, sys.D)
+        lifted = ct.poles(ltp.lift(scaled, method='time'))
+        verdicts.append(ltp.is_stable(scaled))
+        assert verdicts[-1] is bool(np.all(np.abs(lifted) < 1))
+    assert verdicts == [True, False]
+    with pytest.raises(ValueError, match='tol'):
+        ltp.is_stable(sys, tol=2.0)
+    with pytest.raises(ct.ControlArgument, match='nsteps'):
+        ltp.floquet_multipliers(sys, nsteps=4)

@@ -26,6 +26,7 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument, ControlDimension
 
+from .registry import override
 from .subperiods import common_steps
 from .validation import check_positive, real_array
 
@@ -201,8 +202,16 @@ class DiscreteLTPSystem:
         return cyclic_multipliers(self.A, start)
 
     def is_stable(self, tol=1e-10):
-        """True when every core multiplier lies inside the unit circle."""
-        return bool(np.all(np.abs(self.floquet_multipliers()) < 1 - tol))
+        """True when every core multiplier lies inside the unit circle.
+
+        Examples
+        --------
+        >>> sys = ltp.dltpss([[[1.0, 2.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+        ...                  [[[1.0, 0.0]], [[1.0]]], 0)
+        >>> sys.is_stable(), sys.feedback(0.4).is_stable()
+        (False, True)
+        """
+        return _is_stable(self, tol)
 
     def poles(self):
         """Per-step poles ``μ^{1/N}`` of the core multipliers (zeros are kept)."""
@@ -361,6 +370,89 @@ def as_tv(sys, like=None, name='sys'):
                                  [np.zeros((K.shape[0], 0))], [K], like.dt)
     raise ControlArgument(f"{name} must be a discrete periodic system, got "
                           f"{type(sys).__name__}")
+
+
+#
+# Floquet analysis through the public functions (``ltp.floquet_multipliers(sys)``...)
+#
+
+def _no_nsteps(nsteps):
+    if nsteps is not None:
+        raise ControlArgument("nsteps applies to continuous-time systems only; a "
+                              "discrete-time system has N = period/dt steps")
+
+
+@override('floquet_multipliers', DiscreteLTPSystem)
+def _floquet_multipliers(sys, nsteps=None):
+    """`ltpcontrol.floquet_multipliers` with time-varying dimensions (module notes).
+
+    Examples
+    --------
+    >>> sys = ltp.dltpss([[[1.0, 0.0]], [[1.0], [1.0]]], [[[1.0]], [[1.0], [1.0]]],
+    ...                  [[[1.0, 1.0]], [[1.0]]], [[1.0]])
+    >>> ltp.floquet_multipliers(sys)        # core multiplier [1 0][1; 1] = 1, padded
+    array([1.+0.j, 0.+0.j])
+    """
+    _no_nsteps(nsteps)
+    return sys.floquet_multipliers()
+
+
+@override('floquet_exponents', DiscreteLTPSystem)
+def _floquet_exponents(sys, nsteps=None):
+    """`ltpcontrol.floquet_exponents`: the per-step values ``μ^{1/N}`` (`DiscreteLTPSystem.poles`).
+
+    Examples
+    --------
+    >>> sys = ltp.dltpss([[[4.0, 0.0]], [[1.0], [1.0]], [[2.0, 0.0], [0.0, 1.0]]],
+    ...                  [[[1.0]], [[1.0], [1.0]], [[1.0], [2.0]]],
+    ...                  [[[1.0, 1.0]], [[1.0]], [[1.0, 0.0]]], [[1.0]])
+    >>> np.round(ltp.floquet_exponents(sys).real, 12)       # cube root of 8, and 0
+    array([2., 0.])
+    """
+    _no_nsteps(nsteps)
+    return sys.poles()
+
+
+@override('monodromy', DiscreteLTPSystem)
+def _monodromy(sys, nsteps=None):
+    """`ltpcontrol.monodromy`: the cyclic product ``A_{N-1} ... A_0`` (``n_0 x n_0``).
+
+    Examples
+    --------
+    >>> sys = ltp.dltpss([[[1.0, 2.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+    ...                  [[[1.0, 0.0]], [[1.0]]], 0)
+    >>> ltp.monodromy(sys)
+    array([[1. , 2. ],
+           [0.5, 1. ]])
+    """
+    _no_nsteps(nsteps)
+    P = np.eye(sys.nstates[0])
+    for a in sys.A:
+        P = a @ P
+    return P
+
+
+@override('is_stable', DiscreteLTPSystem)
+def _is_stable(sys, tol=1e-10, nsteps=None, *, autonomous=False):
+    """`ltpcontrol.is_stable`: every core multiplier inside ``|μ| < 1 - tol``.
+
+    Examples
+    --------
+    >>> sys = ltp.dltpss([[[1.0, 0.0]], [[0.5], [1.0]]], [[[1.0]], [[1.0], [1.0]]],
+    ...                  [[[1.0, 1.0]], [[1.0]]], 0)
+    >>> ltp.is_stable(sys), ltp.is_stable(sys, autonomous=True)
+    (True, True)
+    """
+    _no_nsteps(nsteps)
+    if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, numbers.Real) \
+            or not 0 <= tol < 1:
+        raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
+    mu = cyclic_multipliers(sys.A, int(np.argmin(sys.nstates)))     # the core ones
+    if autonomous:
+        if mu.size == 0:
+            raise ValueError("autonomous=True needs at least one multiplier (the phase one)")
+        mu = np.delete(mu, np.argmin(np.abs(mu - 1)))
+    return bool(np.all(np.abs(mu) < 1 - tol))
 
 
 def cyclic_multipliers(A, start=0):
