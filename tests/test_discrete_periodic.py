@@ -68,6 +68,51 @@ def test_lyap_continuous_subperiods():
     assert np.abs(X(1.3) - X6(1.3)).max() < 1e-9
 
 
+def _mathieu_sub_periods():
+    """A of period 1 and a state weight of period 1.5 (common period 3)."""
+    A = ltp.PeriodicMatrix.from_function(
+        lambda t: np.array([[0.0, 1.0], [-1 - 0.3 * np.cos(2 * np.pi * t), -0.2]]), 1.0)
+    Q = ltp.PeriodicMatrix.from_function(
+        lambda t: np.diag([1 + 0.5 * np.sin(2 * np.pi * t / 1.5), 1.0]), 1.5)
+    return ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=1.0), Q
+
+
+def test_care_lqr_lqe_continuous_subperiods():
+    sys, Q = _mathieu_sub_periods()
+    R = [[1.0]]
+    X, E, G = ltp.care(sys.A, sys.B, Q, R)
+    assert np.isclose(X.period, 3.0) and np.all(E.real < 0)
+    # truth: the Riccati equation at the three phases of A (central differences)
+    h, t = 1e-5, np.array([0.4, 1.3, 2.2])
+    for ti in t:
+        dX = (X(ti + h) - X(ti - h)) / (2 * h)
+        a, b, x = sys.A(ti), sys.B(ti), X(ti)
+        res = dX + a.T @ x + x @ a - x @ b @ b.T @ x + Q(ti)
+        assert np.abs(res).max() < 1e-5 * np.abs(x).max()
+    K, Xl, _ = ltp.lqr(sys, Q, R)
+    assert np.isclose(K.period, 3.0)
+    assert np.abs(Xl(t) - X(t)).max() < 1e-9 * np.abs(X(t)).max()
+    # an output weight of period 1.5 is the state weight CᵀQyC of period 3
+    Qy = ltp.PeriodicMatrix.from_function(
+        lambda t: np.array([[1 + 0.5 * np.sin(2 * np.pi * t / 1.5)]]), 1.5)
+    Ky, _, _ = ltp.lqr(sys, Qy, R, output=True)
+    Ks, _, _ = ltp.lqr(sys, sys.C.T @ Qy @ sys.C, R)
+    assert np.isclose(Ky.period, 3.0) and np.abs(Ky(t) - Ks(t)).max() < 1e-12
+    L, P, E = ltp.lqe(sys, [[1.0]], 0.1 * Qy)
+    assert np.isclose(L.period, 3.0) and np.isclose(P.period, 3.0) and np.all(E.real < 0)
+
+
+def test_continuous_incommensurate_weights_named():
+    sys, _ = _mathieu_sub_periods()
+    Qi = ltp.PeriodicMatrix.constant(np.eye(2), np.sqrt(2))
+    with pytest.raises(ValueError, match="Q: periods"):
+        ltp.lqr(sys, Qi, [[1.0]])
+    with pytest.raises(ValueError, match="Q: periods"):
+        ltp.care(sys.A, sys.B, Qi, [[1.0]])
+    with pytest.raises(ValueError, match="RN: periods"):
+        ltp.lqe(sys, [[1.0]], ltp.PeriodicMatrix.constant([[1.0]], np.sqrt(2)))
+
+
 def test_dare_dlqr_subperiods():
     rng = np.random.default_rng(2)
     A = rng.standard_normal((3, 2, 2))
