@@ -587,3 +587,88 @@ def test_tv_hankel_norm_equals_constant_dimension_norm():
     s3 = ltp.ltpss(0.4 * rng.standard_normal((3, 3, 3)), rng.standard_normal((3, 3, 2)),
                    rng.standard_normal((3, 1, 3)), 0, period=3.0, dt=1.0)
     assert np.isclose(ltp.norm(ltp.dltpss(s3), 'hankel'), ltp.norm(s3, 'hankel'), rtol=1e-9)
+
+
+#
+# Storage and time responses
+#
+
+def _varying_states():
+    rng = np.random.default_rng(12)
+    n = [2, 1, 3]
+    A = [0.6 * rng.standard_normal((n[(k + 1) % 3], n[k])) for k in range(3)]
+    B = [rng.standard_normal((n[(k + 1) % 3], 2)) for k in range(3)]
+    C = [rng.standard_normal((1, n[k])) for k in range(3)]
+    return ltp.dltpss(A, B, C, list(rng.standard_normal((3, 1, 2))), 0.05, name='plant')
+
+
+def test_save_load_time_varying_dimensions(tmp_path):
+    sys = _varying_states()
+    gain = ltp.dltpss([np.zeros((0, 0))], [np.zeros((0, 2))], [np.zeros((1, 0))],
+                      [[[1.0, -2.0]]], 0.05)             # no state at all
+    for obj in (sys, gain, ltp.minreal(sys + sys)):
+        path = tmp_path / 'tv.npz'
+        ltp.save(path, obj)
+        back = ltp.load(path)
+        assert isinstance(back, ltp.DiscreteLTPSystem)
+        assert (back.nstates, back.ninputs, back.noutputs, back.dt, back.name) == \
+            (obj.nstates, obj.ninputs, obj.noutputs, obj.dt, obj.name)
+        for k in 'ABCD':
+            assert all(np.array_equal(a, b) for a, b in zip(getattr(back, k), getattr(obj, k)))
+    # a file whose dimension chain does not close is refused as corrupt
+    import json
+    ltp.save(tmp_path / 'tv.npz', sys)             # states (2, 1, 3)
+    data = dict(np.load(tmp_path / 'tv.npz'))
+    tree = json.loads(str(data['tree']))
+    tree['A'][1] = tree['A'][0]                    # A_1 now 1x2 where 3x1 belongs
+    data['tree'] = np.array(json.dumps(tree))
+    np.savez(tmp_path / 'bad.npz', **data)
+    with pytest.raises(ValueError, match='corrupt'):
+        ltp.load(tmp_path / 'bad.npz')
+
+
+def test_forced_response_equals_lifted_simulation():
+    sys = _varying_states()
+    N, P = 3, 4                                    # four periods
+    rng = np.random.default_rng(13)
+    U = rng.standard_normal((2, N * P))
+    resp = ltp.forced_response(sys, inputs=U)
+    np.testing.assert_allclose(resp.time, np.arange(N * P) * 0.05)
+    assert resp.states.shape == (0, N * P)         # the state dimension varies
+    # truth: the time-lifted LTI system simulated by python-control
+    L = ltp.lift(sys, method='time')
+    Ul = U.reshape(2, P, N).transpose(2, 0, 1).reshape(N * 2, P)   # [u_0; u_1; u_2] per period
+    yl = ct.forced_response(L, inputs=Ul).outputs.reshape(N, P)
+    np.testing.assert_allclose(resp.outputs[0], yl.T.reshape(-1), rtol=1e-12, atol=1e-12)
+    # a start at step 1 with an initial state of n_1 entries: the shifted system
+    x0 = rng.standard_normal(sys.nstates[1])
+    r1 = ltp.forced_response(sys, 0.05 * np.arange(1, 7), U[:, :6], x0)
+    y1, _ = sys.shifted(1).forced_response(U[:, :6].T, x0)
+    np.testing.assert_allclose(r1.outputs[0], y1[:, 0], rtol=1e-14)
+    # several traces at once, and the free response
+    Um = rng.standard_normal((2, 3, 6))
+    rm = ltp.forced_response(sys, inputs=Um)
+    for i in range(3):
+        np.testing.assert_allclose(rm.outputs[0, i], ltp.forced_response(
+            sys, inputs=Um[:, i]).outputs[0], rtol=1e-14)
+    x0 = rng.standard_normal(sys.nstates[0])
+    free = ltp.initial_response(sys, 0.05 * 5, x0)
+    np.testing.assert_allclose(free.outputs, ltp.forced_response(
+        sys, 0.05 * np.arange(6), np.zeros((2, 6)), x0).outputs[0], rtol=1e-14)
+
+
+def test_forced_response_constant_dims_states_and_refusals():
+    rng = np.random.default_rng(14)
+    sys = ltp.dltpss(list(0.5 * rng.standard_normal((2, 2, 2))), [[[1.0], [0.0]]],
+                     [[[1.0, 1.0]]], 0)
+    U = rng.standard_normal(5)
+    resp = ltp.forced_response(sys, inputs=U, initial_state=[1.0, -1.0])
+    _, xs = sys.forced_response(U[:, None], [1.0, -1.0])
+    np.testing.assert_allclose(resp.states, np.array(xs[:-1]).T, rtol=1e-15)
+    varying_inputs = ltp.dltpss([[[0.5]], [[0.5]]], [[[1.0]], [[1.0, 1.0]]], [[[1.0]]], 0)
+    with pytest.raises(ControlDimension, match='number of inputs varies'):
+        ltp.forced_response(varying_inputs, inputs=np.ones(4))
+    with pytest.raises(ControlDimension, match='initial_state'):
+        ltp.forced_response(_varying_states(), inputs=np.ones((2, 3)), initial_state=[1.0])
+    with pytest.raises(ValueError, match='multiples of dt'):
+        ltp.forced_response(_varying_states(), [0.0, 0.07], np.ones((2, 2)))
