@@ -23,6 +23,14 @@ def _tv_random(seed, na, ma, scale=1.0):
     return [scale * rng.standard_normal((m, n)) for n, m in zip(na, ma)]
 
 
+def _tv_plant(seed, scale):
+    """Two inputs, one output, states [5, 3, 3, 4, 1] (the toolbox's dimensions)."""
+    A = _tv_random(seed, NA, MA, scale)
+    rng = np.random.default_rng(seed)
+    return ltp.dltpss(A, [rng.standard_normal((m, 2)) for m in MA],
+                      [rng.standard_normal((1, n)) for n in NA], rng.standard_normal((1, 2)))
+
+
 def _sym(rng, n):
     x = rng.standard_normal((n, n))
     return x + x.T
@@ -237,16 +245,14 @@ def test_tv_dlqe_is_stable_and_lti_limit():
 
 
 def test_tv_norms_equal_lifted_and_constant_dims():
-    A = _tv_random(6, NA, MA, 0.4)
-    rng = np.random.default_rng(6)
-    sys = ltp.dltpss(A, [rng.standard_normal((m, 2)) for m in MA],
-                     [rng.standard_normal((1, n)) for n in NA], rng.standard_normal((1, 2)))
+    sys = _tv_plant(6, 0.4)
     L = ltp.lift(sys, method='time')
     assert np.isclose(ltp.norm(sys, 2), ct.norm(L, 2) / np.sqrt(5), rtol=1e-9)
     # an independent lower bound from the lifted frequency response on a grid
     grid = max(np.linalg.norm(L(np.exp(1j * w)), 2) for w in np.linspace(0, np.pi, 200))
     assert grid <= ltp.norm(sys, 'inf') * (1 + 1e-9) <= grid * 1.05
     # constant dimensions: the LTPStateSpace norms
+    rng = np.random.default_rng(60)
     s3 = ltp.ltpss(0.4 * rng.standard_normal((3, 3, 3)), rng.standard_normal((3, 3, 2)),
                    rng.standard_normal((3, 1, 3)), 0, period=3.0, dt=1.0)
     assert np.isclose(ltp.norm(ltp.dltpss(s3), 2), ltp.norm(s3, 2), rtol=1e-10)
@@ -433,10 +439,7 @@ def test_tv_balred_bound_and_hsv():
 #
 
 def test_lifting_forms_agree_and_round_trip():
-    A = _tv_random(10, NA, MA, 0.6)
-    rng = np.random.default_rng(10)
-    sys = ltp.dltpss(A, [rng.standard_normal((m, 2)) for m in MA],
-                     [rng.standard_normal((1, n)) for n in NA], rng.standard_normal((1, 2)))
+    sys = _tv_plant(10, 0.6)
     L = ltp.lift(sys, method='time')
     Ast, E, Bst, Cst, Dst = ltp.lift(sys, method='stacked')
     Cy = ltp.lift(sys, method='cyclic')

@@ -143,7 +143,7 @@ def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None, output=False):
     ((1, 2), (1, 2), True)
     """
     check_method(method)
-    if isinstance(sys, DiscreteLTPSystem) or any(is_varying(W) for W in (Q, R, N)):
+    if _time_varying(sys, Q, R, N):
         return tv_dlqr(sys, Q, R, N, integral_action=integral_action)
     sys = as_ltp(sys)
     if not sys.isdtime(strict=True):
@@ -261,15 +261,9 @@ def dlqe(sys, QN, RN, NN=None, *, method=None, G=None, Dw=None):
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
         call works; the periodic algorithm is always used.
-    G : array_like, PeriodicMatrix or callable, optional
-        Noise input matrix (n, q), 2D or one per step when the process noise w does not enter
-        through B (the reference toolbox's separate noise inputs); QN is
-        then (q, q) and NN (q, p).
-    Dw : array_like, PeriodicMatrix or callable, optional
-        Feedthrough (p, q) of w to the measurement, ``y = Cx + Du + Dw w +
-        v``: the filter sees the sensor noise ``Dw w + v`` (covariance
-        ``RN + Dw QN Dwᵀ + Dw NN + NNᵀDwᵀ``) correlated with the process
-        noise (cross term ``G(QN Dwᵀ + NN)``).
+    G, Dw : array_like, PeriodicMatrix or callable, optional
+        Separate noise input matrix (n, q) and its feedthrough (p, q) to the
+        measurement, as in `lqe` (2D, or one matrix per step).
 
     Returns
     -------
@@ -289,7 +283,7 @@ def dlqe(sys, QN, RN, NN=None, *, method=None, G=None, Dw=None):
     ((2, 1), True)
     """
     check_method(method)
-    if isinstance(sys, DiscreteLTPSystem) or any(is_varying(W) for W in (QN, RN, NN)):
+    if _time_varying(sys, QN, RN, NN):
         return tv_dlqe(sys, QN, RN, NN)
     sys = as_ltp(sys)
     if not sys.isdtime(strict=True):
@@ -468,6 +462,12 @@ def _output_weights(sys, Q, R, N, integral_action):
     Nq = C.T @ Q @ D
     N = Nq if N is None else periodic(N, 'N', (n, m)) + Nq
     return C.T @ Q @ C, R + D.T @ Q @ D, N
+
+
+def _time_varying(sys, *weights):
+    """True when the dimensions vary over the period (system or weights): the
+    problem goes to `tvdesign`."""
+    return isinstance(sys, DiscreteLTPSystem) or any(is_varying(W) for W in weights)
 
 
 def _common_period(sys, weights):

@@ -69,38 +69,32 @@ def periodic_minreal(sys, tol=None):
 
 def _reachable_part(sys, tol):
     N = sys.nsteps
-    n = sys.nstates
-    scale = [max(np.linalg.norm(np.hstack([sys.A[k], sys.B[k]]), 2), 1e-300)
-             if sys.A[k].size + sys.B[k].size else 1.0 for k in range(N)]
-    T = [np.zeros((n[k], 0)) for k in range(N)]
-    for _ in range(sum(n) + 2):
+    return _smallest_family(sys, tol, [((k + 1) % N, k, sys.A[k], sys.B[k])
+                                       for k in range(N)])
+
+
+def _observable_part(sys, tol):
+    # the reachable part of the dual: A_kᵀ maps O_(k+1) into O_k, C_kᵀ spans into O_k
+    N = sys.nsteps
+    return _smallest_family(sys, tol, [(k, (k + 1) % N, sys.A[k].T, sys.C[k].T)
+                                       for k in range(N - 1, -1, -1)])
+
+
+def _smallest_family(sys, tol, steps):
+    """Orthonormal bases of the smallest subspaces with ``range G ⊂ S_to`` and
+    ``M S_from ⊂ S_to`` for every ``(to, from, M, G)`` of `steps` (swept in that
+    order until no dimension grows), and the projection of `sys` on them."""
+    T = [np.zeros((nk, 0)) for nk in sys.nstates]
+    scale = [max(np.linalg.norm(np.hstack([M, G]), 2), 1e-300) if M.size + G.size else 1.0
+             for _, _, M, G in steps]
+    for _ in range(sum(sys.nstates) + 2):
         grown = False
-        for k in range(N):
-            k1 = (k + 1) % N
-            T[k1], added = _extend(T[k1], np.hstack([sys.A[k] @ T[k], sys.B[k]]),
-                                   tol * scale[k])
+        for (to, frm, M, G), sc in zip(steps, scale):
+            T[to], added = _extend(T[to], np.hstack([M @ T[frm], G]), tol * sc)
             grown = grown or added
         if not grown:
             break
     return _project(sys, T, T)
-
-
-def _observable_part(sys, tol):
-    N = sys.nsteps
-    n = sys.nstates
-    scale = [max(np.linalg.norm(np.vstack([sys.A[k], sys.C[k]]), 2), 1e-300)
-             if sys.A[k].size + sys.C[k].size else 1.0 for k in range(N)]
-    Z = [np.zeros((n[k], 0)) for k in range(N)]
-    for _ in range(sum(n) + 2):
-        grown = False
-        for k in range(N - 1, -1, -1):
-            k1 = (k + 1) % N
-            Z[k], added = _extend(Z[k], np.hstack([sys.C[k].T, sys.A[k].T @ Z[k1]]),
-                                  tol * scale[k])
-            grown = grown or added
-        if not grown:
-            break
-    return _project(sys, Z, Z)
 
 
 def _extend(T, M, threshold):

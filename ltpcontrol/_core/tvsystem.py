@@ -495,77 +495,91 @@ def _rescaled(A, j):
 #
 
 def series_tv(sys1, sys2):
-    """``sys2 ∘ sys1``: the output of `sys1` drives `sys2` (state ``[x1; x2]``)."""
-    sys1 = as_tv(sys1, sys2 if isinstance(sys2, DiscreteLTPSystem) else None, 'sys1')
-    sys2 = as_tv(sys2, sys1, 'sys2')
-    s1, s2, N, dt = _common(sys1, sys2)
-    A, B, C, D = [], [], [], []
-    for k in range(N):
-        a1, b1, c1, d1 = s1.A[k], s1.B[k], s1.C[k], s1.D[k]
-        a2, b2, c2, d2 = s2.A[k], s2.B[k], s2.C[k], s2.D[k]
+    """``sys2 ∘ sys1``: the output of `sys1` drives `sys2` (state ``[x1; x2]``).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.tvsystem import series_tv
+    >>> P = ltp.dltpss([[[1.0, 2.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+    ...                [[[1.0, 0.0]], [[1.0]]], 0)
+    >>> series_tv(P, 2.0).nstates, series_tv(P, P).nstates      # a gain, a system
+    ((2, 1), (4, 2))
+    """
+    def step(k, a1, b1, c1, d1, a2, b2, c2, d2):
         if c1.shape[0] != b2.shape[1]:
             raise ControlDimension(f"step {k}: sys1 has {c1.shape[0]} outputs but sys2 "
                                    f"has {b2.shape[1]} inputs")
-        A.append(np.block([[a1, np.zeros((a1.shape[0], a2.shape[1]))], [b2 @ c1, a2]]))
-        B.append(np.vstack([b1, b2 @ d1]))
-        C.append(np.hstack([d2 @ c1, c2]))
-        D.append(d2 @ d1)
-    return DiscreteLTPSystem(A, B, C, D, dt)
+        return (np.block([[a1, np.zeros((a1.shape[0], a2.shape[1]))], [b2 @ c1, a2]]),
+                np.vstack([b1, b2 @ d1]), np.hstack([d2 @ c1, c2]), d2 @ d1)
+    return _stepwise(sys1, sys2, step)
 
 
 def parallel_tv(sys1, sys2):
-    """``sys1 + sys2`` (same inputs and outputs at every step)."""
-    sys1 = as_tv(sys1, sys2 if isinstance(sys2, DiscreteLTPSystem) else None, 'sys1')
-    sys2 = as_tv(sys2, sys1, 'sys2')
-    s1, s2, N, dt = _common(sys1, sys2)
-    A, B, C, D = [], [], [], []
-    for k in range(N):
-        if s1.D[k].shape != s2.D[k].shape:
+    """``sys1 + sys2`` (same inputs and outputs at every step).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.tvsystem import parallel_tv
+    >>> P = ltp.dltpss([[[1.0, 2.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+    ...                [[[1.0, 0.0]], [[1.0]]], 0)
+    >>> S = parallel_tv(P, P)
+    >>> S.nstates, bool(np.allclose(ltp.lift(S, method='time').D,
+    ...                             2 * ltp.lift(P, method='time').D))
+    ((4, 2), True)
+    """
+    def step(k, a1, b1, c1, d1, a2, b2, c2, d2):
+        if d1.shape != d2.shape:
             raise ControlDimension(f"step {k}: the systems have input/output shapes "
-                                   f"{s1.D[k].shape} and {s2.D[k].shape}")
-        A.append(_blkdiag(s1.A[k], s2.A[k]))
-        B.append(np.vstack([s1.B[k], s2.B[k]]))
-        C.append(np.hstack([s1.C[k], s2.C[k]]))
-        D.append(s1.D[k] + s2.D[k])
-    return DiscreteLTPSystem(A, B, C, D, dt)
+                                   f"{d1.shape} and {d2.shape}")
+        return (_blkdiag(a1, a2), np.vstack([b1, b2]), np.hstack([c1, c2]), d1 + d2)
+    return _stepwise(sys1, sys2, step)
 
 
 def feedback_tv(sys1, sys2=None, sign=-1):
-    """``u1 = r + sign y2``, ``u2 = y1``; closed loop from r to y1."""
+    """``u1 = r + sign y2``, ``u2 = y1``; closed loop from r to y1.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.tvsystem import feedback_tv
+    >>> P = ltp.dltpss([[[1.0, 2.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+    ...                [[[1.0, 0.0]], [[1.0]]], 0)
+    >>> np.round(feedback_tv(P, 0.4).floquet_multipliers().real, 12)   # 2 - 0.4 * 3
+    array([0.8, 0. ])
+    """
     if sys2 is None:
         sys2 = np.eye(sys1.noutputs[0]) if len(set(sys1.noutputs)) == 1 else None
         if sys2 is None:
             raise ControlArgument("feedback: give the feedback system when the output "
                                   "dimension varies")
-    sys2 = as_tv(sys2, sys1, 'other')
-    s1, s2, N, dt = _common(sys1, sys2)
-    A, B, C, D = [], [], [], []
-    for k in range(N):
-        a1, b1, c1, d1 = s1.A[k], s1.B[k], s1.C[k], s1.D[k]
-        a2, b2, c2, d2 = s2.A[k], s2.B[k], s2.C[k], s2.D[k]
+
+    def step(k, a1, b1, c1, d1, a2, b2, c2, d2):
         m1, p1 = d1.shape[1], d1.shape[0]
         if d2.shape != (m1, p1):
             raise ControlDimension(f"step {k}: the feedback system must map {p1} outputs "
                                    f"to {m1} inputs, got shape {d2.shape}")
         # u1 = r + sign (c2 x2 + d2 y1), y1 = c1 x1 + d1 u1
-        E = np.eye(m1) - sign * d2 @ d1
         try:
-            Einv = np.linalg.inv(E)
+            Einv = np.linalg.inv(np.eye(m1) - sign * d2 @ d1)
         except np.linalg.LinAlgError:
             raise ValueError(f"feedback: the algebraic loop is singular at step {k}") from None
         # u1 = Einv (r + sign d2 c1 x1 + sign c2 x2)
         Fu = Einv @ np.hstack([sign * d2 @ c1, sign * c2])
-        Gu = Einv
-        Y = np.hstack([c1, np.zeros((p1, a2.shape[1]))]) + d1 @ Fu
-        Yr = d1 @ Gu
-        Ax = np.block([[a1, np.zeros((a1.shape[0], a2.shape[1]))],
-                       [b2 @ c1, a2]])
+        Ax = np.block([[a1, np.zeros((a1.shape[0], a2.shape[1]))], [b2 @ c1, a2]])
         Bx = np.vstack([b1, b2 @ d1])
-        A.append(Ax + Bx @ Fu)
-        B.append(Bx @ Gu)
-        C.append(Y)
-        D.append(Yr)
-    return DiscreteLTPSystem(A, B, C, D, dt, name=sys1.name + '$feedback')
+        return (Ax + Bx @ Fu, Bx @ Einv,
+                np.hstack([c1, np.zeros((p1, a2.shape[1]))]) + d1 @ Fu, d1 @ Einv)
+    return _stepwise(sys1, sys2, step, name=sys1.name + '$feedback', other='other')
+
+
+def _stepwise(sys1, sys2, step, name=None, other='sys2'):
+    """The system of the step matrices ``step(k, A1, B1, C1, D1, A2, B2, C2, D2)``
+    of two systems (gains allowed) on their common period."""
+    sys1 = as_tv(sys1, sys2 if isinstance(sys2, DiscreteLTPSystem) else None, 'sys1')
+    sys2 = as_tv(sys2, sys1, other)
+    s1, s2, N, dt = _common(sys1, sys2)
+    mats = [step(k, *(M[k] for M in (s1.A, s1.B, s1.C, s1.D, s2.A, s2.B, s2.C, s2.D)))
+            for k in range(N)]
+    return DiscreteLTPSystem(*(list(M) for M in zip(*mats)), dt=dt, name=name)
 
 
 def _common(s1, s2):
