@@ -135,7 +135,16 @@ def _sqrt_factor(X):
 
 
 def tv_hsvd(sys):
-    """Hankel singular values per step (list of arrays, decreasing)."""
+    """Hankel singular values per step (list of arrays, decreasing; ``n_k`` at step k).
+
+    Examples
+    --------
+    >>> from ltpcontrol._analysis.minimal import tv_hsvd
+    >>> sys = ltp.dltpss([[[0.5, 0.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+    ...                  [[[1.0, 1.0]], [[1.0]]], 0)
+    >>> [len(s) for s in tv_hsvd(sys)]
+    [2, 1]
+    """
     P = tv_gram(sys, 'c')
     Q = tv_gram(sys, 'o')
     return [np.linalg.svd(_sqrt_factor(Qk).T @ _sqrt_factor(Pk), compute_uv=False)
@@ -147,6 +156,17 @@ def tv_balred(sys, r):
 
     Returns the reduced system and the a-priori bound on the ℓ2 gain of the
     error (module notes).
+
+    Examples
+    --------
+    A weakly coupled second mode (Hankel singular value 4.7e-6):
+
+    >>> from ltpcontrol._analysis.minimal import tv_balred
+    >>> sys = ltp.dltpss([np.diag([0.5, 0.1]), 0.3 * np.eye(2)], [[[1.0], [0.01]]],
+    ...                  [[[1.0, 0.01]]], 0)
+    >>> red, bound = tv_balred(sys, 1)
+    >>> red.nstates, float(np.round(bound, 8))       # 2 * 4.7e-6
+    ((1, 1), 9.45e-06)
     """
     P = tv_gram(sys, 'c')
     Q = tv_gram(sys, 'o')

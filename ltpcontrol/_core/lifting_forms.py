@@ -49,7 +49,18 @@ _FORMS = ('time', 'stacked', 'cyclic')
 
 
 def lift_form(sys, method, *, start=0, sparse=False, name=None, nharmonics=None):
-    """`ltpcontrol.lift` for the time-domain forms and `DiscreteLTPSystem`."""
+    """`ltpcontrol.lift` for the time-domain forms and `DiscreteLTPSystem` (module notes).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.lifting_forms import lift_form
+    >>> sys = ltp.dltpss([[[1.0, 2.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+    ...                  [[[1.0, 0.0]], [[1.0]]], 0)
+    >>> lift_form(sys, 'time').nstates, lift_form(sys, 'time', start=1).nstates
+    (2, 1)
+    >>> [M.shape for M in lift_form(sys, 'stacked')]           # A, E, B, C, D
+    [(3, 3), (3, 3), (3, 2), (2, 3), (2, 2)]
+    """
     if method not in _FORMS:
         raise ValueError(f"method must be one of {_FORMS} for this system, got {method!r}")
     if nharmonics is not None:

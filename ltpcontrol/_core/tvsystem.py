@@ -85,13 +85,8 @@ class DiscreteLTPSystem:
         names = ['A', 'B', 'C', 'D'][:len(seqs)]
         N = common_steps([len(s) for s in seqs], names)
         A, B, C = (tuple(s[k % len(s)] for k in range(N)) for s in (A, B, C))
-        n = tuple(a.shape[1] for a in A)
+        n = tuple(check_chain(A, 'A'))
         for k in range(N):
-            if A[k].shape[0] != n[(k + 1) % N]:
-                raise ControlDimension(
-                    f"A[{k}] has {A[k].shape[0]} rows but A[{(k + 1) % N}] has "
-                    f"{n[(k + 1) % N]} columns: the dimension chain n_(k+1) x n_k "
-                    "does not close")
             if B[k].shape[0] != A[k].shape[0]:
                 raise ControlDimension(f"B[{k}] must have {A[k].shape[0]} rows (n_{k + 1}), "
                                        f"got shape {B[k].shape}")
@@ -355,8 +350,43 @@ def dltpss(A, B=None, C=None, D=0, dt=1.0, *, name=None):
     return DiscreteLTPSystem(A, B, C, D, dt, name=name)
 
 
+def check_chain(A, name='A'):
+    """Dimensions ``n_k`` of a closed chain ``A_k: n_k -> n_{k+1}`` (ControlDimension if open).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.tvsystem import check_chain
+    >>> check_chain([np.ones((1, 2)), np.ones((2, 1))])
+    [2, 1]
+    >>> check_chain([np.ones((1, 2)), np.ones((3, 1))])
+    Traceback (most recent call last):
+    ...
+    control.exception.ControlDimension: A[1] has 3 rows but A[0] has 2 columns: the dimension chain n_(k+1) x n_k does not close
+    """
+    N = len(A)
+    n = [a.shape[1] for a in A]
+    for k in range(N):
+        if A[k].shape[0] != n[(k + 1) % N]:
+            raise ControlDimension(f"{name}[{k}] has {A[k].shape[0]} rows but "
+                                   f"{name}[{(k + 1) % N}] has {n[(k + 1) % N]} columns: the "
+                                   "dimension chain n_(k+1) x n_k does not close")
+    return n
+
+
 def as_tv(sys, like=None, name='sys'):
-    """Return `sys` as a `DiscreteLTPSystem` (LTPStateSpace, static gain allowed)."""
+    """Return `sys` as a `DiscreteLTPSystem` (LTPStateSpace, static gain allowed).
+
+    A discrete-time `LTPStateSpace` or `control.StateSpace` is converted; a
+    number or matrix becomes a static gain with the sampling time of `like`.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.tvsystem import as_tv
+    >>> sysd = ltp.ltpss(np.array([[[0.5]], [[0.2]]]), [[1.0]], [[1.0]], 0,
+    ...                  period=2.0, dt=1.0)
+    >>> as_tv(sysd).nstates, as_tv([[2.0, 1.0]], like=as_tv(sysd)).nstates
+    ((1, 1), (0,))
+    """
     if isinstance(sys, DiscreteLTPSystem):
         return sys
     if hasattr(sys, 'nsteps') and hasattr(sys, 'isdtime') and sys.isdtime(strict=True):
