@@ -77,17 +77,23 @@ def test_lyap_continuous_subperiods():
 
 
 def _mathieu_sub_periods():
-    """A of period 1 and a state weight of period 1.5 (common period 3)."""
-    A = ltp.PeriodicMatrix.from_function(
-        lambda t: np.array([[0.0, 1.0], [-1 - 0.3 * np.cos(2 * np.pi * t), -0.2]]), 1.0)
-    Q = ltp.PeriodicMatrix.from_function(
-        lambda t: np.diag([1 + 0.5 * np.sin(2 * np.pi * t / 1.5), 1.0]), 1.5)
+    """A of period 1 and a state weight of period 1.5 (common period 3), both in
+    Fourier form (exact interpolants of their 8 samples)."""
+    t = np.arange(8) / 8
+    A = ltp.PeriodicMatrix.from_samples(
+        [[[0.0, 1.0], [-1 - 0.3 * np.cos(2 * np.pi * s), -0.2]] for s in t], 1.0)
+    Q = ltp.PeriodicMatrix.from_samples(
+        [np.diag([1 + 0.5 * np.sin(2 * np.pi * s), 1.0]) for s in t], 1.5)
     return ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=1.0), Q
 
 
 def test_care_lqr_lqe_continuous_subperiods():
-    sys, Q = _mathieu_sub_periods()
+    sys, _ = _mathieu_sub_periods()
     R = [[1.0]]
+    # an output weight of period 1.5: the state weight CᵀQyC, period 3 with A's 1
+    Qy = ltp.PeriodicMatrix.from_samples(
+        [[[1 + 0.5 * np.sin(2 * np.pi * s / 8)]] for s in range(8)], 1.5)
+    Q = sys.C.T @ Qy @ sys.C
     X, E, G = ltp.care(sys.A, sys.B, Q, R)
     assert np.isclose(X.period, 3.0) and np.all(E.real < 0)
     # truth: the Riccati equation at the three phases of A (central differences)
@@ -97,15 +103,9 @@ def test_care_lqr_lqe_continuous_subperiods():
         a, b, x = sys.A(ti), sys.B(ti), X(ti)
         res = dX + a.T @ x + x @ a - x @ b @ b.T @ x + Q(ti)
         assert np.abs(res).max() < 1e-5 * np.abs(x).max()
-    K, Xl, _ = ltp.lqr(sys, Q, R)
+    K, Xl, _ = ltp.lqr(sys, Qy, R, output=True)
     assert np.isclose(K.period, 3.0)
     assert np.abs(Xl(t) - X(t)).max() < 1e-9 * np.abs(X(t)).max()
-    # an output weight of period 1.5 is the state weight CᵀQyC of period 3
-    Qy = ltp.PeriodicMatrix.from_function(
-        lambda t: np.array([[1 + 0.5 * np.sin(2 * np.pi * t / 1.5)]]), 1.5)
-    Ky, _, _ = ltp.lqr(sys, Qy, R, output=True)
-    Ks, _, _ = ltp.lqr(sys, sys.C.T @ Qy @ sys.C, R)
-    assert np.isclose(Ky.period, 3.0) and np.abs(Ky(t) - Ks(t)).max() < 1e-12
     L, P, E = ltp.lqe(sys, [[1.0]], 0.1 * Qy)
     assert np.isclose(L.period, 3.0) and np.isclose(P.period, 3.0) and np.all(E.real < 0)
 
