@@ -358,10 +358,10 @@ def check_chain(A, name='A'):
     >>> from ltpcontrol._core.tvsystem import check_chain
     >>> check_chain([np.ones((1, 2)), np.ones((2, 1))])
     [2, 1]
-    >>> check_chain([np.ones((1, 2)), np.ones((3, 1))])
+    >>> check_chain([np.ones((1, 2)), np.ones((3, 1))])  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    control.exception.ControlDimension: A[1] has 3 rows but A[0] has 2 columns: the dimension chain n_(k+1) x n_k does not close
+    control.exception.ControlDimension: A[1] has 3 rows but A[0] has 2 columns: ...
     """
     N = len(A)
     n = [a.shape[1] for a in A]
@@ -429,7 +429,7 @@ def _floquet_multipliers(sys, nsteps=None):
 
 @override('floquet_exponents', DiscreteLTPSystem)
 def _floquet_exponents(sys, nsteps=None):
-    """`ltpcontrol.floquet_exponents`: the per-step values ``μ^{1/N}`` (`DiscreteLTPSystem.poles`).
+    """`ltpcontrol.floquet_exponents`: the per-step values ``μ^{1/N}`` (see `poles`).
 
     Examples
     --------
