@@ -66,6 +66,7 @@ from ._identification.montecarlo import monte_carlo, MonteCarloResult
 from ._identification.scenarios import sample_models
 from .storage import save, load
 from ._core.tvsystem import DiscreteLTPSystem, dltpss
+from ._core import tvresponse as _tv_response  # noqa: F401  (registers the overrides)
 from ._core.lifting_forms import unlift
 from ._core.multirate import sample_multirate
 from ._analysis.multirate_loop import lifted_margins

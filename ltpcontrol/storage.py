@@ -14,7 +14,8 @@ Object kinds: `PeriodicMatrix` in the Fourier, switching (sampled with
 ``kind='hold'`` included) and data-backed callable forms (the solutions and
 gains of `care` and `lqr`, Floquet transforms) and their pointwise
 combinations by the library's operations; `LTPStateSpace` (continuous and
-discrete time, identified models included); `HTFData`; `HTFModel` (stored
+discrete time, identified models included); `DiscreteLTPSystem` (its
+matrices step by step, dimensions varying with k); `HTFData`; `HTFModel` (stored
 as its system and options and rebuilt on load); `CampbellDiagram` (its
 tracks, labels and crossings, without the modes of every value).  A matrix defined by an
 arbitrary Python function cannot be stored: sample it first.
@@ -28,6 +29,7 @@ import numpy as np
 
 from ._core import pm_ops
 from ._core.ltpsys import LTPStateSpace
+from ._core.tvsystem import DiscreteLTPSystem
 from ._core.periodic_matrix import PeriodicMatrix
 from ._frequency.htf import HTFData, HTFModel
 from ._rotors.campbell import CampbellDiagram
@@ -45,7 +47,7 @@ def save(path, obj):
     ----------
     path : str or os.PathLike
         File name (``.npz`` is appended by NumPy when missing).
-    obj : LTPStateSpace, PeriodicMatrix, HTFData, HTFModel or CampbellDiagram
+    obj : LTPStateSpace, DiscreteLTPSystem, PeriodicMatrix, HTFData, HTFModel or CampbellDiagram
         Object to store (a Campbell diagram without the Floquet modes of
         its values).
 
@@ -90,7 +92,7 @@ def load(path):
 
     Returns
     -------
-    LTPStateSpace, PeriodicMatrix, HTFData, HTFModel or CampbellDiagram
+    LTPStateSpace, DiscreteLTPSystem, PeriodicMatrix, HTFData, HTFModel or CampbellDiagram
 
     Raises
     ------
@@ -158,6 +160,9 @@ def _encode(obj, arrays):
                 'name': obj.name, 'inputs': list(obj.input_labels),
                 'outputs': list(obj.output_labels), 'states': list(obj.state_labels),
                 **{k: _encode_matrix(getattr(obj, k), arrays) for k in 'ABCD'}}
+    if type(obj) is DiscreteLTPSystem:      # the matrices of every step, any shapes
+        return {'kind': 'DiscreteLTPSystem', 'dt': float(obj.dt), 'name': obj.name,
+                **{k: [_array(M, arrays) for M in getattr(obj, k)] for k in 'ABCD'}}
     if type(obj) is HTFData:
         return {'kind': 'HTFData', 'period': obj.period, 'name': obj.name,
                 'inputs': list(obj.input_labels), 'outputs': list(obj.output_labels),
@@ -180,7 +185,8 @@ def _encode(obj, arrays):
             node[key] = None if value is None else _array(value, arrays)
         return node
     raise TypeError(f"save: cannot store a {type(obj).__name__}; supported are "
-                    "LTPStateSpace, PeriodicMatrix, HTFData, HTFModel and CampbellDiagram")
+                    "LTPStateSpace, DiscreteLTPSystem, PeriodicMatrix, HTFData, HTFModel and "
+                    "CampbellDiagram")
 
 
 _CAMPBELL_ARRAYS = ('values', 'exponents', 'frequency', 'damped_frequency', 'damping',
@@ -244,6 +250,11 @@ def _decode(node, members):
         return LTPStateSpace(*mats, float(node['period']), dt=float(node['dt']),
                              name=node['name'], inputs=node['inputs'],
                              outputs=node['outputs'], states=node['states'])
+    if kind == 'DiscreteLTPSystem':         # the constructor checks the dimension chain
+        mats = [[np.asarray(_get(ref, members), float) for ref in node[k]] for k in 'ABCD']
+        if any(M.ndim != 2 for seq in mats for M in seq) or not mats[0]:
+            raise ValueError("a discrete periodic system's matrices are not 2D")
+        return DiscreteLTPSystem(*mats, dt=float(node['dt']), name=node['name'])
     if kind == 'HTFData':
         std = None if node['std'] is None else _get(node['std'], members)
         return HTFData(_get(node['components'], members), _get(node['omega'], members),

@@ -285,7 +285,7 @@ def test_bad_input_names_the_argument():
     with pytest.raises(ControlDimension, match="R must have shape"):
         ltp.lqr(good, np.eye(2), np.eye(2))
     with pytest.raises(ValueError, match="period"):
-        ltp.lqr(good, ltp.PeriodicMatrix.constant(np.eye(2), 0.3), [[1.0]])
+        ltp.lqr(good, ltp.PeriodicMatrix.constant(np.eye(2), np.sqrt(2)), [[1.0]])
     with pytest.raises(ControlArgument, match="sys must be an LTPStateSpace"):
         ltp.lqr(ct.ss(good.A(0), good.B(0), np.eye(2), 0), np.eye(2), [[1.0]])
     with pytest.raises(ValueError, match="RN must be positive definite"):

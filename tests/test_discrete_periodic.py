@@ -9,6 +9,7 @@ closed-loop simulation.
 import numpy as np
 import control as ct
 import pytest
+import scipy.signal
 from control.exception import ControlDimension
 from hypothesis import given, settings, strategies as st
 
@@ -20,6 +21,14 @@ NA, MA = [5, 3, 3, 4, 1], [3, 3, 4, 1, 5]       # the reference toolbox's dims
 def _tv_random(seed, na, ma, scale=1.0):
     rng = np.random.default_rng(seed)
     return [scale * rng.standard_normal((m, n)) for n, m in zip(na, ma)]
+
+
+def _tv_plant(seed, scale):
+    """Two inputs, one output, states [5, 3, 3, 4, 1] (the toolbox's dimensions)."""
+    A = _tv_random(seed, NA, MA, scale)
+    rng = np.random.default_rng(seed)
+    return ltp.dltpss(A, [rng.standard_normal((m, 2)) for m in MA],
+                      [rng.standard_normal((1, n)) for n in NA], rng.standard_normal((1, 2)))
 
 
 def _sym(rng, n):
@@ -65,6 +74,51 @@ def test_lyap_continuous_subperiods():
     assert np.isclose(X.period, 6.0)
     X6 = ltp.lyap(A.with_period(6.0), Q.with_period(6.0))
     assert np.abs(X(1.3) - X6(1.3)).max() < 1e-9
+
+
+def _mathieu_sub_periods():
+    """A of period 1 and a state weight of period 1.5 (common period 3), both in
+    Fourier form (exact interpolants of their 8 samples)."""
+    t = np.arange(8) / 8
+    A = ltp.PeriodicMatrix.from_samples(
+        [[[0.0, 1.0], [-1 - 0.3 * np.cos(2 * np.pi * s), -0.2]] for s in t], 1.0)
+    Q = ltp.PeriodicMatrix.from_samples(
+        [np.diag([1 + 0.5 * np.sin(2 * np.pi * s), 1.0]) for s in t], 1.5)
+    return ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=1.0), Q
+
+
+def test_care_lqr_lqe_continuous_subperiods():
+    sys, _ = _mathieu_sub_periods()
+    R = [[1.0]]
+    # an output weight of period 1.5: the state weight CᵀQyC, period 3 with A's 1
+    Qy = ltp.PeriodicMatrix.from_samples(
+        [[[1 + 0.5 * np.sin(2 * np.pi * s / 8)]] for s in range(8)], 1.5)
+    Q = sys.C.T @ Qy @ sys.C
+    X, E, G = ltp.care(sys.A, sys.B, Q, R)
+    assert np.isclose(X.period, 3.0) and np.all(E.real < 0)
+    # truth: the Riccati equation at the three phases of A (central differences)
+    h, t = 1e-5, np.array([0.4, 1.3, 2.2])
+    for ti in t:
+        dX = (X(ti + h) - X(ti - h)) / (2 * h)
+        a, b, x = sys.A(ti), sys.B(ti), X(ti)
+        res = dX + a.T @ x + x @ a - x @ b @ b.T @ x + Q(ti)
+        assert np.abs(res).max() < 1e-5 * np.abs(x).max()
+    K, Xl, _ = ltp.lqr(sys, Qy, R, output=True)
+    assert np.isclose(K.period, 3.0)
+    assert np.abs(Xl(t) - X(t)).max() < 1e-9 * np.abs(X(t)).max()
+    L, P, E = ltp.lqe(sys, [[1.0]], 0.1 * Qy)
+    assert np.isclose(L.period, 3.0) and np.isclose(P.period, 3.0) and np.all(E.real < 0)
+
+
+def test_continuous_incommensurate_weights_named():
+    sys, _ = _mathieu_sub_periods()
+    Qi = ltp.PeriodicMatrix.constant(np.eye(2), np.sqrt(2))
+    with pytest.raises(ValueError, match="Q: periods"):
+        ltp.lqr(sys, Qi, [[1.0]])
+    with pytest.raises(ValueError, match="Q: periods"):
+        ltp.care(sys.A, sys.B, Qi, [[1.0]])
+    with pytest.raises(ValueError, match="RN: periods"):
+        ltp.lqe(sys, [[1.0]], ltp.PeriodicMatrix.constant([[1.0]], np.sqrt(2)))
 
 
 def test_dare_dlqr_subperiods():
@@ -191,16 +245,14 @@ def test_tv_dlqe_is_stable_and_lti_limit():
 
 
 def test_tv_norms_equal_lifted_and_constant_dims():
-    A = _tv_random(6, NA, MA, 0.4)
-    rng = np.random.default_rng(6)
-    sys = ltp.dltpss(A, [rng.standard_normal((m, 2)) for m in MA],
-                     [rng.standard_normal((1, n)) for n in NA], rng.standard_normal((1, 2)))
+    sys = _tv_plant(6, 0.4)
     L = ltp.lift(sys, method='time')
     assert np.isclose(ltp.norm(sys, 2), ct.norm(L, 2) / np.sqrt(5), rtol=1e-9)
     # an independent lower bound from the lifted frequency response on a grid
     grid = max(np.linalg.norm(L(np.exp(1j * w)), 2) for w in np.linspace(0, np.pi, 200))
     assert grid <= ltp.norm(sys, 'inf') * (1 + 1e-9) <= grid * 1.05
     # constant dimensions: the LTPStateSpace norms
+    rng = np.random.default_rng(60)
     s3 = ltp.ltpss(0.4 * rng.standard_normal((3, 3, 3)), rng.standard_normal((3, 3, 2)),
                    rng.standard_normal((3, 1, 3)), 0, period=3.0, dt=1.0)
     assert np.isclose(ltp.norm(ltp.dltpss(s3), 2), ltp.norm(s3, 2), rtol=1e-10)
@@ -303,17 +355,69 @@ def test_minreal_lti_written_as_periodic_equals_python_control():
         assert red.nstates == want.nstates == 2
         got = np.sort_complex(np.linalg.eigvals(red.A(0.0)))
         np.testing.assert_allclose(got, np.sort_complex(np.linalg.eigvals(want.A)), rtol=1e-8)
+
+
+def _pole_zero_pair(c):
+    """(s+1)(s+c)/((s+2)(s²+s+1)) as a 3-state (controllable canonical) realization."""
+    num = np.polymul([1.0, 1.0], [1.0, c])
+    den = np.polymul([1.0, 2.0], [1.0, 1.0, 1.0])
+    return ct.ss(*scipy.signal.tf2ss(num, den))
+
+
+def _in_periodic_basis(G, N, seed):
+    """The discrete LTI system G in the state basis x_k = T_k z_k (N steps)."""
+    rng = np.random.default_rng(seed)
+    n = G.nstates
+    T = [np.linalg.qr(rng.standard_normal((n, n)))[0] @ np.diag(rng.uniform(0.5, 2.0, n))
+         for _ in range(N)]
+    A = [np.linalg.solve(T[(k + 1) % N], G.A @ T[k]) for k in range(N)]
+    B = [np.linalg.solve(T[(k + 1) % N], G.B) for k in range(N)]
+    return ltp.dltpss(A, B, [G.C @ T[k] for k in range(N)], [G.D], G.dt)
+
+
+@pytest.mark.parametrize('c', [2.00000000001, 2.0])
+def test_minreal_near_cancellation_as_python_control(c):
+    # python-control's near-cancellation test (xferfcn_test.test_minreal,
+    # minreal_test.testMinrealtf): TransferFunction.minreal cancels the pole -2
+    # against the zero -c with its default tolerance 1000 sqrt(eps)|z|
     s = ct.tf('s')
-    h = (s + 1) * (s + 2.00000000001) / (s + 2) / (s ** 2 + s + 1)
-    assert ct.minreal(h, verbose=False).den[0][0].size - 1 == 2
-    for sys in (ct.ss(h), ct.c2d(ct.ss(h), 0.1)):
-        P = ltp.ltpss(sys, period=0.2) if sys.dt == 0 else \
-            ltp.ltpss(sys.A, sys.B, sys.C, sys.D, period=0.2, dt=0.1)
-        # python-control's tolerance: the same order as ct.minreal of the state space
-        assert ltp.minreal(P).nstates == ct.minreal(sys, verbose=False).nstates
-        # a tolerance above the 1e-11 separation cancels the pair, as ct.minreal(h) does
-        assert ltp.minreal(P, tol=1e-9).nstates == ct.minreal(sys, tol=1e-9,
-                                                              verbose=False).nstates == 2
+    h = (s + 1) * (s + c) / (s + 2) / (s ** 2 + s + 1)
+    hm = ct.minreal(h, verbose=False)
+    hr = (s + 1) / (s ** 2 + s + 1)
+    np.testing.assert_array_almost_equal(hm.num[0][0], hr.num[0][0])
+    np.testing.assert_array_almost_equal(hm.den[0][0], hr.den[0][0])
+    G = _pole_zero_pair(c)
+    assert G.nstates == 3
+    # continuous, constant matrices: the same cancellation, the same reduced tf
+    red = ltp.minreal(ltp.ltpss(G, period=0.2))
+    assert red.nstates == 2
+    got = ct.tf(red.to_ss())
+    lead = got.den[0][0][0]
+    np.testing.assert_array_almost_equal(got.num[0][0][-2:] / lead, hr.num[0][0])
+    np.testing.assert_array_almost_equal(got.den[0][0] / lead, hr.den[0][0])
+    # discrete, through the periodic staircase: the sampled system in a random
+    # periodic basis (3 steps) against the sampled python-control result
+    Gd = ct.c2d(G, 0.1)
+    hd = ct.minreal(ct.tf(Gd), verbose=False)
+    assert hd.den[0][0].size - 1 == 2
+    P = _in_periodic_basis(Gd, 3, seed=1)
+    assert ltp.minreal(ltp.ltpss(Gd.A, Gd.B, Gd.C, Gd.D, period=0.3, dt=0.1)).nstates == 2
+    redd = ltp.minreal(P)
+    assert redd.nstates == (2, 2, 2)
+    L = ltp.lift(redd, method='time')
+    Lw = ltp.lift(ltp.ltpss(ct.ss(hd), period=0.3), method='time')
+    for z in (0.3 + 0.2j, np.exp(0.7j), 2.0):
+        np.testing.assert_allclose(L(z), Lw(z), rtol=1e-9, atol=1e-9)
+
+
+def test_minreal_keeps_a_pair_python_control_keeps():
+    # a pole-zero pair 1e-3 apart is no cancellation for python-control
+    s = ct.tf('s')
+    h = (s + 1) * (s + 2.001) / (s + 2) / (s ** 2 + s + 1)
+    assert ct.minreal(h, verbose=False).den[0][0].size - 1 == 3
+    G = _pole_zero_pair(2.001)
+    assert ltp.minreal(ltp.ltpss(G, period=0.2)).nstates == 3
+    assert ltp.minreal(_in_periodic_basis(ct.c2d(G, 0.1), 3, seed=2)).nstates == (3, 3, 3)
 
 
 def test_tv_balred_bound_and_hsv():
@@ -335,10 +439,7 @@ def test_tv_balred_bound_and_hsv():
 #
 
 def test_lifting_forms_agree_and_round_trip():
-    A = _tv_random(10, NA, MA, 0.6)
-    rng = np.random.default_rng(10)
-    sys = ltp.dltpss(A, [rng.standard_normal((m, 2)) for m in MA],
-                     [rng.standard_normal((1, n)) for n in NA], rng.standard_normal((1, 2)))
+    sys = _tv_plant(10, 0.6)
     L = ltp.lift(sys, method='time')
     Ast, E, Bst, Cst, Dst = ltp.lift(sys, method='stacked')
     Cy = ltp.lift(sys, method='cyclic')
@@ -489,3 +590,88 @@ def test_tv_hankel_norm_equals_constant_dimension_norm():
     s3 = ltp.ltpss(0.4 * rng.standard_normal((3, 3, 3)), rng.standard_normal((3, 3, 2)),
                    rng.standard_normal((3, 1, 3)), 0, period=3.0, dt=1.0)
     assert np.isclose(ltp.norm(ltp.dltpss(s3), 'hankel'), ltp.norm(s3, 'hankel'), rtol=1e-9)
+
+
+#
+# Storage and time responses
+#
+
+def _varying_states():
+    rng = np.random.default_rng(12)
+    n = [2, 1, 3]
+    A = [0.6 * rng.standard_normal((n[(k + 1) % 3], n[k])) for k in range(3)]
+    B = [rng.standard_normal((n[(k + 1) % 3], 2)) for k in range(3)]
+    C = [rng.standard_normal((1, n[k])) for k in range(3)]
+    return ltp.dltpss(A, B, C, list(rng.standard_normal((3, 1, 2))), 0.05, name='plant')
+
+
+def test_save_load_time_varying_dimensions(tmp_path):
+    sys = _varying_states()
+    gain = ltp.dltpss([np.zeros((0, 0))], [np.zeros((0, 2))], [np.zeros((1, 0))],
+                      [[[1.0, -2.0]]], 0.05)             # no state at all
+    for obj in (sys, gain, ltp.minreal(sys + sys)):
+        path = tmp_path / 'tv.npz'
+        ltp.save(path, obj)
+        back = ltp.load(path)
+        assert isinstance(back, ltp.DiscreteLTPSystem)
+        assert (back.nstates, back.ninputs, back.noutputs, back.dt, back.name) == \
+            (obj.nstates, obj.ninputs, obj.noutputs, obj.dt, obj.name)
+        for k in 'ABCD':
+            assert all(np.array_equal(a, b) for a, b in zip(getattr(back, k), getattr(obj, k)))
+    # a file whose dimension chain does not close is refused as corrupt
+    import json
+    ltp.save(tmp_path / 'tv.npz', sys)             # states (2, 1, 3)
+    data = dict(np.load(tmp_path / 'tv.npz'))
+    tree = json.loads(str(data['tree']))
+    tree['A'][1] = tree['A'][0]                    # A_1 now 1x2 where 3x1 belongs
+    data['tree'] = np.array(json.dumps(tree))
+    np.savez(tmp_path / 'bad.npz', **data)
+    with pytest.raises(ValueError, match='corrupt'):
+        ltp.load(tmp_path / 'bad.npz')
+
+
+def test_forced_response_equals_lifted_simulation():
+    sys = _varying_states()
+    N, P = 3, 4                                    # four periods
+    rng = np.random.default_rng(13)
+    U = rng.standard_normal((2, N * P))
+    resp = ltp.forced_response(sys, inputs=U)
+    np.testing.assert_allclose(resp.time, np.arange(N * P) * 0.05)
+    assert resp.states.shape == (0, N * P)         # the state dimension varies
+    # truth: the time-lifted LTI system simulated by python-control
+    L = ltp.lift(sys, method='time')
+    Ul = U.reshape(2, P, N).transpose(2, 0, 1).reshape(N * 2, P)   # [u_0; u_1; u_2] per period
+    yl = ct.forced_response(L, inputs=Ul).outputs.reshape(N, P)
+    np.testing.assert_allclose(resp.outputs[0], yl.T.reshape(-1), rtol=1e-12, atol=1e-12)
+    # a start at step 1 with an initial state of n_1 entries: the shifted system
+    x0 = rng.standard_normal(sys.nstates[1])
+    r1 = ltp.forced_response(sys, 0.05 * np.arange(1, 7), U[:, :6], x0)
+    y1, _ = sys.shifted(1).forced_response(U[:, :6].T, x0)
+    np.testing.assert_allclose(r1.outputs[0], y1[:, 0], rtol=1e-14)
+    # several traces at once, and the free response
+    Um = rng.standard_normal((2, 3, 6))
+    rm = ltp.forced_response(sys, inputs=Um)
+    for i in range(3):
+        np.testing.assert_allclose(rm.outputs[0, i], ltp.forced_response(
+            sys, inputs=Um[:, i]).outputs[0], rtol=1e-14)
+    x0 = rng.standard_normal(sys.nstates[0])
+    free = ltp.initial_response(sys, 0.05 * 5, x0)
+    np.testing.assert_allclose(free.outputs, ltp.forced_response(
+        sys, 0.05 * np.arange(6), np.zeros((2, 6)), x0).outputs[0], rtol=1e-14)
+
+
+def test_forced_response_constant_dims_states_and_refusals():
+    rng = np.random.default_rng(14)
+    sys = ltp.dltpss(list(0.5 * rng.standard_normal((2, 2, 2))), [[[1.0], [0.0]]],
+                     [[[1.0, 1.0]]], 0)
+    U = rng.standard_normal(5)
+    resp = ltp.forced_response(sys, inputs=U, initial_state=[1.0, -1.0])
+    _, xs = sys.forced_response(U[:, None], [1.0, -1.0])
+    np.testing.assert_allclose(resp.states, np.array(xs[:-1]).T, rtol=1e-15)
+    varying_inputs = ltp.dltpss([[[0.5]], [[0.5]]], [[[1.0]], [[1.0, 1.0]]], [[[1.0]]], 0)
+    with pytest.raises(ControlDimension, match='number of inputs varies'):
+        ltp.forced_response(varying_inputs, inputs=np.ones(4))
+    with pytest.raises(ControlDimension, match='initial_state'):
+        ltp.forced_response(_varying_states(), inputs=np.ones((2, 3)), initial_state=[1.0])
+    with pytest.raises(ValueError, match='multiples of dt'):
+        ltp.forced_response(_varying_states(), [0.0, 0.07], np.ones((2, 2)))

@@ -25,7 +25,7 @@ from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .riccati import _GainTable, _care_solution, _check_weights, _table_edges, care, dare
 from .._core.coerce import as_ltp
 from .._core.validation import check_method, real_array
-from .._core.subperiods import align_weights
+from .._core.subperiods import align_weights, common_period
 from .._core.tvsystem import DiscreteLTPSystem
 from .tvlyap import is_varying
 from .tvdesign import tv_dlqe, tv_dlqr
@@ -143,7 +143,7 @@ def dlqr(sys, Q, R, N=None, *, integral_action=None, method=None, output=False):
     ((1, 2), (1, 2), True)
     """
     check_method(method)
-    if isinstance(sys, DiscreteLTPSystem) or any(is_varying(W) for W in (Q, R, N)):
+    if _time_varying(sys, Q, R, N):
         return tv_dlqr(sys, Q, R, N, integral_action=integral_action)
     sys = as_ltp(sys)
     if not sys.isdtime(strict=True):
@@ -215,8 +215,9 @@ def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None, G=None, Dw=None):
     check_method(method)
     if _discrete(sys, nsteps):
         return dlqe(sys, QN, RN, NN)
-    T = sys.period
-    G = sys.B if G is None else as_periodic(G, T, 'G')
+    T = _common_period(sys, {'G': G, 'QN': QN, 'RN': RN, 'NN': NN, 'Dw': Dw})
+    A, C = sys.A.with_period(T), sys.C.with_period(T)
+    G = sys.B.with_period(T) if G is None else as_periodic(G, T, 'G')
     if G.shape[0] != sys.nstates:
         raise ControlDimension(f"G must have {sys.nstates} rows, got shape {G.shape}")
     QN = as_periodic(QN, T, 'QN', shape=(G.shape[1],) * 2)
@@ -229,12 +230,12 @@ def lqe(sys, QN, RN, NN=None, nsteps=None, *, method=None, G=None, Dw=None):
         NN = QN @ Dw.T + NN
     probe = np.arange(16) * T / 16
     _check_weights(QN(probe), RN(probe), 'QN', 'RN')
-    if all(M.is_constant for M in (sys.A, G, sys.C, QN, RN, NN)):   # LTI data
-        X, E, Gd, _ = _care_solution(sys.A.T, sys.C.T, G @ QN @ G.T, RN, G @ NN, T, nsteps)
+    if all(M.is_constant for M in (A, G, C, QN, RN, NN)):   # LTI data
+        X, E, Gd, _ = _care_solution(A.T, C.T, G @ QN @ G.T, RN, G @ NN, T, nsteps)
         L = PeriodicMatrix.constant(Gd(0.0).T, T)
-        E = lti_representatives(E, sys.A(0.0) - L(0.0) @ sys.C(0.0), period=T)
+        E = lti_representatives(E, A(0.0) - L(0.0) @ C(0.0), period=T)
         return L, X, E
-    X, E, Gd, exact = _care_solution(_reverse(sys.A, True), _reverse(sys.C, True),
+    X, E, Gd, exact = _care_solution(_reverse(A, True), _reverse(C, True),
                                     _reverse(G @ QN @ G.T, False), _reverse(RN, False),
                                     _reverse(G @ NN, False), T, nsteps)
     L = _reversed_gain(exact, T - Gd.function.grid[::-1])
@@ -260,15 +261,9 @@ def dlqe(sys, QN, RN, NN=None, *, method=None, G=None, Dw=None):
     method : {None, 'slycot', 'scipy'}, optional
         python-control's choice of LTI solver, accepted so that the same
         call works; the periodic algorithm is always used.
-    G : array_like, PeriodicMatrix or callable, optional
-        Noise input matrix (n, q), 2D or one per step when the process noise w does not enter
-        through B (the reference toolbox's separate noise inputs); QN is
-        then (q, q) and NN (q, p).
-    Dw : array_like, PeriodicMatrix or callable, optional
-        Feedthrough (p, q) of w to the measurement, ``y = Cx + Du + Dw w +
-        v``: the filter sees the sensor noise ``Dw w + v`` (covariance
-        ``RN + Dw QN Dwᵀ + Dw NN + NNᵀDwᵀ``) correlated with the process
-        noise (cross term ``G(QN Dwᵀ + NN)``).
+    G, Dw : array_like, PeriodicMatrix or callable, optional
+        Separate noise input matrix (n, q) and its feedthrough (p, q) to the
+        measurement, as in `lqe` (2D, or one matrix per step).
 
     Returns
     -------
@@ -288,7 +283,7 @@ def dlqe(sys, QN, RN, NN=None, *, method=None, G=None, Dw=None):
     ((2, 1), True)
     """
     check_method(method)
-    if isinstance(sys, DiscreteLTPSystem) or any(is_varying(W) for W in (QN, RN, NN)):
+    if _time_varying(sys, QN, RN, NN):
         return tv_dlqe(sys, QN, RN, NN)
     sys = as_ltp(sys)
     if not sys.isdtime(strict=True):
@@ -451,7 +446,9 @@ def _output_weights(sys, Q, R, N, integral_action):
     """State weights ``(CᵀQC, R + DᵀQD, N + CᵀQD)`` of an output weight Q."""
     if integral_action is not None:
         raise ControlArgument("output=True cannot be combined with integral_action")
-    T, (n, m, p) = sys.period, (sys.nstates, sys.ninputs, sys.noutputs)
+    (n, m, p) = (sys.nstates, sys.ninputs, sys.noutputs)
+    T = sys.period if sys.isdtime(strict=True) else _common_period(sys, {'Q': Q, 'R': R,
+                                                                         'N': N})
 
     def periodic(M, name, shape):
         if sys.isdtime(strict=True) and not (isinstance(M, PeriodicMatrix) or callable(M)):
@@ -465,6 +462,19 @@ def _output_weights(sys, Q, R, N, integral_action):
     Nq = C.T @ Q @ D
     N = Nq if N is None else periodic(N, 'N', (n, m)) + Nq
     return C.T @ Q @ C, R + D.T @ Q @ D, N
+
+
+def _time_varying(sys, *weights):
+    """True when the dimensions vary over the period (system or weights): the
+    problem goes to `tvdesign`."""
+    return isinstance(sys, DiscreteLTPSystem) or any(is_varying(W) for W in weights)
+
+
+def _common_period(sys, weights):
+    """The common period of `sys` and its periodic weights (sub-periods)."""
+    periodic = {k: W for k, W in weights.items() if isinstance(W, PeriodicMatrix)}
+    return common_period([sys.period] + [W.period for W in periodic.values()],
+                         ['sys'] + list(periodic))
 
 
 def _discrete(sys, nsteps):

@@ -32,7 +32,7 @@ from control.exception import ControlArgument
 
 from .._core.ltpsys import LTPStateSpace
 from .._core.tvsystem import DiscreteLTPSystem, dltpss
-from .minimal import periodic_minreal, tv_balred, tv_hsvd
+from .minimal import MINREAL_TOL, periodic_minreal, tv_balred, tv_hsvd
 from .lyapunov import dlyap
 from .periodic_balancing import gramians, hankel_svd, truncate
 from .._core.coerce import as_ltp
@@ -223,11 +223,15 @@ def minreal(sys, tol=None, *, verbose=False, nsteps=None):
         with periodic matrices, or continuous-time system with constant
         matrices.
     tol : float, optional
-        Discrete time: relative rank tolerance of the projections (default
-        ``sqrt(eps)``, about 1.5e-8).  Continuous periodic matrices:
-        relative tolerance on the Hankel singular values (default 1e-6, the
-        gramians are integrated to about 1e-12).  Constant matrices use
-        `control.minreal` with this `tol` (default python-control's).
+        Discrete time and constant matrices: relative rank tolerance
+        (default ``1000 sqrt(eps)``, about 1.5e-5: the relative distance
+        below which python-control's ``TransferFunction.minreal`` cancels a
+        pole and a zero, so that the near-cancellation
+        ``(s+1)(s+2.00000000001)/((s+2)(s²+s+1))`` gives 2 states as in
+        python-control; constant matrices go to `control.minreal` with this
+        `tol`).  Continuous periodic matrices: relative tolerance on the
+        Hankel singular values (default 1e-6, the gramians are integrated
+        to about 1e-12).
     verbose : bool, optional
         Print the number of removed states, as `control.minreal` (whose
         default is True; here False).
@@ -270,15 +274,15 @@ def _minreal(sys, tol, nsteps):
     periodic_ct = not sys.isdtime(strict=True) and not sys.is_lti \
         if isinstance(sys, LTPStateSpace) else False
     lti_ct = isinstance(sys, LTPStateSpace) and not sys.isdtime(strict=True) and sys.is_lti
-    if tol is None and not lti_ct:
-        tol = 1e-6 if periodic_ct else np.sqrt(np.finfo(float).eps)
+    if tol is None:
+        tol = 1e-6 if periodic_ct else MINREAL_TOL if lti_ct else np.sqrt(np.finfo(float).eps)
     if tol is not None and (isinstance(tol, (bool, np.bool_))
                             or not isinstance(tol, (int, float, np.floating))
                             or not 0 <= tol < 1):
         raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
     _check(sys)
     if lti_ct:
-        # python-control's algorithm and default tolerance for constant matrices
+        # python-control's algorithm, its transfer functions' tolerance
         red = ct.minreal(sys.to_ss(), tol=tol, verbose=False)
         return LTPStateSpace(red.A, red.B, red.C, red.D, sys.period,
                              inputs=sys.input_labels, outputs=sys.output_labels,
@@ -307,15 +311,16 @@ def _discrete_minreal(sys, tol, nsteps):
     tv = sys if isinstance(sys, DiscreteLTPSystem) else dltpss(sys)
     same = all(all(np.array_equal(M[0], Mk) for Mk in M) for M in (tv.A, tv.B, tv.C, tv.D))
     if same and tv.has_constant_dimensions:
-        # python-control's algorithm and default tolerance for constant matrices
-        red = ct.minreal(ct.ss(tv.A[0], tv.B[0], tv.C[0], tv.D[0], tv.dt), tol=tol,
+        # python-control's algorithm, its transfer functions' tolerance
+        red = ct.minreal(ct.ss(tv.A[0], tv.B[0], tv.C[0], tv.D[0], tv.dt),
+                         tol=MINREAL_TOL if tol is None else tol,
                          verbose=False)
         red = DiscreteLTPSystem([red.A], [red.B], [red.C], [red.D], tv.dt,
                                 name=tv.name + '$minreal')
         red = DiscreteLTPSystem(*(list(M) * tv.nsteps for M in (red.A, red.B, red.C, red.D)),
                                 dt=tv.dt, name=red.name)
     else:
-        red = periodic_minreal(tv, np.sqrt(np.finfo(float).eps) if tol is None else tol)
+        red = periodic_minreal(tv, tol)
     return _as_input_kind(sys, red)
 
 

@@ -59,7 +59,7 @@ from .._core.pm_ops import register_op, register_func
 from .._core.steps import step_grid
 from .._core.transition import step_transitions
 from .._core.validation import check_period, real_array
-from .._core.subperiods import tile_steps
+from .._core.subperiods import common_period, tile_steps
 from .tvlyap import is_varying
 from .tvdesign import tv_dare
 
@@ -784,12 +784,13 @@ def _grid(H, period, breaks, nsteps):
 
 
 def _period_of(args, period):
-    if period is None:
-        for M in args:
-            if isinstance(M, PeriodicMatrix):
-                return M.period
+    """The common period of `period` and the periodic arguments (sub-periods)."""
+    given = [] if period is None else [check_period(period)]
+    named = [(M.period, n) for M, n in zip(args, 'ABQRS') if isinstance(M, PeriodicMatrix)]
+    if not given and not named:
         raise ControlArgument("period must be given when no argument is a PeriodicMatrix")
-    return check_period(period)
+    return common_period(given + [p for p, _ in named],
+                         ['period'] * len(given) + [n for _, n in named])
 
 
 def _step_arrays(A, B, Q, R, S):

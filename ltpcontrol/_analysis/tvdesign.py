@@ -29,9 +29,9 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 
 from .._core.subperiods import common_steps
-from .._core.tvsystem import DiscreteLTPSystem, as_tv, cyclic_multipliers, _sequence
+from .._core.tvsystem import DiscreteLTPSystem, as_tv, check_chain, cyclic_multipliers, _sequence
 from .._core.lifting_forms import tv_time_lift
-from .tvlyap import check_chain, tv_dlyap
+from .tvlyap import tv_dlyap
 
 __all__ = ['tv_dare']
 
@@ -225,7 +225,22 @@ def tv_dlqe(sys, QN, RN, NN=None):
 
 
 def tv_gram(sys, type):
-    """Periodic gramians ``P_k`` ('c') or ``Q_k`` ('o') of a stable `DiscreteLTPSystem`."""
+    """Periodic gramians ``P_k`` ('c') or ``Q_k`` ('o') of a stable `DiscreteLTPSystem`.
+
+    ``P_{k+1} = A_kP_kA_kᵀ + B_kB_kᵀ`` and ``Q_k = A_kᵀQ_{k+1}A_k + C_kᵀC_k``
+    (`ltpcontrol.gram` of these systems), ``P_k`` and ``Q_k`` ``n_k x n_k``.
+
+    Examples
+    --------
+    >>> from ltpcontrol._analysis.tvdesign import tv_gram
+    >>> sys = ltp.dltpss([[[0.5, 0.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+    ...                  [[[1.0, 1.0]], [[1.0]]], 0)
+    >>> P = tv_gram(sys, 'c')
+    >>> [p.shape for p in P]
+    [(2, 2), (1, 1)]
+    >>> bool(np.allclose(sys.A[0] @ P[0] @ sys.A[0].T + sys.B[0] @ sys.B[0].T, P[1]))
+    True
+    """
     if type not in ('c', 'o'):
         raise ValueError(f"type must be 'c' or 'o', got {type!r}")
     if not sys.is_stable():

@@ -26,7 +26,7 @@ import scipy.sparse.linalg as spla
 from control.exception import ControlArgument, ControlDimension
 
 from .._core.subperiods import common_steps
-from .._core.tvsystem import cyclic_multipliers, _sequence
+from .._core.tvsystem import check_chain, cyclic_multipliers, _sequence
 
 __all__ = ['tv_dlyap']
 
@@ -113,23 +113,11 @@ def tv_dlyap(A, Q, *, adjoint=False):
         scale = max(1.0, np.abs(Q[k]).max(initial=0.0))
         if np.abs(Q[k] - Q[k].T).max(initial=0.0) > 1e-10 * scale:
             raise ValueError(f"Q[{k}] must be symmetric")
-    check_unique(A)
-    return solve_cyclic(A, Q, n, adjoint)
+    _check_unique(A)
+    return _solve_cyclic(A, Q, n, adjoint)
 
 
-def check_chain(A, name='A'):
-    """Dimensions ``n_k`` of a closed chain ``A_k: n_k -> n_{k+1}``."""
-    N = len(A)
-    n = [a.shape[1] for a in A]
-    for k in range(N):
-        if A[k].shape[0] != n[(k + 1) % N]:
-            raise ControlDimension(f"{name}[{k}] has {A[k].shape[0]} rows but "
-                                   f"{name}[{(k + 1) % N}] has {n[(k + 1) % N]} columns: the "
-                                   "dimension chain n_(k+1) x n_k does not close")
-    return n
-
-
-def check_unique(A):
+def _check_unique(A):
     """Raise if two core multipliers of the cyclic product satisfy ``μ_i μ_j = 1``."""
     mu = cyclic_multipliers(A)
     if mu.size == 0:
@@ -145,7 +133,7 @@ def check_unique(A):
                       UserWarning, stacklevel=3)
 
 
-def solve_cyclic(A, Q, n, adjoint):
+def _solve_cyclic(A, Q, n, adjoint):
     """Sparse LU solution of the cyclic block system (module notes)."""
     N = len(A)
     sizes = np.array([m * m for m in n])

@@ -38,7 +38,6 @@ from .transition import expm_batch, step_transitions, uniform_transitions
 from .coerce import as_ltp
 from .validation import check_positive_int, steps_per_period
 from .registry import method_alias, overridden
-from .tvsystem import DiscreteLTPSystem
 
 __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
            'is_stable', 'floquet_transform']
@@ -131,10 +130,8 @@ def floquet_multipliers(sys, nsteps=None):
     >>> np.allclose(ltp.floquet_multipliers(sys), np.exp([-1.0, -3.0]))
     True
     """
-    if (own := overridden('floquet_multipliers', sys)) is not None:   # systems with delays
+    if (own := overridden('floquet_multipliers', sys)) is not None:   # delays, varying dims
         return own(sys, nsteps)
-    if isinstance(sys, DiscreteLTPSystem):          # time-varying dimensions
-        return sys.floquet_multipliers()
     logmod, arg = _log_multipliers(sys, nsteps)
     with np.errstate(under='ignore', over='ignore', invalid='ignore'):
         mu = np.exp(logmod) * np.exp(1j * arg)
@@ -264,13 +261,11 @@ def is_stable(sys, tol=1e-10, nsteps=None, *, autonomous=False):
     >>> ltp.is_stable(ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=np.pi))
     True
     """
-    if (own := overridden('is_stable', sys)) is not None:      # systems with delays
+    if (own := overridden('is_stable', sys)) is not None:      # delays, varying dims
         return own(sys, tol, nsteps, autonomous=autonomous)
     if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, numbers.Real) \
             or not 0 <= tol < 1:
         raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
-    if isinstance(sys, DiscreteLTPSystem):          # time-varying dimensions
-        return sys.is_stable(tol)
     logmod, arg = _log_multipliers(sys, nsteps)
     if autonomous:
         logmod = _without_phase_multiplier(logmod, arg)

@@ -49,7 +49,18 @@ _FORMS = ('time', 'stacked', 'cyclic')
 
 
 def lift_form(sys, method, *, start=0, sparse=False, name=None, nharmonics=None):
-    """`ltpcontrol.lift` for the time-domain forms and `DiscreteLTPSystem`."""
+    """`ltpcontrol.lift` for the time-domain forms and `DiscreteLTPSystem` (module notes).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.lifting_forms import lift_form
+    >>> sys = ltp.dltpss([[[1.0, 2.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+    ...                  [[[1.0, 0.0]], [[1.0]]], 0)
+    >>> lift_form(sys, 'time').nstates, lift_form(sys, 'time', start=1).nstates
+    (2, 1)
+    >>> [M.shape for M in lift_form(sys, 'stacked')]           # A, E, B, C, D
+    [(3, 3), (3, 3), (3, 2), (2, 3), (2, 2)]
+    """
     if method not in _FORMS:
         raise ValueError(f"method must be one of {_FORMS} for this system, got {method!r}")
     if nharmonics is not None:
@@ -118,12 +129,9 @@ def _offsets(sizes):
 
 
 def _stacked(sys, sparse):
-    N = sys.nsteps
-    n, m = sys.nstates, sys.ninputs
-    no, mo = _offsets(n), _offsets(m)
-    A = sps.lil_matrix((no[-1], no[-1]))
-    B = sps.lil_matrix((no[-1], mo[-1]))
-    E = sps.lil_matrix((no[-1], no[-1]))
+    N, n = sys.nsteps, sys.nstates
+    no, mo, A, B, C, D = _step_blocks(sys)
+    E = sps.lil_matrix(A.shape)
     E[:n[0], :n[0]] = np.eye(n[0])
     # row 0: x_{(p+1)N} = A_{N-1} x_{N-1} + B_{N-1} u_{N-1}
     A[:n[0], no[N - 1]:no[N]] = sys.A[N - 1]
@@ -133,27 +141,29 @@ def _stacked(sys, sparse):
         A[no[k]:no[k + 1], no[k - 1]:no[k]] = sys.A[k - 1]
         A[no[k]:no[k + 1], no[k]:no[k + 1]] = -np.eye(n[k])
         B[no[k]:no[k + 1], mo[k - 1]:mo[k]] = sys.B[k - 1]
-    C = sps.block_diag(sys.C, format='csr') if N else None
-    D = sps.block_diag(sys.D, format='csr')
-    mats = [M.tocsr() for M in (A, E, B)] + [C, D]
-    if sparse:
-        return tuple(mats)
-    return tuple(M.toarray() for M in mats)
+    return _finished((A, E, B, C, D), sparse)
 
 
 def _cyclic(sys, sparse):
     N = sys.nsteps
-    n, m = sys.nstates, sys.ninputs
-    no, mo = _offsets(n), _offsets(m)
-    A = sps.lil_matrix((no[-1], no[-1]))
-    B = sps.lil_matrix((no[-1], mo[-1]))
+    no, mo, A, B, C, D = _step_blocks(sys)
     for k in range(N):
         k1 = (k + 1) % N
         A[no[k1]:no[k1 + 1], no[k]:no[k + 1]] = sys.A[k]
         B[no[k1]:no[k1 + 1], mo[k]:mo[k + 1]] = sys.B[k]
-    C = sps.block_diag(sys.C, format='csr')
-    D = sps.block_diag(sys.D, format='csr')
-    mats = (A.tocsr(), B.tocsr(), C, D)
+    return _finished((A, B, C, D), sparse)
+
+
+def _step_blocks(sys):
+    """State and input offsets, empty state and input matrices of the stacked
+    states (to be filled), and the block diagonal ``C = blkdiag(C_k)``, ``D``."""
+    no, mo = _offsets(sys.nstates), _offsets(sys.ninputs)
+    return (no, mo, sps.lil_matrix((no[-1], no[-1])), sps.lil_matrix((no[-1], mo[-1])),
+            sps.block_diag(sys.C, format='csr'), sps.block_diag(sys.D, format='csr'))
+
+
+def _finished(mats, sparse):
+    mats = tuple(sps.csr_matrix(M) for M in mats)
     return mats if sparse else tuple(M.toarray() for M in mats)
 
 

@@ -105,11 +105,6 @@ def common_period(periods, names):
     return T
 
 
-def step_counts_of(arrays):
-    """Step counts of the 3D stacks among `arrays`."""
-    return [np.shape(a)[0] for a in arrays if _is_stack(a)]
-
-
 def _is_stack(a):
     return a is not None and not callable(a) and not hasattr(a, 'sample') \
         and not isinstance(a, (list, tuple)) and np.ndim(a) == 3 \

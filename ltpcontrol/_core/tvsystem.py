@@ -26,6 +26,7 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument, ControlDimension
 
+from .registry import override
 from .subperiods import common_steps
 from .validation import check_positive, real_array
 
@@ -84,13 +85,8 @@ class DiscreteLTPSystem:
         names = ['A', 'B', 'C', 'D'][:len(seqs)]
         N = common_steps([len(s) for s in seqs], names)
         A, B, C = (tuple(s[k % len(s)] for k in range(N)) for s in (A, B, C))
-        n = tuple(a.shape[1] for a in A)
+        n = tuple(check_chain(A, 'A'))
         for k in range(N):
-            if A[k].shape[0] != n[(k + 1) % N]:
-                raise ControlDimension(
-                    f"A[{k}] has {A[k].shape[0]} rows but A[{(k + 1) % N}] has "
-                    f"{n[(k + 1) % N]} columns: the dimension chain n_(k+1) x n_k "
-                    "does not close")
             if B[k].shape[0] != A[k].shape[0]:
                 raise ControlDimension(f"B[{k}] must have {A[k].shape[0]} rows (n_{k + 1}), "
                                        f"got shape {B[k].shape}")
@@ -201,8 +197,16 @@ class DiscreteLTPSystem:
         return cyclic_multipliers(self.A, start)
 
     def is_stable(self, tol=1e-10):
-        """True when every core multiplier lies inside the unit circle."""
-        return bool(np.all(np.abs(self.floquet_multipliers()) < 1 - tol))
+        """True when every core multiplier lies inside the unit circle.
+
+        Examples
+        --------
+        >>> sys = ltp.dltpss([[[1.0, 2.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+        ...                  [[[1.0, 0.0]], [[1.0]]], 0)
+        >>> sys.is_stable(), sys.feedback(0.4).is_stable()
+        (False, True)
+        """
+        return _is_stable(self, tol)
 
     def poles(self):
         """Per-step poles ``μ^{1/N}`` of the core multipliers (zeros are kept)."""
@@ -346,8 +350,43 @@ def dltpss(A, B=None, C=None, D=0, dt=1.0, *, name=None):
     return DiscreteLTPSystem(A, B, C, D, dt, name=name)
 
 
+def check_chain(A, name='A'):
+    """Dimensions ``n_k`` of a closed chain ``A_k: n_k -> n_{k+1}`` (ControlDimension if open).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.tvsystem import check_chain
+    >>> check_chain([np.ones((1, 2)), np.ones((2, 1))])
+    [2, 1]
+    >>> check_chain([np.ones((1, 2)), np.ones((3, 1))])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    control.exception.ControlDimension: A[1] has 3 rows but A[0] has 2 columns: ...
+    """
+    N = len(A)
+    n = [a.shape[1] for a in A]
+    for k in range(N):
+        if A[k].shape[0] != n[(k + 1) % N]:
+            raise ControlDimension(f"{name}[{k}] has {A[k].shape[0]} rows but "
+                                   f"{name}[{(k + 1) % N}] has {n[(k + 1) % N]} columns: the "
+                                   "dimension chain n_(k+1) x n_k does not close")
+    return n
+
+
 def as_tv(sys, like=None, name='sys'):
-    """Return `sys` as a `DiscreteLTPSystem` (LTPStateSpace, static gain allowed)."""
+    """Return `sys` as a `DiscreteLTPSystem` (LTPStateSpace, static gain allowed).
+
+    A discrete-time `LTPStateSpace` or `control.StateSpace` is converted; a
+    number or matrix becomes a static gain with the sampling time of `like`.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.tvsystem import as_tv
+    >>> sysd = ltp.ltpss(np.array([[[0.5]], [[0.2]]]), [[1.0]], [[1.0]], 0,
+    ...                  period=2.0, dt=1.0)
+    >>> as_tv(sysd).nstates, as_tv([[2.0, 1.0]], like=as_tv(sysd)).nstates
+    ((1, 1), (0,))
+    """
     if isinstance(sys, DiscreteLTPSystem):
         return sys
     if hasattr(sys, 'nsteps') and hasattr(sys, 'isdtime') and sys.isdtime(strict=True):
@@ -361,6 +400,89 @@ def as_tv(sys, like=None, name='sys'):
                                  [np.zeros((K.shape[0], 0))], [K], like.dt)
     raise ControlArgument(f"{name} must be a discrete periodic system, got "
                           f"{type(sys).__name__}")
+
+
+#
+# Floquet analysis through the public functions (``ltp.floquet_multipliers(sys)``...)
+#
+
+def _no_nsteps(nsteps):
+    if nsteps is not None:
+        raise ControlArgument("nsteps applies to continuous-time systems only; a "
+                              "discrete-time system has N = period/dt steps")
+
+
+@override('floquet_multipliers', DiscreteLTPSystem)
+def _floquet_multipliers(sys, nsteps=None):
+    """`ltpcontrol.floquet_multipliers` with time-varying dimensions (module notes).
+
+    Examples
+    --------
+    >>> sys = ltp.dltpss([[[1.0, 0.0]], [[1.0], [1.0]]], [[[1.0]], [[1.0], [1.0]]],
+    ...                  [[[1.0, 1.0]], [[1.0]]], [[1.0]])
+    >>> ltp.floquet_multipliers(sys)        # core multiplier [1 0][1; 1] = 1, padded
+    array([1.+0.j, 0.+0.j])
+    """
+    _no_nsteps(nsteps)
+    return sys.floquet_multipliers()
+
+
+@override('floquet_exponents', DiscreteLTPSystem)
+def _floquet_exponents(sys, nsteps=None):
+    """`ltpcontrol.floquet_exponents`: the per-step values ``μ^{1/N}`` (see `poles`).
+
+    Examples
+    --------
+    >>> sys = ltp.dltpss([[[4.0, 0.0]], [[1.0], [1.0]], [[2.0, 0.0], [0.0, 1.0]]],
+    ...                  [[[1.0]], [[1.0], [1.0]], [[1.0], [2.0]]],
+    ...                  [[[1.0, 1.0]], [[1.0]], [[1.0, 0.0]]], [[1.0]])
+    >>> np.round(ltp.floquet_exponents(sys).real, 12)       # cube root of 8, and 0
+    array([2., 0.])
+    """
+    _no_nsteps(nsteps)
+    return sys.poles()
+
+
+@override('monodromy', DiscreteLTPSystem)
+def _monodromy(sys, nsteps=None):
+    """`ltpcontrol.monodromy`: the cyclic product ``A_{N-1} ... A_0`` (``n_0 x n_0``).
+
+    Examples
+    --------
+    >>> sys = ltp.dltpss([[[1.0, 2.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+    ...                  [[[1.0, 0.0]], [[1.0]]], 0)
+    >>> ltp.monodromy(sys)
+    array([[1. , 2. ],
+           [0.5, 1. ]])
+    """
+    _no_nsteps(nsteps)
+    P = np.eye(sys.nstates[0])
+    for a in sys.A:
+        P = a @ P
+    return P
+
+
+@override('is_stable', DiscreteLTPSystem)
+def _is_stable(sys, tol=1e-10, nsteps=None, *, autonomous=False):
+    """`ltpcontrol.is_stable`: every core multiplier inside ``|μ| < 1 - tol``.
+
+    Examples
+    --------
+    >>> sys = ltp.dltpss([[[1.0, 0.0]], [[0.5], [1.0]]], [[[1.0]], [[1.0], [1.0]]],
+    ...                  [[[1.0, 1.0]], [[1.0]]], 0)
+    >>> ltp.is_stable(sys), ltp.is_stable(sys, autonomous=True)
+    (True, True)
+    """
+    _no_nsteps(nsteps)
+    if isinstance(tol, (bool, np.bool_)) or not isinstance(tol, numbers.Real) \
+            or not 0 <= tol < 1:
+        raise ValueError(f"tol must be a number in [0, 1), got {tol!r}")
+    mu = cyclic_multipliers(sys.A, int(np.argmin(sys.nstates)))     # the core ones
+    if autonomous:
+        if mu.size == 0:
+            raise ValueError("autonomous=True needs at least one multiplier (the phase one)")
+        mu = np.delete(mu, np.argmin(np.abs(mu - 1)))
+    return bool(np.all(np.abs(mu) < 1 - tol))
 
 
 def cyclic_multipliers(A, start=0):
@@ -403,77 +525,91 @@ def _rescaled(A, j):
 #
 
 def series_tv(sys1, sys2):
-    """``sys2 ∘ sys1``: the output of `sys1` drives `sys2` (state ``[x1; x2]``)."""
-    sys1 = as_tv(sys1, sys2 if isinstance(sys2, DiscreteLTPSystem) else None, 'sys1')
-    sys2 = as_tv(sys2, sys1, 'sys2')
-    s1, s2, N, dt = _common(sys1, sys2)
-    A, B, C, D = [], [], [], []
-    for k in range(N):
-        a1, b1, c1, d1 = s1.A[k], s1.B[k], s1.C[k], s1.D[k]
-        a2, b2, c2, d2 = s2.A[k], s2.B[k], s2.C[k], s2.D[k]
+    """``sys2 ∘ sys1``: the output of `sys1` drives `sys2` (state ``[x1; x2]``).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.tvsystem import series_tv
+    >>> P = ltp.dltpss([[[1.0, 2.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+    ...                [[[1.0, 0.0]], [[1.0]]], 0)
+    >>> series_tv(P, 2.0).nstates, series_tv(P, P).nstates      # a gain, a system
+    ((2, 1), (4, 2))
+    """
+    def step(k, a1, b1, c1, d1, a2, b2, c2, d2):
         if c1.shape[0] != b2.shape[1]:
             raise ControlDimension(f"step {k}: sys1 has {c1.shape[0]} outputs but sys2 "
                                    f"has {b2.shape[1]} inputs")
-        A.append(np.block([[a1, np.zeros((a1.shape[0], a2.shape[1]))], [b2 @ c1, a2]]))
-        B.append(np.vstack([b1, b2 @ d1]))
-        C.append(np.hstack([d2 @ c1, c2]))
-        D.append(d2 @ d1)
-    return DiscreteLTPSystem(A, B, C, D, dt)
+        return (np.block([[a1, np.zeros((a1.shape[0], a2.shape[1]))], [b2 @ c1, a2]]),
+                np.vstack([b1, b2 @ d1]), np.hstack([d2 @ c1, c2]), d2 @ d1)
+    return _stepwise(sys1, sys2, step)
 
 
 def parallel_tv(sys1, sys2):
-    """``sys1 + sys2`` (same inputs and outputs at every step)."""
-    sys1 = as_tv(sys1, sys2 if isinstance(sys2, DiscreteLTPSystem) else None, 'sys1')
-    sys2 = as_tv(sys2, sys1, 'sys2')
-    s1, s2, N, dt = _common(sys1, sys2)
-    A, B, C, D = [], [], [], []
-    for k in range(N):
-        if s1.D[k].shape != s2.D[k].shape:
+    """``sys1 + sys2`` (same inputs and outputs at every step).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.tvsystem import parallel_tv
+    >>> P = ltp.dltpss([[[1.0, 2.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+    ...                [[[1.0, 0.0]], [[1.0]]], 0)
+    >>> S = parallel_tv(P, P)
+    >>> S.nstates, bool(np.allclose(ltp.lift(S, method='time').D,
+    ...                             2 * ltp.lift(P, method='time').D))
+    ((4, 2), True)
+    """
+    def step(k, a1, b1, c1, d1, a2, b2, c2, d2):
+        if d1.shape != d2.shape:
             raise ControlDimension(f"step {k}: the systems have input/output shapes "
-                                   f"{s1.D[k].shape} and {s2.D[k].shape}")
-        A.append(_blkdiag(s1.A[k], s2.A[k]))
-        B.append(np.vstack([s1.B[k], s2.B[k]]))
-        C.append(np.hstack([s1.C[k], s2.C[k]]))
-        D.append(s1.D[k] + s2.D[k])
-    return DiscreteLTPSystem(A, B, C, D, dt)
+                                   f"{d1.shape} and {d2.shape}")
+        return (_blkdiag(a1, a2), np.vstack([b1, b2]), np.hstack([c1, c2]), d1 + d2)
+    return _stepwise(sys1, sys2, step)
 
 
 def feedback_tv(sys1, sys2=None, sign=-1):
-    """``u1 = r + sign y2``, ``u2 = y1``; closed loop from r to y1."""
+    """``u1 = r + sign y2``, ``u2 = y1``; closed loop from r to y1.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.tvsystem import feedback_tv
+    >>> P = ltp.dltpss([[[1.0, 2.0]], [[1.0], [0.5]]], [[[1.0]], [[0.0], [1.0]]],
+    ...                [[[1.0, 0.0]], [[1.0]]], 0)
+    >>> np.round(feedback_tv(P, 0.4).floquet_multipliers().real, 12)   # 2 - 0.4 * 3
+    array([0.8, 0. ])
+    """
     if sys2 is None:
         sys2 = np.eye(sys1.noutputs[0]) if len(set(sys1.noutputs)) == 1 else None
         if sys2 is None:
             raise ControlArgument("feedback: give the feedback system when the output "
                                   "dimension varies")
-    sys2 = as_tv(sys2, sys1, 'other')
-    s1, s2, N, dt = _common(sys1, sys2)
-    A, B, C, D = [], [], [], []
-    for k in range(N):
-        a1, b1, c1, d1 = s1.A[k], s1.B[k], s1.C[k], s1.D[k]
-        a2, b2, c2, d2 = s2.A[k], s2.B[k], s2.C[k], s2.D[k]
+
+    def step(k, a1, b1, c1, d1, a2, b2, c2, d2):
         m1, p1 = d1.shape[1], d1.shape[0]
         if d2.shape != (m1, p1):
             raise ControlDimension(f"step {k}: the feedback system must map {p1} outputs "
                                    f"to {m1} inputs, got shape {d2.shape}")
         # u1 = r + sign (c2 x2 + d2 y1), y1 = c1 x1 + d1 u1
-        E = np.eye(m1) - sign * d2 @ d1
         try:
-            Einv = np.linalg.inv(E)
+            Einv = np.linalg.inv(np.eye(m1) - sign * d2 @ d1)
         except np.linalg.LinAlgError:
             raise ValueError(f"feedback: the algebraic loop is singular at step {k}") from None
         # u1 = Einv (r + sign d2 c1 x1 + sign c2 x2)
         Fu = Einv @ np.hstack([sign * d2 @ c1, sign * c2])
-        Gu = Einv
-        Y = np.hstack([c1, np.zeros((p1, a2.shape[1]))]) + d1 @ Fu
-        Yr = d1 @ Gu
-        Ax = np.block([[a1, np.zeros((a1.shape[0], a2.shape[1]))],
-                       [b2 @ c1, a2]])
+        Ax = np.block([[a1, np.zeros((a1.shape[0], a2.shape[1]))], [b2 @ c1, a2]])
         Bx = np.vstack([b1, b2 @ d1])
-        A.append(Ax + Bx @ Fu)
-        B.append(Bx @ Gu)
-        C.append(Y)
-        D.append(Yr)
-    return DiscreteLTPSystem(A, B, C, D, dt, name=sys1.name + '$feedback')
+        return (Ax + Bx @ Fu, Bx @ Einv,
+                np.hstack([c1, np.zeros((p1, a2.shape[1]))]) + d1 @ Fu, d1 @ Einv)
+    return _stepwise(sys1, sys2, step, name=sys1.name + '$feedback', other='other')
+
+
+def _stepwise(sys1, sys2, step, name=None, other='sys2'):
+    """The system of the step matrices ``step(k, A1, B1, C1, D1, A2, B2, C2, D2)``
+    of two systems (gains allowed) on their common period."""
+    sys1 = as_tv(sys1, sys2 if isinstance(sys2, DiscreteLTPSystem) else None, 'sys1')
+    sys2 = as_tv(sys2, sys1, other)
+    s1, s2, N, dt = _common(sys1, sys2)
+    mats = [step(k, *(M[k] for M in (s1.A, s1.B, s1.C, s1.D, s2.A, s2.B, s2.C, s2.D)))
+            for k in range(N)]
+    return DiscreteLTPSystem(*(list(M) for M in zip(*mats)), dt=dt, name=name)
 
 
 def _common(s1, s2):
