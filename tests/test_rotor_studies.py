@@ -443,6 +443,22 @@ def test_mode_labels_equal_identify_modes_of_the_toolbox(toolbox_models):
         for family in ('1st flap', '1st edge', '2nd flap'):
             mine = sorted(n[len(family) + 1:] for n in names if n.startswith(family))
             assert mine == sorted(['collective'] + pair), (name, family, mine)
+    # an overdamped collective degree of freedom has two real roots, both collective
+    Ab = np.array([[0.0, 1.0], [-4.0, -5.0]])                      # roots -1 and -4
+    desc = [f'ED 1st flapwise bending-mode DOF of blade {b}, m' for b in (1, 2, 3)]
+    desc += [d.replace('ED ', 'ED First time derivative of ') + '/s' for d in desc]
+    rot = ltp.RotorStateSpace(
+        ltp.PeriodicMatrix.constant(np.kron(Ab, np.eye(3)), 2 * np.pi), np.zeros((6, 0)),
+        np.zeros((0, 6)), np.zeros((0, 0)), 2 * np.pi,
+        rotor=dict(rotor_speed=1.0, state_descriptions=desc, rotating_states=np.ones(6, bool),
+                   derivative_order=np.full(6, 2)))
+    nr, _ = ltp.mbc(rot, 3)
+    modes = ltp.floquet_modes(nr)
+    labels = ltp.mode_labels(modes, nr)
+    real = np.abs(modes.exponents.imag) < 1e-9
+    assert np.allclose(np.sort(modes.exponents[real].real), [-4, -1])
+    assert [lab for lab, r in zip(labels, real) if r] == ['1st flap collective'] * 2
+    assert labels.count('1st flap collective') == 2
 
 
 def test_mode_labels_openfast_rule_equals_identify_modes(toolbox_models):
