@@ -114,7 +114,8 @@ def mode_labels(modes, sys, rule='participation', *, blade_length=None, tower_le
     Raises
     ------
     ValueError
-        If `rule` is unknown or a length is not positive and finite.
+        If `rule` is unknown, a length is not positive and finite, or
+        `modes` has another number of states than `sys`.
 
     Notes
     -----
