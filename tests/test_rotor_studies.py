@@ -8,9 +8,11 @@ labels on its own files (tests/data/README.md), and files written in
 OpenFAST's format.
 """
 
+import copy
 import csv
 import pathlib
 import re
+import warnings
 
 import numpy as np
 import pytest
@@ -266,11 +268,12 @@ def test_read_lin_sources_and_mbc_blade_count_in_second_place():
 # Campbell diagrams from files
 #
 
-# openfast_toolbox's IdentifyModes (its commit d34b283, BladeLen 40, TowerLen 55) on its own
-# files: mode number (1-based, the modes of Im λ > 0 by natural frequency) -> label.  The
-# Standstill_ForID_ED table is the toolbox's test_modesID reference table; the others are
-# its output (test_modesID asserts modes 1, 2, 3, 7, 47, 50, 51, 58, 59, 60 of the EDHD
-# file); 'Generator DOF (not shown)' is a mode the toolbox hides, not a label.
+# openfast_toolbox's IdentifyModes (its commit d34b283) on its own files, with its test's
+# BladeLen 40 and TowerLen 55: mode number (1-based, the modes of Im λ > 0 by natural
+# frequency) -> label, for every mode it names.  The Standstill_ForID_ED table is the
+# toolbox's test_modesID reference table; the others are its output (test_modesID asserts
+# modes 1, 2, 3, 7, 47, 50, 51, 58, 59, 60 of the EDHD file).  The toolbox reads the file
+# format without derivative orders (Standstill_old) as first-order states.
 TOOLBOX_LABELS = {
     'Standstill_ForID_ED.1.lin': {
         1: '1st Tower SS', 2: '1st Tower FA', 3: '1st Blade Edge (Collective)',
@@ -290,12 +293,58 @@ TOOLBOX_LABELS = {
         1: '1st Blade Flap (Regressive)', 2: '1st Blade Flap (Collective)',
         3: '1st Blade Flap (Progressive)', 4: '1st Blade Edge (Regressive)',
         5: '1st Blade Edge (Progressive)', 6: '2nd Blade Flap (Regressive)',
-        7: '2nd Blade Flap (Collective)', 8: '2nd Blade Flap (Progressive)'},
+        7: '2nd Blade Flap (Collective)', 8: '2nd Blade Flap (Progressive)',
+        9: 'Generator DOF (not shown)'},
+    'ws03.0.*.lin': {
+        1: '1st Tower SS', 2: '1st Tower FA', 3: '1st Blade Edge (Collective)',
+        4: '1st Blade Flap (Progressive)', 5: '1st Blade Flap (Collective)',
+        6: '1st Blade Edge (Regressive)', 7: '1st Blade Flap (Regressive)',
+        8: '1st Blade Edge (Progressive)', 9: '2nd Blade Flap (Regressive)',
+        10: '2nd Blade Flap (Collective)', 11: '2nd Blade Flap (Progressive)',
+        12: '2nd Tower FA', 13: '2nd Tower SS', 14: '1st Drivetrain Torsion'},
+    'ws00.0.1.lin': {
+        1: '1st Tower SS', 2: '1st Tower FA', 3: '1st Blade Edge (Collective)',
+        4: '1st Blade Flap (Regressive)', 5: '1st Blade Flap (Collective)',
+        6: '1st Blade Flap (Progressive)', 7: '1st Blade Edge (Regressive)',
+        8: '1st Blade Edge (Progressive)', 9: '2nd Blade Flap (Regressive)',
+        10: '2nd Blade Flap (Collective)', 11: '2nd Blade Flap (Progressive)',
+        12: '2nd Tower FA', 13: '2nd Tower SS', 14: '1st Drivetrain Torsion'},
+    'Standstill.1.lin': {
+        1: '1st Tower SS', 2: '1st Tower FA', 3: '1st Blade Edge (Collective)',
+        4: '1st Blade Flap (Regressive)', 5: '1st Blade Flap (Progressive)',
+        6: '1st Blade Flap (Collective)', 7: '1st Blade Edge (Regressive)',
+        8: '1st Blade Edge (Progressive)', 9: '2nd Blade Flap (Regressive)',
+        10: '1st Drivetrain Torsion', 11: '2nd Blade Flap (Progressive)',
+        12: '2nd Blade Flap (Collective)', 13: '2nd Tower FA', 14: '2nd Tower SS'},
+    'BAR_URC_EDBD.1.lin': {
+        1: '1st Tower SS', 2: '1st Tower FA', 3: '2nd Tower SS', 4: '2nd Tower FA',
+        5: '1st Blade Edge (Regressive)', 8: '1st Blade Flap (Collective)',
+        9: '1st Blade Flap (Regressive)', 10: '2nd Blade Flap (Collective)'},
+    'Standstill_old.1.lin': {
+        1: '1st Tower SS', 2: '1st Blade Flap (Collective)', 3: '1st Blade Edge (Collective)',
+        4: '1st Blade Flap (Regressive)', 5: '1st Blade Flap (Progressive)',
+        7: '1st Blade Edge (Regressive)', 8: '1st Blade Edge (Progressive)',
+        9: '2nd Blade Flap (Regressive)', 10: '2nd Blade Flap (Collective)',
+        11: '2nd Blade Flap (Progressive)', 13: '2nd Tower FA', 14: '2nd Tower SS'},
 }
-# Where the labels differ on purpose (mode_labels' docstring): the toolbox takes the state
-# whose eigenvector magnitude peaks at a mode (a measure that depends on the states' units
-# and favours low frequencies), ties by its list order, and guesses modes where no state
+# ... and without BladeLen and TowerLen (no scaling): the modes that change (None: unnamed)
+TOOLBOX_UNSCALED = {
+    'Standstill_ForID_ED.1.lin': {12: None},
+    'StandstillSemi_ForID_EDHD.1.lin': {54: '1st Tower FA'},
+    'ws03.0.*.lin': {4: '1st Blade Flap (Collective)', 5: '1st Blade Flap (Progressive)',
+                     14: None},
+    'ws00.0.1.lin': {14: None},
+    'Standstill.1.lin': {10: None},
+    'BAR_URC_EDBD.1.lin': {5: None, 8: None, 9: None, 10: None},
+}
+# The default rule against the 37 modes the toolbox names on its identification files and
+# the rotating NREL 5 MW files ('Generator DOF (not shown)' is a mode it hides).  Where the
+# labels differ on purpose (mode_labels' docstring): the toolbox takes the state whose
+# eigenvector magnitude peaks at a mode (a measure that depends on the states' units and
+# favours low frequencies), ties by its list order, and guesses modes where no state
 # peaks; the participation factors name instead:
+COMPARED = ('Standstill_ForID_ED.1.lin', 'StandstillSemi_ForID_EDHD.1.lin',
+            'Main_Rotating.*.lin')
 DIFFERENT = {
     'Standstill_ForID_ED.1.lin': {3: 'drivetrain', 12: '1st edge collective'},
     'StandstillSemi_ForID_EDHD.1.lin': {47: 'hydrodynamics', 50: '1st tower FA',
@@ -304,15 +353,15 @@ DIFFERENT = {
 _STATES = {'drivetrain': r'Drivetrain', 'hydrodynamics': r'^HD ', 'tower FA': r'tower fore-aft',
            'tower SS': r'tower side-to-side', '1st flap': r'1st flapwise',
            '1st edge': r'1st edgewise'}
+# IdentifyModes' names in mode_labels' words (the table of its docstring)
+_TOOLBOX_WORDS = {'Generator DOF (not shown)': 'generator', 'Nacelle Yaw (not shown)':
+                  'nacelle yaw', '1st Drivetrain Torsion': 'drivetrain', 'Tower': 'tower',
+                  'Platform': 'platform', 'Blade Flap': 'flap', 'Blade Edge': 'edge',
+                  '(Collective)': 'collective', '(Regressive)': 'BW', '(Progressive)': 'FW'}
 
 
-def _toolbox_as_ours(label, standstill):
-    """The toolbox's label in mode_labels' words."""
-    words = {'Tower': 'tower', 'Platform': 'platform', '1st Drivetrain Torsion': 'drivetrain',
-             'Blade Flap': 'flap', 'Blade Edge': 'edge', '(Collective)': 'collective',
-             '(Regressive)': 'cyclic' if standstill else 'BW',
-             '(Progressive)': 'cyclic' if standstill else 'FW'}
-    for old, new in words.items():
+def _toolbox_as_ours(label):
+    for old, new in _TOOLBOX_WORDS.items():
         label = label.replace(old, new)
     return label
 
@@ -332,23 +381,39 @@ def _family(label):
     return next(f for f in _STATES if f in label)
 
 
-def test_mode_labels_equal_identify_modes_of_the_toolbox():
-    agree = 0
-    for name, truth in TOOLBOX_LABELS.items():
-        with _no_warning():
-            lin = ltp.read_lin(str(DATA / name))
-            nr, _ = ltp.mbc(lin, 3)
-        standstill = abs(lin.rotor_speed) < 1e-3          # (0.0002 rad/s in the files)
+@pytest.fixture(scope='module')
+def toolbox_models():
+    """Per file set: the multi-blade model, its averaged A, modes, and the modes of Im λ > 0
+    by natural frequency."""
+    out = {}
+    for name in TOOLBOX_LABELS:
+        with warnings.catch_warnings():
+            warnings.simplefilter('error' if name in COMPARED else 'ignore')
+            nr, _ = ltp.mbc(ltp.read_lin(str(DATA / name)), 3)
         A = nr.average(method='samples').A
-        modes = ltp.floquet_modes(ltp.ltpss(A, np.zeros((len(A), 0)), np.zeros((0, len(A))), 0,
-                                            period=2 * np.pi))
+        modes = ltp.floquet_modes(ltp.ltpss(A, np.zeros((len(A), 0)), np.zeros((0, len(A))),
+                                            0, period=2 * np.pi))
         upper = [i for i in np.argsort(np.abs(modes.exponents)) if modes.exponents[i].imag > 0]
+        out[name] = nr, A, modes, upper
+    return out
+
+
+def test_mode_labels_equal_identify_modes_of_the_toolbox(toolbox_models):
+    agree = 0
+    for name in COMPARED:
+        nr, A, modes, upper = toolbox_models[name]
+        standstill = abs(nr.rotor_speed) < 1e-3          # (0.0002 rad/s in the files)
         labels = ltp.mode_labels(modes, nr)
-        for number, theirs in truth.items():
+        for number, theirs in TOOLBOX_LABELS[name].items():
+            if theirs == 'Generator DOF (not shown)':
+                continue
+            theirs = _toolbox_as_ours(theirs)
+            if standstill:
+                theirs = theirs.replace('BW', 'cyclic').replace('FW', 'cyclic')
             ours = labels[upper[number - 1]]
             other = DIFFERENT.get(name, {}).get(number)
             if other is None:
-                assert ours == _toolbox_as_ours(theirs, standstill), (name, number, ours)
+                assert ours == theirs, (name, number, ours)
                 agree += 1
                 continue
             # a deliberate difference: the frequency depends on the stiffness of the
@@ -358,9 +423,68 @@ def test_mode_labels_equal_identify_modes_of_the_toolbox():
             mine = _stiffness_share(A, nr.state_descriptions, nr.derivative_order, lam,
                                     _family(ours))
             toolbox = _stiffness_share(A, nr.state_descriptions, nr.derivative_order, lam,
-                                       _family(_toolbox_as_ours(theirs, True)))
+                                       _family(theirs))
             assert mine > 1.5 * toolbox, (name, number, mine, toolbox)
     assert agree == 31                                   # of 37 labelled by both
+    # a blade family has one collective mode: on the floating platform at standstill the
+    # collective and cosine flap coordinates mix in modes 52 and 54 (shares 0.54, 0.53)
+    nr, A, modes, upper = toolbox_models['StandstillSemi_ForID_EDHD.1.lin']
+    labels = ltp.mode_labels(modes, nr)
+    assert [labels[upper[k - 1]] for k in (52, 53, 54)] == [
+        '1st flap collective', '1st flap cyclic', '1st flap cyclic']
+    # ... and every ElastoDyn blade family of the ElastoDyn files: one collective mode and a
+    # cyclic pair (BW and FW when the rotor turns)
+    for name, (nr, A, modes, upper) in toolbox_models.items():
+        if 'BD' in name:
+            continue
+        labels = ltp.mode_labels(modes, nr)
+        names = [labels[i] for i in upper]
+        pair = ['cyclic', 'cyclic'] if abs(nr.rotor_speed) < 1e-3 else ['BW', 'FW']
+        for family in ('1st flap', '1st edge', '2nd flap'):
+            mine = sorted(n[len(family) + 1:] for n in names if n.startswith(family))
+            assert mine == sorted(['collective'] + pair), (name, family, mine)
+    # an overdamped collective degree of freedom has two real roots, both collective
+    Ab = np.array([[0.0, 1.0], [-4.0, -5.0]])                      # roots -1 and -4
+    desc = [f'ED 1st flapwise bending-mode DOF of blade {b}, m' for b in (1, 2, 3)]
+    desc += [d.replace('ED ', 'ED First time derivative of ') + '/s' for d in desc]
+    rot = ltp.RotorStateSpace(
+        ltp.PeriodicMatrix.constant(np.kron(Ab, np.eye(3)), 2 * np.pi), np.zeros((6, 0)),
+        np.zeros((0, 6)), np.zeros((0, 0)), 2 * np.pi,
+        rotor=dict(rotor_speed=1.0, state_descriptions=desc, rotating_states=np.ones(6, bool),
+                   derivative_order=np.full(6, 2)))
+    nr, _ = ltp.mbc(rot, 3)
+    modes = ltp.floquet_modes(nr)
+    labels = ltp.mode_labels(modes, nr)
+    real = np.abs(modes.exponents.imag) < 1e-9
+    assert np.allclose(np.sort(modes.exponents[real].real), [-4, -1])
+    assert [lab for lab, r in zip(labels, real) if r] == ['1st flap collective'] * 2
+    assert labels.count('1st flap collective') == 2
+
+
+def test_mode_labels_openfast_rule_equals_identify_modes(toolbox_models):
+    """rule='openfast' names every mode as IdentifyModes does, scaled or not."""
+    for name, table in TOOLBOX_LABELS.items():
+        nr, A, modes, upper = toolbox_models[name]
+        if 'old' in name:                # the toolbox's reading of the old format
+            nr = copy.copy(nr)
+            nr.derivative_order = np.ones(nr.nstates, int)
+        unscaled = {**table, **TOOLBOX_UNSCALED.get(name, {})}
+        for lengths, truth in (((40, 55), table), ((None, None), unscaled)):
+            labels = ltp.mode_labels(modes, nr, 'openfast', blade_length=lengths[0],
+                                     tower_length=lengths[1])
+            ours = {k + 1: labels[i] for k, i in enumerate(upper) if labels[i] != 'unidentified'}
+            assert ours == {k: _toolbox_as_ours(v) for k, v in truth.items() if v}, \
+                (name, lengths)
+            # a pair has one name; real modes have none
+            for i, lam in enumerate(modes.exponents):
+                j = np.argmin(np.abs(modes.exponents - np.conj(lam)))
+                assert labels[i] == labels[j] if lam.imag else labels[i] == 'unidentified'
+    with pytest.raises(ValueError, match="rule must be"):
+        ltp.mode_labels(modes, nr, 'toolbox')
+    with pytest.raises(ValueError, match="blade_length must be a positive"):
+        ltp.mode_labels(modes, nr, 'openfast', blade_length=-1.0)
+    with pytest.raises(ValueError, match="modes must be the modes of sys"):
+        ltp.mode_labels(toolbox_models['Main_Rotating.*.lin'][2], nr)
 
 
 def test_campbell_of_a_folder_tree_exported_and_reloaded(tmp_path):
@@ -423,6 +547,11 @@ def test_campbell_of_files_by_floquet_equals_averaging(tmp_path):
     assert avg.xlabel == 'wind speed [m/s]'
     for k in range(2):
         assert max(np.abs(avg.exponents[k] - lam).min() for lam in flo.exponents[k]) < 1e-7
+    # clean modes: OpenFAST's rule names them alike
+    named = ltp.campbell_lin(tmp_path, label_rule='openfast', blade_length=40, tower_length=80)
+    assert named.labels == avg.labels and '1st edge FW' in named.labels
+    with pytest.raises(ValueError, match="label_rule must be"):
+        ltp.campbell_lin(tmp_path, label_rule='IdentifyModes')
     with pytest.raises(ValueError, match="same rotor_speed"):
         ltp.campbell_lin([sorted(next(tmp_path.glob('ws05.0*')).glob('*.lin'))] * 2,
                          x='rotor_speed')

@@ -79,7 +79,8 @@ def operating_points(source):
 
 
 def campbell_lin(source, nblades=3, *, method='average', x='auto', per_rev=(1, 2, 3),
-                 remove_states=None, nharmonics=None):
+                 remove_states=None, nharmonics=None, label_rule='participation',
+                 blade_length=None, tower_length=None):
     """Campbell diagram of OpenFAST linearizations at several operating points.
 
     Parameters
@@ -108,6 +109,13 @@ def campbell_lin(source, nblades=3, *, method='average', x='auto', per_rev=(1, 2
         `read_lin`).
     nharmonics : int, optional
         Passed to `floquet_modes` (``method='floquet'``).
+    label_rule : {'participation', 'openfast'}
+        How the modes are named (`mode_labels`' `rule`): by the degrees of
+        freedom that participate, or as openfast_toolbox's
+        ``IdentifyModes`` names them.
+    blade_length, tower_length : float, optional
+        ``label_rule='openfast'``: the lengths the toolbox scales the
+        eigenvectors by (see `mode_labels`).
 
     Returns
     -------
@@ -123,7 +131,7 @@ def campbell_lin(source, nblades=3, *, method='average', x='auto', per_rev=(1, 2
     ValueError
         If two operating points share the axis value, an operating point
         has no periodic model for ``method='floquet'``, or the models have
-        different states.
+        different states, or `label_rule` is unknown.
 
     Examples
     --------
@@ -137,7 +145,21 @@ def campbell_lin(source, nblades=3, *, method='average', x='auto', per_rev=(1, 2
     >>> [(lab, round(float(f), 4)) for lab, f in zip(t['label'][at3],
     ...                                               t['frequency_hz'][at3])][2:5]
     [('1st tower SS', 0.314), ('1st tower FA', 0.3314), ('drivetrain', 0.6263)]
+
+    Named as OpenFAST's Campbell tools name them (the NREL 5 MW blade and
+    tower lengths): the 0.63 Hz mode, whose frequency depends most on the
+    drivetrain's stiffness, is their 1st edge collective.
+
+    >>> cd = ltp.campbell_lin(str(data / 'ws0*.lin'), label_rule='openfast',
+    ...                       blade_length=61.5, tower_length=87.6)
+    >>> t = cd.table()
+    >>> at3 = t['value'] == 3.0
+    >>> [(lab, round(float(f), 4)) for lab, f in zip(t['label'][at3],
+    ...                                               t['frequency_hz'][at3])][2:5]
+    [('1st tower SS', 0.314), ('1st tower FA', 0.3314), ('1st edge collective', 0.6263)]
     """
+    if label_rule not in ('participation', 'openfast'):
+        raise ValueError(f"label_rule must be 'participation' or 'openfast', got {label_rule!r}")
     if method not in ('average', 'floquet'):
         raise ValueError(f"method must be 'average' or 'floquet', got {method!r}")
     if x not in ('auto', 'rotor_speed', 'wind_speed'):
@@ -193,12 +215,15 @@ def campbell_lin(source, nblades=3, *, method='average', x='auto', per_rev=(1, 2
     # multi-blade (or averaged) models: the principal harmonic is the physical branch
     cd = campbell(lookup.__getitem__, values, rotor_speed=speeds[order], per_rev=per_rev,
                   nharmonics=nharmonics, n_jobs=1, branch='principal')
-    names = [mode_labels(m, models[k][1]) for m, k in zip(cd.modes, order)]
+    names = [mode_labels(m, models[k][1], label_rule, blade_length=blade_length,
+                         tower_length=tower_length) for m, k in zip(cd.modes, order)]
     labels = []
     for track in range(cd.frequency.shape[1]):
         seen = collections.Counter(names[i][cd.indices[i, track]] for i in range(len(values)))
-        # the most frequent name; a whirl direction is preferred to a standing 'cyclic'
-        labels.append(max(seen, key=lambda lab: (seen[lab], not lab.endswith('cyclic'))))
+        # the most frequent name; a whirl direction is preferred to a standing 'cyclic',
+        # a name to none
+        labels.append(max(seen, key=lambda lab: (seen[lab], lab != 'unidentified',
+                                                 not lab.endswith('cyclic'))))
     frame = frames[0] if len(set(frames)) == 1 else None
     return replace(cd, labels=tuple(labels), wind_speed=winds[order],
                    xlabel='wind speed [m/s]' if x == 'wind_speed' else 'rotor speed [rad/s]',
