@@ -85,6 +85,10 @@ from ._delays.connect import Delay, delay
 from ._delays.margins import delay_margin
 from ._delays import timeresp as _delay_timeresp  # noqa: F401  (registers the overrides)
 from ._delays.chart import stability_chart, StabilityChart, StabilityChartError
+from ._frequency.impedance import LTIHTF, rlc_impedance
+from ._frequency.products import harmonic_product
+from ._frequency.measured_loop import (impedance_nyquist, impedance_margins,
+                                       SampledNyquistResponse)
 
 #: Alias of `sample_system`, as in python-control.
 c2d = sample_system
@@ -152,6 +156,9 @@ __all__ = [
     'care_finite', 'lyap_finite', 'h2norm_finite', 'sylvester', 'dsylvester',
     # validation of identified models on time records
     'validate_ltp', 'LTPValidation',
+    # impedance-based stability: network impedances, products, measured loops
+    'LTIHTF', 'rlc_impedance', 'harmonic_product', 'impedance_nyquist',
+    'impedance_margins', 'SampledNyquistResponse',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise
