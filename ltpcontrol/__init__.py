@@ -89,6 +89,7 @@ from ._frequency.impedance import LTIHTF, rlc_impedance
 from ._frequency.products import harmonic_product
 from ._frequency.measured_loop import (impedance_nyquist, impedance_margins,
                                        SampledNyquistResponse)
+from ._analysis.sampled_loop import sampled_loop, lifted_nyquist, LiftedNyquistResponse
 
 #: Alias of `sample_system`, as in python-control.
 c2d = sample_system
@@ -159,6 +160,8 @@ __all__ = [
     # impedance-based stability: network impedances, products, measured loops
     'LTIHTF', 'rlc_impedance', 'harmonic_product', 'impedance_nyquist',
     'impedance_margins', 'SampledNyquistResponse',
+    # sampled-data loops around continuous periodic plants
+    'sampled_loop', 'lifted_nyquist', 'LiftedNyquistResponse',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise
