@@ -90,6 +90,7 @@ from ._frequency.products import harmonic_product
 from ._frequency.measured_loop import (impedance_nyquist, impedance_margins,
                                        SampledNyquistResponse)
 from ._analysis.sampled_loop import sampled_loop, lifted_nyquist, LiftedNyquistResponse
+from ._frequency.coupling import frame_htf, FrameHTF
 
 #: Alias of `sample_system`, as in python-control.
 c2d = sample_system
@@ -159,7 +160,7 @@ __all__ = [
     'validate_ltp', 'LTPValidation',
     # impedance-based stability: network impedances, products, measured loops
     'LTIHTF', 'rlc_impedance', 'harmonic_product', 'impedance_nyquist',
-    'impedance_margins', 'SampledNyquistResponse',
+    'impedance_margins', 'SampledNyquistResponse', 'frame_htf', 'FrameHTF',
     # sampled-data loops around continuous periodic plants
     'sampled_loop', 'lifted_nyquist', 'LiftedNyquistResponse',
 ]
