@@ -215,3 +215,24 @@ def test_measured_margins_match_the_model_to_grid_accuracy(measured):
     assert np.isclose(data.gain_upper.frequency, exact.gain_upper.frequency, rtol=1e-2)
     assert np.isclose(data.stability.value, exact.stability.value, rtol=1e-3)
     assert 'Hz' in data.report(hz=True)
+
+
+def test_measured_two_phase_admittance_with_a_frame_changed_impedance():
+    # a balanced grid given in dq, seen in αβ (frame_htf), times a measured
+    # admittance y(s) per phase: two identical SISO loops z y (python-control)
+    w1, N = 2 * np.pi, 3
+    R, L = 1.0, 0.3
+    Zab = ltp.frame_htf(ltp.rlc_impedance(R, L, period=T, nharmonics=N + 1, omega1=w1),
+                        'dq', 'ab', w1, nharmonics=N)
+    w = np.arange(1, 64 * (N + 2)) * WP / 64
+    for k in (2.0, 40.0):
+        y = ct.tf([k], [1, 2, 3, 1])
+        G = np.zeros((1, 2, 2, w.size), complex)
+        G[0, 0, 0] = G[0, 1, 1] = y(1j * w)
+        Ym = ltp.HTFData(G, w, period=T)
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore')
+            resp = ltp.impedance_nyquist((Zab, Ym), N, open_loop_unstable=0)
+        cl = ct.feedback(ct.tf([L, R], [1]) * y, 1)
+        assert resp.stable == bool(np.all(np.real(ct.poles(cl)) < 0)), k
+        assert any('FrameHTF' in c for c in resp.caveats)

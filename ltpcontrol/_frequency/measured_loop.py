@@ -388,9 +388,17 @@ class _SampledLoop:
             else:
                 sys = _model(f, T)
                 M = _model_blocks(f, sys, w, N)
-                if sys is not None and sys.nstates:
+                lam = None
+                if isinstance(f, LTIHTF):
+                    lam = np.atleast_1d(f.sys.poles()).astype(complex)
+                elif sys is not None and sys.nstates:
                     lam = (np.linalg.eigvals(sys.A(0.0)) if sys.A.is_constant
                            else np.atleast_1d(floquet_exponents(sys)))
+                elif sys is None:
+                    caveats.append(f"factor {i + 1} ({type(f).__name__}): its open-loop "
+                                   "exponents are not computed; count them in "
+                                   "open_loop_unstable")
+                if lam is not None and lam.size:
                     atol = 1e-9 * wp
                     P_models += int(np.count_nonzero(lam.real > atol))
                     if np.any(np.abs(lam.real) <= atol):
@@ -517,9 +525,16 @@ def _model_blocks(f, sys, w, N):
     elif sys is not None:
         from .htf import htf
         H = htf(sys, N)
+    elif isinstance(f, HTF) and f.nharmonics >= N:
+        # another harmonic object (frame change, delays): its central blocks
+        M = np.moveaxis(np.asarray(f(1j * w), complex), -1, 0)
+        d = f.nharmonics - N
+        r = slice(d * f.noutputs, (d + 2 * N + 1) * f.noutputs)
+        c = slice(d * f.ninputs, (d + 2 * N + 1) * f.ninputs)
+        return M[:, r, c]
     else:
-        raise ValueError(f"impedance_nyquist: a factor of type {type(f).__name__} cannot "
-                         "be evaluated with N harmonics")
+        raise ValueError(f"impedance_nyquist: a factor of type {type(f).__name__} with "
+                         f"{f.nharmonics} harmonics cannot be evaluated with N = {N}")
     return np.moveaxis(H(1j * w), -1, 0)
 
 
