@@ -315,7 +315,8 @@ def lifted_nyquist(loop, *, omega_num=401, name=None):
     def evaluate(theta):
         z = radius * np.exp(1j * theta)
         if n:
-            R = np.linalg.solve(z[:, None, None] * np.eye(n) - A, np.broadcast_to(B, (len(z),) + B.shape))
+            R = np.linalg.solve(z[:, None, None] * np.eye(n) - A,
+                                np.broadcast_to(B, (len(z),) + B.shape))
             Lz = C @ R + D
         else:
             Lz = np.broadcast_to(D, (len(z), M, M)).astype(complex)

@@ -142,8 +142,10 @@ class SampledNyquistResponse(HarmonicNyquistResponse):
         w = self.omega
         step = np.min(np.diff(w)) if len(w) > 1 else np.nan
         P = self.open_loop_unstable
+        verdict = ('no verdict' if P is None
+                   else 'stable' if self.stable else 'unstable')
         lines = [f"encirclements {self.encirclements}, P = {P}, Z = "
-                 f"{self.closed_loop_unstable} ({'no verdict' if P is None else ('stable' if self.stable else 'unstable')})",
+                 f"{self.closed_loop_unstable} ({verdict})",
                  f"samples: {len(w)} in the strip [{-self.omega_p / 2 * f:.4g}, "
                  f"{self.omega_p / 2 * f:.4g}] {unit} (spacing {step * f:.4g} {unit}) of "
                  f"harmonics -{self.nharmonics}..{self.nharmonics}",

@@ -43,7 +43,7 @@ def harmonic_product(*factors, period=None, name=None):
 
     Parameters
     ----------
-    *factors : LTPStateSpace, HTFModel, LTIHTF, control.StateSpace, control.TransferFunction or float
+    *factors : LTPStateSpace, HTFModel, LTIHTF, control LTI system or float
         ``F_1, ..., F_k`` of the product ``F_1 F_2 ... F_k`` (``F_k`` acts
         first), e.g. ``(Z_g, Y)`` for a grid impedance and a converter
         admittance.  LTI factors may be improper when a neighbouring
