@@ -214,7 +214,8 @@ def test_measured_margins_match_the_model_to_grid_accuracy(measured):
     assert np.isclose(data.gain_upper.value, exact.gain_upper.value, rtol=2e-3)
     assert np.isclose(data.gain_upper.frequency, exact.gain_upper.frequency, rtol=1e-2)
     assert np.isclose(data.stability.value, exact.stability.value, rtol=1e-3)
-    assert 'Hz' in data.report(hz=True)
+    assert data.report(Hz=True) == data.report(hz=True) != data.report()
+    assert 'frequency [Hz]' in data.report(Hz=True)
 
 
 def test_measured_two_phase_admittance_with_a_frame_changed_impedance():
