@@ -89,6 +89,34 @@ def test_sampled_loop_verdict_and_multipliers_equal_a_hybrid_simulation():
     assert verdicts == {True, False}
 
 
+def test_periodic_controller_is_delayed_after_it_acts():
+    # a gain alternating between steps: u[j] = -K[j - k] y[j - k], which is not
+    # K[j] y[j - k]; the hybrid simulation steps the gain by hand
+    plant, A = mathieu_plant()
+    N, Ts, delay = 6, 1.0 / 6, 1
+    gains = np.array([3.0, 0.5])
+    Kp = ltp.ltpss(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)),
+                   gains.reshape(2, 1, 1), period=2 * Ts, dt=Ts)
+    resp = ltp.lifted_nyquist(ltp.sampled_loop(plant, Kp, Ts, delay=delay))
+    n, dim = 2, 3
+    M = np.eye(dim)
+    for j in range(N):
+        def rhs(t, z):
+            Z = z.reshape(2, 3)
+            return np.hstack([A(t) @ Z[:, :2], A(t) @ Z[:, 2:] + [[0.0], [1.0]]]).ravel()
+        sol = solve_ivp(rhs, (j * Ts, (j + 1) * Ts), np.hstack([np.eye(2), np.zeros((2, 1))]
+                                                               ).ravel(),
+                        method='DOP853', rtol=1e-12, atol=1e-14)
+        Z = sol.y[:, -1].reshape(2, 3)
+        S = np.zeros((dim, dim))
+        S[:n, :n], S[:n, n] = Z[:, :2], -Z[:, 2]          # u_j = -v_{j-1}
+        S[n, 0] = gains[j % 2]                            # v_j = K[j] y_j
+        M = S @ M
+    truth = np.linalg.eigvals(M)
+    assert np.allclose(np.sort_complex(resp.multipliers), np.sort_complex(truth), atol=1e-8)
+    assert resp.stable == (np.abs(truth).max() < 1)
+
+
 @pytest.mark.parametrize('P, K, delay', [
     (ct.tf([1], [0.1, 1]), ct.tf([2, -1.8], [1, -1], 0.01), 1),           # PI, stable
     (ct.tf([1], [1, -1]), ct.tf([30.0], [1], 0.01), 2),                 # unstable plant
