@@ -237,3 +237,12 @@ def test_measured_two_phase_admittance_with_a_frame_changed_impedance():
         cl = ct.feedback(ct.tf([L, R], [1]) * y, 1)
         assert resp.stable == bool(np.all(np.real(ct.poles(cl)) < 0)), k
         assert any('FrameHTF' in c for c in resp.caveats)
+
+
+def test_loop_functions_take_impedance_products():
+    Zh = ltp.rlc_impedance(0.5, 0.2, period=T, nharmonics=3)
+    S = ltp.sensitivity_htf((Zh, Y), 3)
+    s = 0.4 + 1.3j
+    Lh = Zh(s) @ ltp.htf(Y, 3, internal_harmonics=25)(s)
+    want = np.linalg.inv(np.eye(7) + Lh)
+    assert np.allclose(S(s)[2:5, 2:5], want[2:5, 2:5], atol=1e-9)
