@@ -316,7 +316,9 @@ def impedance_margins(factors, nharmonics=10, *, period=None, skew=0.0, omega_nu
                                 internal_harmonics=internal_harmonics, edge_tol=edge_tol,
                                 check=check, floquet_steps=floquet_steps)
     skew = float(real_array(skew, 'skew', ndim=0))
-    loop = _SampledLoop(factors, nharmonics, period, None)
+    # the strip widened by ω_p/8 on both sides: crossings at its edges are seen
+    # from both sides (and counted once, by physical frequency)
+    loop = _SampledLoop(factors, nharmonics, period, None, extend=0.125)
     Lh, w, wp = loop.values, loop.omega, loop.omega_p
     eig = track(np.linalg.eigvals(Lh))
     _, V = np.linalg.eig(Lh)
@@ -364,7 +366,7 @@ def impedance_margins(factors, nharmonics=10, *, period=None, skew=0.0, omega_nu
 class _SampledLoop:
     """``L̂_N(jω)`` of the product at the strip frequencies the data provide."""
 
-    def __init__(self, factors, nharmonics, period, omega):
+    def __init__(self, factors, nharmonics, period, omega, extend=0.0):
         self.N = N = check_positive_int(nharmonics, 'nharmonics', minimum=1)
         data = [f for f in factors if isinstance(f, HTFData)]
         periods = [f.period for f in factors if isinstance(f, (HTF, LTPStateSpace))]
@@ -376,7 +378,7 @@ class _SampledLoop:
         wp = 2 * np.pi / T
         self.omega_p, self.name = wp, 'L'
         caveats = []
-        w = _strip(data, N, wp) if omega is None else np.unique(
+        w = _strip(data, N, wp, extend) if omega is None else np.unique(
             real_array(omega, 'omega', ndim=1))
         mats, keep = [], np.ones(len(w), bool)
         P_models = 0
@@ -455,11 +457,13 @@ def _unstable(P, loop):
     return int(P) + loop.P_models
 
 
-def _strip(data, N, wp):
-    """Strip frequencies ω at which every ``|ω + nω_p|``, |n| <= N, is on every grid."""
+def _strip(data, N, wp, extend=0.0):
+    """Strip frequencies ω at which every ``|ω + nω_p|``, |n| <= N, is on every grid
+    (the strip widened by `extend` ω_p on both sides)."""
     g = data[0].omega
+    half = (0.5 + extend) * wp
     cand = np.concatenate([s * g - n * wp for s in (1, -1) for n in range(-N, N + 1)])
-    cand = cand[(cand > -wp / 2 * (1 - 1e-9)) & (cand <= wp / 2 * (1 + 1e-9))]
+    cand = cand[(cand > -half + 1e-9 * wp) & (cand <= half * (1 + 1e-9))]
     cand = np.unique(np.round(cand / (wp * _GRID_RTOL)) * (wp * _GRID_RTOL))
     ok = np.ones(len(cand), bool)
     for H in data:
