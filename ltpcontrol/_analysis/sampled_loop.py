@@ -93,7 +93,7 @@ def sampled_loop(plant, controller, Ts, *, delay=0, name=None):
     Examples
     --------
     A first-order plant with a sampled PI controller and one period of
-    computation delay (python-control's `c2d` gives the same loop):
+    computation delay (python-control's ``ct.c2d`` gives the same loop):
 
     >>> P = ct.tf([1], [0.1, 1])
     >>> K = ct.c2d(ct.tf([2, 20], [1, 0]), 0.01, 'tustin')
