@@ -87,6 +87,12 @@ from ._delays.margins import delay_margin
 from ._delays import nyquist as _delay_nyquist  # noqa: F401  (registers the overrides)
 from ._delays import timeresp as _delay_timeresp  # noqa: F401  (registers the overrides)
 from ._delays.chart import stability_chart, StabilityChart, StabilityChartError
+from ._frequency.impedance import LTIHTF, rlc_impedance
+from ._frequency.products import harmonic_product
+from ._frequency.measured_loop import (impedance_nyquist, impedance_margins,
+                                       SampledNyquistResponse)
+from ._analysis.sampled_loop import sampled_loop, lifted_nyquist, LiftedNyquistResponse
+from ._frequency.coupling import frame_htf, FrameHTF
 
 #: Alias of `sample_system`, as in python-control.
 c2d = sample_system
@@ -154,6 +160,11 @@ __all__ = [
     'care_finite', 'lyap_finite', 'h2norm_finite', 'sylvester', 'dsylvester',
     # validation of identified models on time records
     'validate_ltp', 'LTPValidation',
+    # impedance-based stability: network impedances, products, measured loops
+    'LTIHTF', 'rlc_impedance', 'harmonic_product', 'impedance_nyquist',
+    'impedance_margins', 'SampledNyquistResponse', 'frame_htf', 'FrameHTF',
+    # sampled-data loops around continuous periodic plants
+    'sampled_loop', 'lifted_nyquist', 'LiftedNyquistResponse',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

@@ -157,6 +157,10 @@ KWARG_CALLS.update({
 
 # plotting functions hand **kwargs to matplotlib, whose error is AttributeError
 _MATPLOTLIB_KWARGS = {'bode_htf', 'HTF.plot', 'HarmonicNyquistResponse.plot'}
+# sampled-data loops
+KWARG_CALLS['LiftedNyquistResponse.plot'] = lambda **kw: ltp.lifted_nyquist(
+    ltp.ltpss(ct.ss(ct.tf([0.5], [1, 0.5], 0.1)), period=0.2)).plot(**kw)
+_MATPLOTLIB_KWARGS |= {'LiftedNyquistResponse.plot'}
 
 
 def _accepts_var_keyword(func):
@@ -232,6 +236,7 @@ _RESULT_CLASSES |= {'DelayMonodromy', 'StabilityChart'}
 _RESULT_CLASSES |= {'HarmonicModes'}
 _RESULT_CLASSES |= {'OutputFeedbackResult'}
 _RESULT_CLASSES |= {'LTPValidation'}
+_RESULT_CLASSES |= {'SampledNyquistResponse', 'LiftedNyquistResponse'}
 
 DOC_DEFECTS = {}
 

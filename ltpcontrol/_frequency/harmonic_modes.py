@@ -96,10 +96,29 @@ class HarmonicModes:
         """True when every mode has a negative real part."""
         return bool(np.all(self.exponents.real < 0))
 
-    def frequency(self, hz=False):
-        """Physical frequencies ``|Im λ|`` of the modes (rad/s, or Hz)."""
+    def frequency(self, Hz=False, *, hz=None):
+        """Physical frequencies ``|Im λ|`` of the modes (rad/s, or Hz).
+
+        Parameters
+        ----------
+        Hz : bool
+            In Hz (python-control's keyword) instead of rad/s.
+        hz : bool, optional
+            Former spelling of `Hz`, still accepted.
+
+        Returns
+        -------
+        ndarray
+
+        Examples
+        --------
+        >>> sys = ltp.ltpss(ct.ss([[0.0, 1.0], [-4.0, 0.0]], [[0.0], [1.0]],
+        ...                       [[1.0, 0.0]], 0), period=1.0)
+        >>> np.round(ltp.harmonic_modes(sys).frequency(Hz=True), 6)
+        array([0.31831, 0.31831])
+        """
         f = np.abs(self.exponents.imag)
-        return f / (2 * np.pi) if hz else f
+        return f / (2 * np.pi) if (Hz if hz is None else hz) else f
 
     @property
     def damping(self):
@@ -108,13 +127,15 @@ class HarmonicModes:
         with np.errstate(invalid='ignore', divide='ignore'):
             return np.where(mag > 0, -self.exponents.real / np.where(mag > 0, mag, 1), 1.0)
 
-    def table(self, hz=False):
+    def table(self, Hz=False, *, hz=None):
         """Frequency/damping table of the modes, with each mode's leading state.
 
         Parameters
         ----------
-        hz : bool
-            Frequencies in Hz instead of rad/s.
+        Hz : bool
+            Frequencies in Hz instead of rad/s (python-control's keyword).
+        hz : bool, optional
+            Former spelling of `Hz`, still accepted.
 
         Returns
         -------
@@ -124,14 +145,15 @@ class HarmonicModes:
         --------
         >>> sys = ltp.ltpss(ct.ss([[-1.0, 0.0], [1.0, -3.0]], [[0.0], [1.0]],
         ...                       [[1.0, 0.0]], 0), period=1.0)
-        >>> print(ltp.harmonic_modes(sys).table(hz=True))     # doctest: +NORMALIZE_WHITESPACE
+        >>> print(ltp.harmonic_modes(sys).table(Hz=True))     # doctest: +NORMALIZE_WHITESPACE
         mode  real part   frequency [Hz]  damping  leading state (share)
            0         -1                0        1  x[0] (1)
            1         -3                0        1  x[1] (1)
         """
-        unit = 'Hz' if hz else 'rad/s'
+        Hz = Hz if hz is None else hz
+        unit = 'Hz' if Hz else 'rad/s'
         rows = [f"mode  real part   frequency [{unit}]  damping  leading state (share)"]
-        f = self.frequency(hz)
+        f = self.frequency(Hz)
         for j, lam in enumerate(self.exponents):
             k = int(np.argmax(self.participation[:, j]))
             rows.append(f"{j:4d}  {lam.real:9.5g}  {f[j]:15.5g}  {self.damping[j]:7.4g}  "

@@ -44,6 +44,12 @@ def as_loop(L, name='L', period=None, where=None):
     ...
     control.exception.ControlDimension: L must be a square loop (as many outputs as inputs) to be closed by negative feedback; it has 2 outputs and 1 inputs
     """
+    # --- products of harmonic objects (impedances, HTF models), realized exactly;
+    # --- module products (impedance workflow)
+    from .products import harmonic_product, is_harmonic_sequence
+    if is_harmonic_sequence(L):
+        L = harmonic_product(*L, period=period, name=name)
+    # ---
     if isinstance(L, (list, tuple)):
         if not L:
             raise ControlArgument(f"{name} must be a system or a non-empty sequence of systems")

@@ -138,13 +138,16 @@ class HarmonicMargins:
     nharmonics: int
     skew: float
 
-    def report(self, hz=False):
-        """The margins as a table, frequencies in rad/s or (``hz=True``) Hz.
+    def report(self, Hz=False, *, hz=None):
+        """The margins as a table, frequencies in rad/s or (``Hz=True``) Hz.
 
         Parameters
         ----------
-        hz : bool
-            Physical frequencies in Hz instead of rad/s.
+        Hz : bool
+            Physical frequencies in Hz instead of rad/s (python-control's
+            keyword, as in ``ct.bode_plot(Hz=True)``).
+        hz : bool, optional
+            Former spelling of `Hz`, still accepted.
 
         Returns
         -------
@@ -153,7 +156,7 @@ class HarmonicMargins:
         Examples
         --------
         >>> m = ltp.harmonic_margins(ltp.ltpss(ct.tf([4], [1, 3, 3, 1]), period=1.0), 5)
-        >>> print(m.report(hz=True))          # doctest: +NORMALIZE_WHITESPACE
+        >>> print(m.report(Hz=True))          # doctest: +NORMALIZE_WHITESPACE
         margin       value  harmonic  frequency [Hz]
         gain upper       2         0         0.27566
         gain lower       0         0             nan
@@ -161,12 +164,13 @@ class HarmonicMargins:
         stability   0.3333         0         0.22508
         disk        0.3777         0         0.22117
         """
-        unit = 'Hz' if hz else 'rad/s'
+        Hz = Hz if hz is None else hz
+        unit = 'Hz' if Hz else 'rad/s'
         rows = [f"margin       value  harmonic  frequency [{unit}]"]
         for name, p in (('gain upper', self.gain_upper), ('gain lower', self.gain_lower),
                         ('phase [deg]', self.phase), ('stability', self.stability),
                         ('disk', self.disk)):
-            f = p.frequency / (2 * np.pi) if hz else p.frequency
+            f = p.frequency / (2 * np.pi) if Hz else p.frequency
             rows.append(f"{name:<11} {p.value:6.4g} {p.harmonic:9d} {f:15.5g}")
         return "\n".join(rows)
 
