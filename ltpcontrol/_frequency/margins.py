@@ -499,6 +499,7 @@ def _extremum(loop, w, Lh, fun, kind):
 
 def _disk_gain_phase(alpha, skew):
     """Gain interval and phase (deg) of the disk of radius α (control.disk_margins)."""
+    alpha, skew = np.float64(alpha), np.float64(skew)        # α = 2: gmax = ∞, not an error
     with np.errstate(divide='ignore', invalid='ignore'):
         gmin = (1 - 0.5 * alpha * (1 - skew)) / (1 + 0.5 * alpha * (1 + skew))
         gmax = (1 + 0.5 * alpha * (1 - skew)) / (1 - 0.5 * alpha * (1 + skew))
