@@ -31,7 +31,8 @@ from .ltpsys import ltpss
 from .periodic_matrix import PeriodicMatrix
 from .periodic_schur import product_eigenvalues
 from .pm_ops import register_func
-from .steps import floquet_grid
+from .steps import floquet_grid, floquet_norm
+from .graded import STIFF, stiff_log_multipliers
 from .fastform import constant_value, fast_form
 from .memory import check_allocation
 from .transition import expm_batch, step_transitions, uniform_transitions
@@ -452,6 +453,12 @@ def _log_multipliers(sys, nsteps, grid=None, factors=None):
             arg[arg == -np.pi] = np.pi
             order = np.lexsort((-arg, -lam.real))
             return lam.real[order], arg[order]
+        if not sys.dt and nsteps is None and sys.nstates >= 2:
+            A = fast_form(sys.A)
+            norm = floquet_norm(A)
+            if sys.period * norm > STIFF:
+                # stiff: graded factors keep every exponent without stiff step counts
+                return stiff_log_multipliers(A, norm)
         grid, factors = _factors(sys, nsteps)
     if factors.shape[1] == 0:
         return np.zeros(0), np.zeros(0)

@@ -149,7 +149,7 @@ def _rank_deficiency(F, tol):
     return int(np.max(np.count_nonzero(small, axis=1)))
 
 
-def _product_qr(F, zeros=0, noise=0):
+def _product_qr(F, zeros=0, noise=0, warn=True, min_sweeps=None):
     """Block periodic Schur form by QR sweeps: sorted (log|μ|, arg μ, error).
 
     The `zeros` smallest eigenvalues are exact zeros (singular factors); the
@@ -173,7 +173,7 @@ def _product_qr(F, zeros=0, noise=0):
             logmod[smallest], arg[smallest] = -np.inf, 0.0
         changes.append(_change(previous, blocks, logmod, arg, zeros + noise))
         previous, Q0 = (blocks, logmod, arg), Q
-        if sweep + 1 >= _MIN_SWEEPS and (changes[-1] <= _SETTLE_TOL or _at_floor(changes)):
+        if sweep + 1 >= (min_sweeps or _MIN_SWEEPS) and (changes[-1] <= _SETTLE_TOL or _at_floor(changes)):
             break
     # the last changes estimate the error: rounding noise at the floor, or
     # the remaining (geometric) convergence
@@ -181,7 +181,7 @@ def _product_qr(F, zeros=0, noise=0):
     error = 2 * (changes[-1] if changes[-1] <= _SETTLE_TOL else max(recent, default=np.inf))
     determined = np.sort(logmod)[zeros + noise:]
     worst = error * (1 + np.abs(determined[np.isfinite(determined)]).max(initial=0.0))
-    if worst > _WARN_ERROR:
+    if warn and worst > _WARN_ERROR:
         warnings.warn(f"product_eigenvalues: eigenvalue moduli are accurate only to about "
                       f"{worst:.1g} relative (ill-conditioned product or eigenvalues of close "
                       "but different moduli)", UserWarning, stacklevel=3)
