@@ -20,16 +20,24 @@ Rows (n = 38, 120, 300):
   ``scipy.linalg.expm`` steps ``Φ = Π e^{A((k+½)h) h}`` then ``eig``,
   with N = 720 (the smallest N of the form 36 * 2^j whose structural
   exponents reach the tolerance, checked against the reference at 2N).
-* accuracy: the exponents of the structural part against an independent
-  converged product (Richardson of midpoint products at 2N and 4N steps;
-  log-moduli from the periodic Schur form so that no product is formed),
-  error relative to the largest real part; the stiff exponents against
-  the same reference when it resolves them.
+* accuracy: every exponent, stiff ones included, against an independent
+  reference that forms no product: the structural block's exponents from
+  Richardson-extrapolated midpoint products (2N and 4N steps; N and 2N
+  above 150 states) in 36 groups through the periodic Schur form, and the
+  lag rates, which are the stiff exponents exactly.  Error: the largest
+  difference of the sorted real parts relative to the largest ``|Re λ|``
+  (the must-show measure, 1e-8); the structural exponents are also
+  reported relative to their own largest ``|Re λ|``.  The peer's stiff
+  multipliers (``e^{-6e4}``) underflow its formed product, so its
+  all-exponent error is meaningless (shown with ``*``); its structural
+  error is the fair comparison of accuracy.
 
 Peak memory: tracemalloc peak of the call (NumPy allocations).
 
 The BAR row: the 44-state OpenFAST model ``BAR_URC_EDBD.1.lin``
-(ElastoDyn + BeamDyn, one azimuth) after ``mbc``; the time-varying
+(ElastoDyn + BeamDyn, one azimuth), its rotating-frame matrix taken as
+independent of the azimuth and turning at the file's rotor speed, after
+``mbc``; the time-varying
 multi-blade model has ``‖A‖ = 5e6`` and exponents down to -1.5e4 rad/s
 (Ω = 0.83 rad/s).  Being one constant rotating-frame matrix seen through
 the multi-blade transform, its exact exponents are the eigenvalues of
@@ -359,7 +367,10 @@ def run(quick=False, log=print):
         t_ours, lam, peak = measure(ltp.floquet_exponents, sys)
         N = 720
         t_peer, lam_peer, peak_peer = measure(peer_exponents, sys, N)
-        t_ref, (ref, k) = timed(reference_exponents, n, 2 * N, 0, cfg['stiff'])
+        # the reference: Richardson of 2N and 4N steps (N and 2N above 150 states,
+        # still fourth order against the peer's second)
+        t_ref, (ref, k) = timed(reference_exponents, n, 2 * N if n <= 150 else N, 0,
+                                cfg['stiff'])
         scale = np.max(np.abs(ref.real))
         err_ours = real_error(lam, ref, scale=scale)
         err_peer = real_error(lam_peer, ref, scale=scale)
