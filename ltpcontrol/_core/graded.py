@@ -176,6 +176,8 @@ def ordered_schur(X, band=_BAND):
     # blocks move ahead keeping their order, so the bands end up sorted
     for level in np.unique(levels)[1:]:
         select = (np.floor(np.diag(S) / band) >= level).astype(np.int32)
+        if np.all(np.diff(select) <= 0):        # the selected ones lead already
+            continue
         S, U, *_, info = lapack.dtrsen(select, S, U, job='N')
         if info != 0:          # reordering failed (ill-conditioned swap): keep the order
             break
