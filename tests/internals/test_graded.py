@@ -56,4 +56,4 @@ def test_graded_factors_agree_with_the_plain_factors():
     grid = np.linspace(0, 1, 601)
     plain, _ = product_eigenvalues(uniform_transitions(A, grid[:-1], np.diff(grid)))
     graded, _ = stiff_log_multipliers(A, floquet_norm(A))
-    assert np.abs(plain - graded).max() <= 1e-10 * np.abs(plain).max()
+    assert np.abs(plain - graded).max() <= 1e-12 * np.abs(plain).max()
