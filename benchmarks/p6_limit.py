@@ -19,6 +19,8 @@ Rows:
   200 s x 100 Hz);
 * **P6b** a 20-state, 2-input, 2-output plant with periodic A(t), B(t), C(t)
   and D(t), 1000 random-input experiments of 2000 samples;
+* **P6d** the P6a data set with the default call (states kept) against
+  the loop that stores the states as well;
 * **P6c** memory: peak traced allocation of `ltp.forced_response` on the
   Mathieu plant with 1000 experiments at 5000 and 20000 samples, divided by
   the size of the returned arrays (inputs, states, outputs); linear memory
@@ -151,6 +153,28 @@ def _compare(rid, workload, sys, t, U, x0, repeats, recurrence, log):
                           kernel_ratio=t_peer / t_kernel))
 
 
+def _compare_states(rid, workload, sys, t, U, x0, repeats, recurrence, log):
+    """The default call (states kept) against the loop that stores the states too."""
+    log(f"P6: {rid} {workload}, default call (states kept)")
+    t_ours, times, resp = median_time(lambda _: ltp.forced_response(sys, t, U, x0),
+                                      repeats, setup=lambda: None)
+    Phi, G0, G1, C, D = _step_data(sys, t)
+    recurrence(Phi, G0, G1, C, D, U[:, :1, :3].copy(), x0[:, :1].copy(), True)  # compile
+    t_peer, _, (xr, yr) = median_time(lambda _: recurrence(Phi, G0, G1, C, D, U, x0, True),
+                                      repeats, setup=lambda: None)
+    err = max(float(np.abs(np.asarray(resp.states) - xr).max() / np.abs(xr).max()),
+              float(np.abs(np.asarray(resp.outputs) - yr).max() / np.abs(yr).max()))
+    del resp, xr, yr
+    return row(rid, workload + ', states kept',
+               ours='ltp.forced_response(sys, t, u, x0), default call, public',
+               peer='compiled scalar recurrence (numba), states and outputs, same '
+                    'discretization', t_ours=t_ours, t_peer=t_peer,
+               target='>= 0.33x (within 3x)', target_met=t_peer / t_ours >= 1 / 3,
+               err_ours=err, err_peer=0.0, tol=TOL, checks={'agree <= 1e-12': err <= TOL},
+               matched=err <= TOL, notes='error: states and outputs against the loop',
+               extra=dict(ours_times=times))
+
+
 def _memory(sys, nexp, samples, log):
     h = sys.period / 50
     quotients, peaks, seconds = [], [], []
@@ -195,6 +219,9 @@ def run(quick=False, log=print):
         U = np.cos(2 * np.pi * f[:, None] * t[None, :])[None]
         rows.append(_compare('P6a', work_a, mathieu(), t, U, np.zeros((2, spec['nexp'])),
                              cfg['repeats'], recurrence, log))
+        rows.append(_compare_states('P6d', work_a, mathieu(), t, U,
+                                    np.zeros((2, spec['nexp'])), cfg['repeats'], recurrence,
+                                    log))
         del U
         sys = big_plant()
         rng = np.random.default_rng(1)

@@ -373,3 +373,32 @@ def test_validation():
     assert floquet_multipliers(nostate).size == 0 and is_stable(nostate)
     with pytest.raises(ValueError, match="no states"):
         floquet_transform(nostate)
+
+
+def test_stiff_exponents_without_stiff_step_counts():
+    # two Mathieu oscillators drive lags at -3e4 that do not feed back: the lag
+    # exponents are the lag rates (multipliers e^{-3e4} underflow any product),
+    # the others those of the oscillators' own monodromy (DOP853)
+    w = 2 * np.pi
+    lags = np.array([-3e4, -4.2e4])
+
+    def A(t):
+        K = np.array([[1.0 + 0.3 * np.cos(w * t), 0.2], [0.2, 2.3 + 0.2 * np.sin(2 * w * t)]])
+        out = np.zeros((6, 6))
+        out[:2, 2:4] = np.eye(2)
+        out[2:4, :2] = -w ** 2 * K
+        out[2:4, 2:4] = -np.diag([0.3, 0.1])
+        out[4:, 2:4] = [[1.0, -2.0], [0.5, 3.0]]
+        out[4:, 4:] = np.diag(lags)
+        return out
+    sys = ltpss(A, np.zeros((6, 1)), np.zeros((1, 6)), 0, period=1.0)
+    lam = floquet_exponents(sys)
+    sol = solve_ivp(lambda t, x: (A(t)[:4, :4] @ x.reshape(4, 4)).ravel(), (0, 1),
+                    np.eye(4).ravel(), method='DOP853', rtol=1e-12, atol=1e-14)
+    slow = np.log(np.abs(np.linalg.eigvals(sol.y[:, -1].reshape(4, 4))))
+    truth = np.concatenate([np.sort(slow), np.sort(lags)])
+    got = np.sort(lam.real)[::-1]
+    truth = np.sort(truth)[::-1]
+    assert np.abs(got - truth).max() <= 1e-8 * np.abs(truth).max()
+    assert np.allclose(got[-2:], np.sort(lags)[::-1], rtol=1e-12, atol=0)
+    assert np.allclose(got[:4], truth[:4], rtol=1e-8, atol=1e-9)

@@ -25,6 +25,7 @@ accuracy; moduli below the smallest float are still returned as finite
 log-moduli.
 """
 
+import math
 import warnings
 
 import numpy as np
@@ -149,7 +150,7 @@ def _rank_deficiency(F, tol):
     return int(np.max(np.count_nonzero(small, axis=1)))
 
 
-def _product_qr(F, zeros=0, noise=0):
+def _product_qr(F, zeros=0, noise=0, warn=True, min_sweeps=None):
     """Block periodic Schur form by QR sweeps: sorted (log|μ|, arg μ, error).
 
     The `zeros` smallest eigenvalues are exact zeros (singular factors); the
@@ -173,7 +174,7 @@ def _product_qr(F, zeros=0, noise=0):
             logmod[smallest], arg[smallest] = -np.inf, 0.0
         changes.append(_change(previous, blocks, logmod, arg, zeros + noise))
         previous, Q0 = (blocks, logmod, arg), Q
-        if sweep + 1 >= _MIN_SWEEPS and (changes[-1] <= _SETTLE_TOL or _at_floor(changes)):
+        if sweep + 1 >= (min_sweeps or _MIN_SWEEPS) and (changes[-1] <= _SETTLE_TOL or _at_floor(changes)):
             break
     # the last changes estimate the error: rounding noise at the floor, or
     # the remaining (geometric) convergence
@@ -181,7 +182,7 @@ def _product_qr(F, zeros=0, noise=0):
     error = 2 * (changes[-1] if changes[-1] <= _SETTLE_TOL else max(recent, default=np.inf))
     determined = np.sort(logmod)[zeros + noise:]
     worst = error * (1 + np.abs(determined[np.isfinite(determined)]).max(initial=0.0))
-    if worst > _WARN_ERROR:
+    if warn and worst > _WARN_ERROR:
         warnings.warn(f"product_eigenvalues: eigenvalue moduli are accurate only to about "
                       f"{worst:.1g} relative (ill-conditioned product or eigenvalues of close "
                       "but different moduli)", UserWarning, stacklevel=3)
@@ -230,14 +231,17 @@ def _block_partition(W, R):
     with np.errstate(divide='ignore'):
         d = np.sum(np.log(np.abs(np.diagonal(R, axis1=1, axis2=2))), axis=0) \
             + np.log(np.abs(np.diag(W)))
+    # below[i, j] = max_{r >= i} |W_rj| (lower part), top[i] = max d[i:] (NaN spreads)
+    below = np.maximum.accumulate(lower[::-1], axis=0)[::-1]
+    top = np.maximum.accumulate(d[::-1])[::-1]
     blocks, start = [], 0
     for split in range(1, n + 1):
         if split < n:
             # a block ends at `split` when nothing below it couples to columns before it
-            coupling = lower[split:, start:split].max()
-            with np.errstate(invalid='ignore', over='ignore'):
-                gap = np.nan_to_num(d[start:split].min() - d[split:].max(), nan=0.0)
-                limit = max(1e-14, min(_SPLIT_TOL, 1e-15 * np.exp(min(gap, 700.0))))
+            coupling = float(below[split, start:split].max())
+            gap = float(d[start:split].min()) - float(top[split])
+            gap = 0.0 if gap != gap else gap                   # NaN: no gap
+            limit = max(1e-14, min(_SPLIT_TOL, 1e-15 * math.exp(min(gap, 700.0))))
             if coupling > limit:
                 continue
         blocks.append((start, split))
@@ -253,15 +257,18 @@ def _block_eigenvalues(W, R):
         d = np.append(R[:, 0, 0], W[0, 0])
         negative = np.count_nonzero(d < 0) % 2
         return np.array([np.sum(np.log(np.abs(d)))]), np.array([np.pi if negative else 0.0])
-    prod, logscale = np.eye(m), 0.0
-    # running product normalised at every factor: e^{logscale} prod
-    for Rk in list(R) + [W]:
-        prod = Rk @ prod
-        s = np.abs(prod).max()
-        if s == 0:
+    # pairwise products normalised at every level: e^{logscale} prod
+    mats, logscale = np.concatenate([R, W[None]]), 0.0
+    while len(mats) > 1:
+        odd = mats[-1:] if len(mats) % 2 else mats[:0]
+        pairs = mats[1:len(mats) - len(odd):2] @ mats[0:len(mats) - len(odd):2]
+        s = np.abs(pairs).max(axis=(1, 2))
+        if np.any(s == 0):
             return np.full(m, -np.inf), np.zeros(m)
-        prod /= s
-        logscale += np.log(s)
+        pairs /= s[:, None, None]
+        logscale += float(np.sum(np.log(s)))
+        mats = np.concatenate([pairs, odd])
+    prod = mats[0]
     mu = np.linalg.eigvals(prod)
     arg = np.angle(mu)
     arg[(mu.imag == 0) & (mu.real < 0)] = np.pi

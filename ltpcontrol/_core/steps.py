@@ -109,6 +109,28 @@ def floquet_grid(A, nsteps=None, budget=FACTOR_BUDGET):
         nsteps = check_positive_int(nsteps, 'nsteps')
         check_allocation((nsteps, n, n), f"{nsteps} Floquet factors of {n} states", copies=2)
         return step_grid(A, nsteps=nsteps)
+    norm = floquet_norm(A)
+    cap = int(min(4096, max(16, budget // (24 * max(n, 1) ** 2))))
+    nsteps = int(np.clip(np.ceil(T * norm), 16, cap))
+    if T * norm > _LOG_SPREAD * nsteps:
+        warnings.warn(f"the Floquet factors of {n} states are capped at {nsteps} steps "
+                      f"(memory budget {budget / 1e6:.0f} MB) while T max‖A(t)‖ = "
+                      f"{T * norm:.3g}: exponents below about {-_LOG_SPREAD * nsteps / T:.3g} "
+                      "fall under the rounding of the factors and may be inaccurate",
+                      UserWarning, stacklevel=3)
+    return step_grid(A, nsteps=nsteps)
+
+
+def floquet_norm(A):
+    """``max_t ‖A(t)‖`` on probe instants, A balanced when its states are badly scaled.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.steps import floquet_norm
+    >>> floquet_norm(ltp.PeriodicMatrix.constant(np.diag([-1.0, -1e4]), 1.0))
+    10000.0
+    """
+    T, n = A.period, A.shape[0]
     breaks = np.unique(np.mod(A.breakpoints, T))
     few = n <= 64
     probe = np.concatenate([[0.0] if A._piecewise_constant
@@ -126,15 +148,7 @@ def floquet_grid(A, nsteps=None, budget=FACTOR_BUDGET):
         # sqrt(‖·‖₁ ‖·‖∞) bounds the 2-norm without an SVD per probe
         norm = np.sqrt(np.abs(At).sum(axis=1).max(initial=0.0)
                        * np.abs(At).sum(axis=2).max(initial=0.0))
-    cap = int(min(4096, max(16, budget // (24 * max(n, 1) ** 2))))
-    nsteps = int(np.clip(np.ceil(T * norm), 16, cap))
-    if T * norm > _LOG_SPREAD * nsteps:
-        warnings.warn(f"the Floquet factors of {n} states are capped at {nsteps} steps "
-                      f"(memory budget {budget / 1e6:.0f} MB) while T max‖A(t)‖ = "
-                      f"{T * norm:.3g}: exponents below about {-_LOG_SPREAD * nsteps / T:.3g} "
-                      "fall under the rounding of the factors and may be inaccurate",
-                      UserWarning, stacklevel=3)
-    return step_grid(A, nsteps=nsteps)
+    return float(norm)
 
 
 def gram_weight(F, adjoint=False):

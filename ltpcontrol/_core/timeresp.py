@@ -13,6 +13,7 @@ A reference path (``method='solve_ivp'``) integrates with
 """
 
 import functools
+import numbers
 import warnings
 
 import numpy as np
@@ -113,9 +114,8 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
     if timepts is None and sys.isdtime(strict=True) and np.ndim(inputs) > 0:
         # python-control: a discrete-time input without timepts is sampled at k dt
         timepts = np.arange(np.shape(inputs)[-1]) * sys.dt
-    t = _time_vector(sys, timepts)
-    u, ntraces = _input_array(sys, inputs, len(t))
-    x0 = _initial_state(sys, initial_state, ntraces)
+    t, u, ntraces, x0 = forced_arguments(sys, timepts, inputs, initial_state, method,
+                                         ('transition', 'solve_ivp'), input_hold)
     if not isinstance(compute_states, (bool, np.bool_)):
         raise ValueError(f"compute_states must be True or False, got {compute_states!r}")
     if return_states and not compute_states:
@@ -379,6 +379,37 @@ def _outputs(sys, t, x, u):
 #
 # Argument processing
 #
+
+def forced_arguments(sys, timepts, inputs, initial_state, method, methods, input_hold,
+                     rtol=None):
+    """The validated arguments of a forced response: ``(t, u, ntraces, x0)``.
+
+    Checks `method` (one of `methods`), `input_hold` ('foh' or 'zoh') and,
+    when given, `rtol` (in (0, 1)), then builds the time vector, the input
+    array ``(ninputs, ntraces, len(t))`` and the initial states ``(n,
+    ntraces)``, as every ``forced_response`` of the library does.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.timeresp import forced_arguments
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> t, u, ntraces, x0 = forced_arguments(sys, [0.0, 0.5, 1.0], 1.0, 0.0,
+    ...                                      'transition', ('transition',), 'foh')
+    >>> u.shape, ntraces, x0.shape
+    ((1, 1, 3), 1, (1, 1))
+    """
+    if method not in methods:
+        raise ValueError(f"method must be {' or '.join(repr(m) for m in methods)}, "
+                         f"got {method!r}")
+    if input_hold not in ('foh', 'zoh'):
+        raise ValueError(f"input_hold must be 'foh' or 'zoh', got {input_hold!r}")
+    if rtol is not None and (isinstance(rtol, (bool, np.bool_))
+                             or not isinstance(rtol, numbers.Real) or not 0 < rtol < 1):
+        raise ValueError(f"rtol must be a number in (0, 1), got {rtol!r}")
+    t = _time_vector(sys, timepts)
+    u, ntraces = _input_array(sys, inputs, len(t))
+    return t, u, ntraces, _initial_state(sys, initial_state, ntraces)
+
 
 def _time_vector(sys, timepts, is_step=None):
     if is_step is not None and sys.is_lti and np.ndim(timepts) == 0:

@@ -16,14 +16,13 @@ rounding when the polynomial reproduces it and otherwise accurate to the
 tolerance checked by a second march at degree ``p + 4``.
 """
 
-import numbers
 import warnings
 
 import numpy as np
 import control as ct
 
 from .._core.registry import override
-from .._core.timeresp import _initial_state, _input_array, _time_vector
+from .._core.timeresp import forced_arguments
 from .._core.validation import check_kwargs, real_array
 from . import terms as tm
 from .ltpdsys import LTPDelayStateSpace
@@ -198,16 +197,8 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *, method=
     -0.5
     """
     check_kwargs(kwargs, 'forced_response')
-    if method not in ('transition', 'collocation'):
-        raise ValueError(f"method must be 'transition' or 'collocation' for a system with "
-                         f"delays, got {method!r}")
-    if input_hold not in ('foh', 'zoh'):
-        raise ValueError(f"input_hold must be 'foh' or 'zoh', got {input_hold!r}")
-    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real) or not 0 < rtol < 1:
-        raise ValueError(f"rtol must be a number in (0, 1), got {rtol!r}")
-    t = _time_vector(sys, timepts)
-    u, ntr = _input_array(sys, inputs, len(t))
-    x0 = _initial_state(sys, initial_state, ntr)
+    t, u, ntr, x0 = forced_arguments(sys, timepts, inputs, initial_state, method,
+                                     ('transition', 'collocation'), input_hold, rtol)
     taus = [a for a, _ in sys.state_delays]
     hist = _check_history(history, t[0], max(taus) if taus else 0.0)
     x, y = _simulate(sys, t, u, x0, hist, input_hold, _ORDER)
