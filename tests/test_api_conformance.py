@@ -232,6 +232,7 @@ _RESULT_CLASSES |= {'DelayMonodromy', 'StabilityChart'}
 _RESULT_CLASSES |= {'HarmonicModes'}
 _RESULT_CLASSES |= {'OutputFeedbackResult'}
 _RESULT_CLASSES |= {'LTPValidation'}
+_RESULT_CLASSES |= {'HinfStateFeedbackResult'}
 
 DOC_DEFECTS = {}
 

@@ -121,9 +121,10 @@ def care(A, B, Q, R, S=None, period=None, nsteps=None):
     return X, L, G
 
 
-def _care_solution(A, B, Q, R, S, period, nsteps):
+def _care_solution(A, B, Q, R, S, period, nsteps, definite=True):
     """``(X, L, G, exact)`` of `care`; G's table not built yet (``exact`` is the
-    pointwise gain ``R⁻¹(BᵀX + Sᵀ)``)."""
+    pointwise gain ``R⁻¹(BᵀX + Sᵀ)``).  ``definite=False`` admits an
+    indefinite (invertible) R, as in the H∞ Riccati equation."""
     period = _period_of((A, B, Q, R, S), period)
     A = as_periodic(A, period, 'A')
     n = A.shape[0]
@@ -138,8 +139,9 @@ def _care_solution(A, B, Q, R, S, period, nsteps):
     S = as_periodic(np.zeros((n, m)) if S is None else S, period, 'S', shape=(n, m))
     ops = (A, B, Q, R, S)
     breaks = np.unique(np.concatenate([M.breakpoints for M in ops]))
-    probe = np.union1d(np.arange(16) * period / 16, breaks)
-    _check_weights(Q(probe), R(probe), 'Q', 'R')
+    if definite:
+        probe = np.union1d(np.arange(16) * period / 16, breaks)
+        _check_weights(Q(probe), R(probe), 'Q', 'R')
 
     H = _hamiltonian(ops, breaks)
     grid = _grid(H, period, breaks, nsteps)
@@ -148,16 +150,25 @@ def _care_solution(A, B, Q, R, S, period, nsteps):
     X0 = _stable_solution(ident, Psi, n)
     Psi_inv = np.linalg.inv(Psi)
 
+    det_signs = np.ones(len(grid) - 1)
+
     def sweep(X0):
         # backward flow from X(T) = X(0): [U; V] = Ψ_k⁻¹ [I; X_{k+1}]
         Xg = np.empty((len(grid), n, n))
         Xg[-1] = X0
         for k in range(len(grid) - 2, -1, -1):
             UV = Psi_inv[k, :, :n] + Psi_inv[k, :, n:] @ Xg[k + 1]
+            det_signs[k] = np.linalg.slogdet(UV[:n])[0]
             Xg[k] = _graph(UV, n)
         # closed-loop step factors: x(t_{k+1}) = [Ψ_k [I; X_k]]_top x(t_k)
         return Xg, (Psi @ _stack(Xg[:-1]))[:, :n]
     Xg, factors = _refine(X0, sweep)
+    if not definite and np.any(det_signs <= 0):
+        # U(t) runs from I at t_{k+1} to U_k at t_k: a sign change of det U
+        # is a singular U inside the step, where X escapes to infinity
+        # (impossible for a definite R)
+        raise ValueError("the periodic Riccati solution escapes to infinity inside the "
+                         f"period (near t = {grid[np.argmax(det_signs <= 0)]:.6g})")
     L = _exponents(factors, period=period)
     if all(M.is_constant for M in ops):
         # LTI data: constant X and gain (flagged constant), the eigenvalues of A - BG
@@ -231,8 +242,14 @@ def dare(A, B, Q, R, S=None):
         return tv_dare(A, B, Q, R, S)
     A, B, Q, R, S = tile_steps([A, B, Q, R, S], ['A', 'B', 'Q', 'R', 'S'])   # sub-periods
     A, B, Q, R, S = _step_arrays(A, B, Q, R, S)
-    N, n, m = B.shape
     _check_weights(Q, R, 'Q', 'R')
+    return _dare_solution(A, B, Q, R, S)
+
+
+def _dare_solution(A, B, Q, R, S):
+    """``(X, L, G)`` of `dare` for validated step stacks (N, ., .); R may be
+    indefinite (invertible), as in the H∞ Riccati equation."""
+    N, n, m = B.shape
     Abar = A - B @ np.linalg.solve(R, np.swapaxes(S, 1, 2))
     Qbar = Q - S @ np.linalg.solve(R, np.swapaxes(S, 1, 2))
     Lk = np.zeros((N, 2 * n, 2 * n))
