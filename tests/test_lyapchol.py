@@ -55,3 +55,15 @@ def test_bad_input():
         ltp.lyapchol([[-1.0]], [[1.0]])
     with pytest.raises(TypeError, match="adjoint"):
         ltp.dlyapchol(np.eye(1) * 0.5, [[1.0]], adjoint=1)
+
+
+def test_hankel_singular_values_from_the_factors_equal_the_gramians():
+    # hsvd uses the factors; the gramians of lyap give the same values
+    sys = ltp.ltpss([[-1.0, 0.0], [1.0, -2.0]],
+                    lambda t: np.array([[1.0 + 0.5 * np.cos(t)], [0.0]]),
+                    [[0.0, 1.0]], 0, period=2 * np.pi)
+    t = np.array([0.0, 1.0, np.pi])
+    P = ltp.lyap(sys.A, sys.B @ sys.B.T)(t)
+    Q = ltp.lyap(sys.A, sys.C.T @ sys.C, adjoint=True)(t)
+    ref = np.sqrt(np.sort(np.linalg.eigvals(P @ Q).real, axis=1)[:, ::-1])
+    np.testing.assert_allclose(ltp.hsvd(sys, t=t), ref, rtol=1e-10)
