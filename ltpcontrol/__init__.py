@@ -72,6 +72,8 @@ from ._core.multirate import sample_multirate
 from ._analysis.multirate_loop import lifted_margins
 from ._analysis.output_feedback import ofstab, oflqr, OutputFeedbackResult
 from ._analysis.hinf import hinfnorm
+from ._analysis.hinf_statefbk import hinf_statefbk, HinfStateFeedbackResult
+from ._analysis.lyapchol import lyapchol, dlyapchol
 from ._analysis.finite_horizon import care_finite, lyap_finite, h2norm_finite
 from ._analysis.sylvester import sylvester, dsylvester
 from ._identification.validate import validate_ltp, LTPValidation
@@ -165,6 +167,8 @@ __all__ = [
     'impedance_margins', 'SampledNyquistResponse', 'frame_htf', 'FrameHTF',
     # sampled-data loops around continuous periodic plants
     'sampled_loop', 'lifted_nyquist', 'LiftedNyquistResponse',
+    # periodic H∞ state feedback, factored Lyapunov solutions
+    'hinf_statefbk', 'HinfStateFeedbackResult', 'lyapchol', 'dlyapchol',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

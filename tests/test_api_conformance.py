@@ -237,6 +237,7 @@ _RESULT_CLASSES |= {'HarmonicModes'}
 _RESULT_CLASSES |= {'OutputFeedbackResult'}
 _RESULT_CLASSES |= {'LTPValidation'}
 _RESULT_CLASSES |= {'SampledNyquistResponse', 'LiftedNyquistResponse'}
+_RESULT_CLASSES |= {'HinfStateFeedbackResult'}
 
 DOC_DEFECTS = {}
 

@@ -26,7 +26,8 @@ from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .._core.steps import gram_weight, step_integrals
 from .._core.transition import step_transitions
 from .._core.validation import real_array
-from .riccati import _check_weights, _graph, _stack
+from .riccati import _check_weights
+from .riccati_solution import _graph, _stack
 
 __all__ = ['care_finite', 'lyap_finite', 'h2norm_finite']
 

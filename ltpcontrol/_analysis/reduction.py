@@ -34,7 +34,8 @@ from .._core.ltpsys import LTPStateSpace
 from .._core.tvsystem import DiscreteLTPSystem, dltpss
 from .minimal import MINREAL_TOL, periodic_minreal, tv_balred, tv_hsvd
 from .lyapunov import dlyap
-from .periodic_balancing import gramians, hankel_svd, truncate
+from .lyapchol import lyapchol
+from .periodic_balancing import hankel_svd, truncate
 from .._core.coerce import as_ltp
 from .._core.validation import check_positive_int, real_array
 
@@ -46,7 +47,8 @@ def hsvd(sys, t=None, *, nsteps=None):
 
     ``σ_j = sqrt(λ_j(P Q))`` of the periodic gramians (`gram`), at every
     step of a discrete-time system and at the instants `t` of a
-    continuous-time one.
+    continuous-time one (there by the square-root method, from the
+    factors of `lyapchol`).
 
     Parameters
     ----------
@@ -92,8 +94,11 @@ def hsvd(sys, t=None, *, nsteps=None):
     if t is None:
         t = np.arange(64) * sys.period / 64
     t = real_array(t, 't', ndim=(0, 1)).reshape(-1)
-    P, Q = gramians(sys, nsteps)
-    return hankel_svd(P(t), Q(t))[3]
+    # square-root method: σ_j(t) are the singular values of R_o(t) R_c(t)ᵀ
+    # for the factored gramians P = R_cᵀR_c, Q = R_oᵀR_o (never formed)
+    Rc = lyapchol(sys.A, sys.B, nsteps=nsteps)(t)
+    Ro = lyapchol(sys.A, sys.C, adjoint=True, nsteps=nsteps)(t)
+    return np.linalg.svd(Ro @ np.swapaxes(Rc, 1, 2), compute_uv=False)
 
 
 def balred(sys, orders, method='truncate', *, return_bound=False, nsteps=None):

@@ -42,50 +42,29 @@ Values inside a step ``[t_k, t_{k+1}]`` are ``X(t) = V U⁻¹`` with
 contracts onto the stabilizing solution), computed at Chebyshev points of
 every step when X is first evaluated between the step boundaries and
 interpolated (checked against the exact value inside every step).
+
+The steps live in their own modules: the cyclic pencil, its stable
+subspace and the Newton refinement in `periodic_pencil`, X(t) between the
+step boundaries in `riccati_solution`, the verified gain tables in
+`gain_table`.
 """
 
-import bisect
-import math
-import warnings
-
 import numpy as np
-import scipy.linalg as la
 from control.exception import ControlArgument, ControlDimension
 
-from .._core.floquet import (PiecewiseChebyshev, _log_multipliers, chebyshev_nodes,
-                             lti_representatives, piecewise_chebyshev)
+from .._core.floquet import lti_representatives
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
-from .._core.pm_ops import register_op, register_func
+from .._core.pm_ops import register_op
 from .._core.steps import step_grid
-from .._core.transition import step_transitions
 from .._core.validation import check_period, real_array
 from .._core.subperiods import common_period, tile_steps
 from .tvlyap import is_varying
 from .tvdesign import tv_dare
+from .gain_table import _GainTable, _table_edges
+from .periodic_pencil import _exponents, _refine, _stable_solution
+from .riccati_solution import _RiccatiSolution, _flow, _graph, _stack
 
 __all__ = ['care', 'dare']
-
-# relative periodicity residual above which a warning is issued
-_RESIDUAL_WARN = 1e-8
-# degree of the Chebyshev interpolant of X(t) on every step
-_CHEB_DEG = 16
-# steps per call of the integrator (bounded memory)
-_FLOW_CHUNK = 512
-# uniform pieces a verified table (gain, X) starts from before bisection;
-# step grids up to _GRID_STEPS steps are used directly (cheaper short flows),
-# longer (stiff) ones give way to these coarse pieces and exact values
-_TABLE_PIECES = 32
-_GRID_STEPS = 256
-# multipliers within this distance of the unit circle count as on it
-_CIRCLE_TOL = 1e-10
-# tabulated gain: degree on every piece, verified relative accuracy (to
-# 1 + max |G| on the piece), finest bisection of a step
-_GAIN_DEG = 16
-_GAIN_TOL = 1e-9
-_GAIN_DEPTH = 12
-# closed-loop log|μ| above -first: not stabilizing; above -second: doubtful
-# (a defective unit-circle pair splits by about sqrt(eps))
-_CLOSED_LOOP_TOL = (1e-9, 1e-6)
 
 
 def care(A, B, Q, R, S=None, period=None, nsteps=None):
@@ -142,9 +121,10 @@ def care(A, B, Q, R, S=None, period=None, nsteps=None):
     return X, L, G
 
 
-def _care_solution(A, B, Q, R, S, period, nsteps):
+def _care_solution(A, B, Q, R, S, period, nsteps, definite=True):
     """``(X, L, G, exact)`` of `care`; G's table not built yet (``exact`` is the
-    pointwise gain ``R⁻¹(BᵀX + Sᵀ)``)."""
+    pointwise gain ``R⁻¹(BᵀX + Sᵀ)``).  ``definite=False`` admits an
+    indefinite (invertible) R, as in the H∞ Riccati equation."""
     period = _period_of((A, B, Q, R, S), period)
     A = as_periodic(A, period, 'A')
     n = A.shape[0]
@@ -159,8 +139,9 @@ def _care_solution(A, B, Q, R, S, period, nsteps):
     S = as_periodic(np.zeros((n, m)) if S is None else S, period, 'S', shape=(n, m))
     ops = (A, B, Q, R, S)
     breaks = np.unique(np.concatenate([M.breakpoints for M in ops]))
-    probe = np.union1d(np.arange(16) * period / 16, breaks)
-    _check_weights(Q(probe), R(probe), 'Q', 'R')
+    if definite:
+        probe = np.union1d(np.arange(16) * period / 16, breaks)
+        _check_weights(Q(probe), R(probe), 'Q', 'R')
 
     H = _hamiltonian(ops, breaks)
     grid = _grid(H, period, breaks, nsteps)
@@ -169,16 +150,25 @@ def _care_solution(A, B, Q, R, S, period, nsteps):
     X0 = _stable_solution(ident, Psi, n)
     Psi_inv = np.linalg.inv(Psi)
 
+    det_signs = np.ones(len(grid) - 1)
+
     def sweep(X0):
         # backward flow from X(T) = X(0): [U; V] = Ψ_k⁻¹ [I; X_{k+1}]
         Xg = np.empty((len(grid), n, n))
         Xg[-1] = X0
         for k in range(len(grid) - 2, -1, -1):
             UV = Psi_inv[k, :, :n] + Psi_inv[k, :, n:] @ Xg[k + 1]
+            det_signs[k] = np.linalg.slogdet(UV[:n])[0]
             Xg[k] = _graph(UV, n)
         # closed-loop step factors: x(t_{k+1}) = [Ψ_k [I; X_k]]_top x(t_k)
         return Xg, (Psi @ _stack(Xg[:-1]))[:, :n]
     Xg, factors = _refine(X0, sweep)
+    if not definite and np.any(det_signs <= 0):
+        # U(t) runs from I at t_{k+1} to U_k at t_k: a sign change of det U
+        # is a singular U inside the step, where X escapes to infinity
+        # (impossible for a definite R)
+        raise ValueError("the periodic Riccati solution escapes to infinity inside the "
+                         f"period (near t = {grid[np.argmax(det_signs <= 0)]:.6g})")
     L = _exponents(factors, period=period)
     if all(M.is_constant for M in ops):
         # LTI data: constant X and gain (flagged constant), the eigenvalues of A - BG
@@ -203,196 +193,6 @@ def _gain(b, r, s, x):
 
 
 register_op('riccati_gain', _gain)
-
-
-def _tabulated(G, grid):
-    """``(edges, coefs)`` of G as a verified piecewise Chebyshev table, or None.
-
-    On every step ``[t_k, t_{k+1}]`` (where the data and the interpolant of X
-    are smooth) G is sampled at the Chebyshev points of the first kind and
-    the degree-`_GAIN_DEG` interpolant is compared with G at other points;
-    steps that miss `_GAIN_TOL` are bisected, at most `_GAIN_DEPTH` times.
-    """
-    m, n = G.shape
-    nodes = np.polynomial.chebyshev.chebpts1(_GAIN_DEG + 1)
-    checks = 0.5 * (nodes[:-1] + nodes[1:])[::3]
-    vander = np.polynomial.chebyshev.chebvander(nodes, _GAIN_DEG)
-    at_checks = np.polynomial.chebyshev.chebvander(checks, _GAIN_DEG)
-    lo, hi = grid[:-1], grid[1:]
-    starts, coefs = [], []
-    for _ in range(_GAIN_DEPTH + 1):
-        mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
-        values = G((mid[:, None] + half[:, None] * nodes).ravel()).reshape(len(lo), -1, m * n)
-        exact = G((mid[:, None] + half[:, None] * checks).ravel()).reshape(len(lo), -1, m * n)
-        coef = np.linalg.solve(vander, values)
-        err = np.abs(at_checks @ coef - exact).max(axis=(1, 2))
-        scale = 1 + np.maximum(np.abs(values).max(axis=(1, 2)), np.abs(exact).max(axis=(1, 2)))
-        ok = (err <= _GAIN_TOL * scale) & np.all(np.isfinite(coef), axis=(1, 2))
-        starts.append(lo[ok])
-        coefs.append(coef[ok])
-        lo, hi = np.concatenate([lo[~ok], mid[~ok]]), np.concatenate([mid[~ok], hi[~ok]])
-        if not len(lo):
-            break
-    else:
-        return None                  # not verified at the finest subdivision
-    starts, coefs = np.concatenate(starts), np.concatenate(coefs)
-    order = np.argsort(starts)
-    return (np.append(starts[order], grid[-1]),
-            coefs[order].reshape(len(order), _GAIN_DEG + 1, m, n))
-
-
-class _GainTable:
-    """Piecewise Chebyshev series of a gain, ``t -> (m, n)`` (data-backed).
-
-    ``edges`` (P + 1) split ``[0, T]``; ``coefs[k, j]`` (P, D + 1, m, n) is
-    the coefficient of ``T_j(s)``, ``s = (2t - e_k - e_{k+1}) / (e_{k+1} - e_k)``
-    on piece k.  Pieces are closed on the left: at an edge the piece that
-    starts there is used (within ``1e-12 T``, as for switching matrices).
-    `scalar` evaluates one time with Python floats and one small product.
-
-    Built from the exact gain (a `PeriodicMatrix`) and the step grid, the
-    table is tabulated on first use, or when pickled or saved; if it cannot
-    be verified, the exact gain is evaluated instead.
-    """
-
-    def __init__(self, edges=None, coefs=None, exact=None, grid=None):
-        self.exact, self.grid, self.edges, self.coefs = exact, grid, None, None
-        self._ready = coefs is not None
-        if self._ready:
-            self.edges, self.coefs = np.asarray(edges, float), np.asarray(coefs, float)
-            self._setup()
-
-    def _setup(self):
-        P, D1, m, n = self.coefs.shape
-        self._flat = self.coefs.reshape(P, D1, m * n)
-        self._list = self.edges.tolist()
-        self._degrees = np.arange(D1, dtype=float)
-        self._period = float(self.edges[-1])
-        self._shape = (m, n)
-
-    def _build(self):
-        if not self._ready:
-            table = _tabulated(self.exact, self.grid)
-            if table is not None:
-                self.edges, self.coefs = table
-                self.exact = self.grid = None
-                self._setup()
-            else:
-                warnings.warn("the periodic gain could not be verified as a Chebyshev table "
-                              f"(relative accuracy {_GAIN_TOL:.0e}); it is evaluated from the "
-                              "Riccati solution at every call instead (slower)", UserWarning,
-                              stacklevel=5)
-            self._ready = True
-        return self.coefs is not None
-
-    def __getstate__(self):
-        self._build()
-        return {'edges': self.edges, 'coefs': self.coefs, 'exact': self.exact}
-
-    def __setstate__(self, state):
-        self.__init__(state['edges'], state['coefs'], state['exact'])
-        self._ready = True
-
-    def scalar(self, t):
-        """Value at one float time t, shape (m, n)."""
-        if not self._ready:
-            self._build()
-        if self.coefs is None:
-            return self.exact(t)
-        T, edges = self._period, self._list
-        eps = 1e-12 * T
-        tau = t % T
-        if tau >= T - eps:
-            tau -= T
-        k = bisect.bisect_right(edges, tau + eps) - 1
-        last = len(edges) - 2
-        k = 0 if k < 0 else (last if k > last else k)
-        a, b = edges[k], edges[k + 1]
-        s = (2 * tau - a - b) / (b - a)
-        s = -1.0 if s < -1.0 else (1.0 if s > 1.0 else s)
-        # Σ_j c_j T_j(s), T_j(s) = cos(j arccos s)
-        return (np.cos(self._degrees * math.acos(s)) @ self._flat[k]).reshape(self._shape)
-
-    def __call__(self, t):
-        if np.ndim(t) == 0:
-            return self.scalar(float(t))
-        if not self._build():
-            return self.exact(t)
-        T, edges = self._period, self.edges
-        eps = 1e-12 * T
-        tau = np.mod(np.asarray(t, float), T)
-        tau[tau >= T - eps] -= T
-        k = np.clip(np.searchsorted(edges, tau + eps, side='right') - 1, 0, len(edges) - 2)
-        a, b = edges[k], edges[k + 1]
-        s = np.clip((2 * tau - a - b) / (b - a), -1.0, 1.0)
-        basis = np.cos(np.arccos(s)[:, None] * self._degrees)
-        return np.einsum('tj,tjs->ts', basis, self._flat[k]).reshape((len(tau),) + self._shape)
-
-    def _portable(self):
-        if not self._build():
-            raise TypeError("save: the gain could not be tabulated to its verified accuracy; "
-                            "save the Riccati solution X and compute the gain from it")
-        return 'gain_table', {}, {'edges': self.edges, 'coefs': self.coefs}
-
-    @classmethod
-    def _from_portable(cls, params, arrays):
-        return cls(arrays['edges'], arrays['coefs'])
-
-
-register_func('gain_table', _GainTable)
-
-
-class _RiccatiSolution:
-    """X(t) of `care`: exact at the step boundaries and, between them, by the
-    backward Hamiltonian flow over the partial step (exact, bounded cost).
-
-    A verified piecewise Chebyshev interpolant (`_interpolant`) is built
-    when the solution is pickled or saved, so that it is data-backed; once
-    built (or after loading) it serves the evaluations.
-    """
-
-    def __init__(self, H, grid, Xg, interp=None, breaks=()):
-        self.H, self.grid, self.Xg, self.interp = H, grid, Xg, interp
-        self.breaks = np.asarray(breaks, float)
-
-    def __call__(self, t):
-        grid = self.grid
-        period = grid[-1]
-        tau = np.mod(np.atleast_1d(np.asarray(t, float)), period)
-        k = np.searchsorted(grid, tau)
-        on = np.abs(grid[np.minimum(k, len(grid) - 1)] - tau) <= 1e-14 * period
-        if np.all(on):                      # step boundaries: no interpolant needed
-            return self.Xg[k]
-        if self.interp is not None or self.H is None or len(grid) - 1 <= _GRID_STEPS:
-            return self._interpolant()(t)
-        return _exact_values(self.H, grid, self.Xg, tau)
-
-    def _interpolant(self):
-        if self.interp is None:
-            self.interp = _interpolant(self.H, self.grid, self.Xg, self.breaks)
-        return self.interp
-
-    def __getstate__(self):
-        self._interpolant()
-        return {'H': None, 'grid': self.grid, 'Xg': self.Xg, 'interp': self.interp,
-                'breaks': self.breaks}
-
-    def __setstate__(self, state):
-        self.__init__(state['H'], state['grid'], state['Xg'], state['interp'],
-                      state.get('breaks', ()))
-
-    def _portable(self):
-        it = self._interpolant()
-        return 'riccati_solution', {}, {'grid': self.grid, 'Xg': self.Xg,
-                                        'interp_grid': it.grid, 'interp_values': it.values}
-
-    @classmethod
-    def _from_portable(cls, params, arrays):
-        return cls(None, arrays['grid'], arrays['Xg'],
-                   PiecewiseChebyshev(arrays['interp_grid'], arrays['interp_values']))
-
-
-register_func('riccati_solution', _RiccatiSolution)
 
 
 def dare(A, B, Q, R, S=None):
@@ -442,8 +242,14 @@ def dare(A, B, Q, R, S=None):
         return tv_dare(A, B, Q, R, S)
     A, B, Q, R, S = tile_steps([A, B, Q, R, S], ['A', 'B', 'Q', 'R', 'S'])   # sub-periods
     A, B, Q, R, S = _step_arrays(A, B, Q, R, S)
-    N, n, m = B.shape
     _check_weights(Q, R, 'Q', 'R')
+    return _dare_solution(A, B, Q, R, S)
+
+
+def _dare_solution(A, B, Q, R, S):
+    """``(X, L, G)`` of `dare` for validated step stacks (N, ., .); R may be
+    indefinite (invertible), as in the H∞ Riccati equation."""
+    N, n, m = B.shape
     Abar = A - B @ np.linalg.solve(R, np.swapaxes(S, 1, 2))
     Qbar = Q - S @ np.linalg.solve(R, np.swapaxes(S, 1, 2))
     Lk = np.zeros((N, 2 * n, 2 * n))
@@ -512,255 +318,12 @@ def _hamiltonian(ops, breaks):
     return PeriodicMatrix.pointwise(hamiltonian, ops, (2 * n, 2 * n), breakpoints=breaks)
 
 
-def _grid_interpolant(H, grid, Xg):
-    """X(t) inside the steps of a short grid: the backward flow at Chebyshev
-    points of every step, interpolated (``16 x len(grid)`` short flows)."""
-    n = Xg.shape[1]
-    cheb = chebyshev_nodes(_CHEB_DEG)
-    nodes = grid[:-1, None] + np.diff(grid)[:, None] * cheb
-    sub = _flow(H, nodes[:, :-1].ravel(), np.diff(nodes, axis=1).ravel())
-    sub = sub.reshape(len(grid) - 1, _CHEB_DEG, 2 * n, 2 * n)
-    # W[k, j] = Φ_H(t_{k+1}, s_j),  [U; V] = W⁻¹ [I; X_{k+1}]
-    W = np.empty((len(grid) - 1, _CHEB_DEG + 1, 2 * n, 2 * n))
-    W[:, -1] = np.eye(2 * n)
-    for j in range(_CHEB_DEG - 1, -1, -1):
-        W[:, j] = W[:, j + 1] @ sub[:, j]
-    values = _graph(np.linalg.solve(W, _stack(Xg[1:])[:, None]), n)
-    values[:, 0] = Xg[:-1]
-    interp = piecewise_chebyshev(grid, values)
-    probe = grid[:-1] + 0.3717 * np.diff(grid)
-    exact = _graph(np.linalg.solve(_flow(H, probe, grid[1:] - probe), _stack(Xg[1:])), n)
-    err = np.abs(interp(probe) - exact).max() / max(1.0, np.abs(exact).max())
-    if err > 1e-10:
-        warnings.warn(f"the interpolated Riccati solution has relative errors up to "
-                      f"{err:.1e} inside the steps; increase nsteps", UserWarning,
-                      stacklevel=4)
-    return interp
-
-
-
-def _exact_values(H, grid, Xg, tau):
-    """X at the times tau in [0, T): ``[U; V] = Φ_H(t_{k+1}, τ)⁻¹ [I; X_{k+1}]``
-    on the step k that holds τ (the backward flow contracts onto the
-    stabilizing solution)."""
-    n = Xg.shape[1]
-    k = np.clip(np.searchsorted(grid, tau, side='right') - 1, 0, len(grid) - 2)
-    Phi = _flow(H, tau, grid[k + 1] - tau)
-    return _graph(np.linalg.solve(Phi, _stack(Xg[k + 1])), n)
-
-
-def _interpolant(H, grid, Xg, breaks):
-    """`_grid_interpolant` for a grid of at most `_GRID_STEPS` steps, else
-    `_coarse_interpolant`."""
-    if len(grid) - 1 <= _GRID_STEPS:
-        return _grid_interpolant(H, grid, Xg)
-    return _coarse_interpolant(H, grid, Xg, breaks)
-
-
-def _coarse_interpolant(H, grid, Xg, breaks):
-    """Verified piecewise Chebyshev interpolant of X (`PiecewiseChebyshev`).
-
-    Pieces start from `_coarse_edges` (X is smooth between switching
-    instants, whatever the solver's step grid) and are bisected, at most
-    `_GAIN_DEPTH` times, until the interpolant matches the exact values at
-    interior probes to 1e-10 relative.  The cost is set by the smoothness
-    of X, not by the stiffness of the data.
-    """
-    n = Xg.shape[1]
-    period = grid[-1]
-    scale = max(np.abs(Xg).max(), 1e-300)
-    nodes = chebyshev_nodes(_CHEB_DEG)
-    probe = np.array([0.1234, 0.3717, 0.6543, 0.8911])
-    bary = (-1.0) ** np.arange(_CHEB_DEG + 1)
-    bary[[0, -1]] *= 0.5
-    weights = bary / (probe[:, None] - nodes[None, :])
-    weights /= weights.sum(axis=1, keepdims=True)
-    edges = _coarse_edges(period, breaks)
-    lo, hi = edges[:-1], edges[1:]
-    starts, values, err = [], [], 0.0
-    for depth in range(_GAIN_DEPTH + 1):
-        h = (hi - lo)[:, None]
-        vals = _exact_values(H, grid, Xg, (lo[:, None] + h * nodes).ravel())
-        vals = vals.reshape(len(lo), _CHEB_DEG + 1, n, n)
-        exact = _exact_values(H, grid, Xg, (lo[:, None] + h * probe).ravel())
-        approx = np.einsum('pj,kjab->kpab', weights, vals)
-        dev = np.abs(approx - exact.reshape(approx.shape)).max(axis=(1, 2, 3)) / scale
-        ok = dev <= 1e-10
-        if depth == _GAIN_DEPTH:
-            ok[:] = True
-            err = float(dev.max(initial=0.0))
-        starts.append(lo[ok])
-        values.append(vals[ok])
-        mid = 0.5 * (lo + hi)
-        lo, hi = np.concatenate([lo[~ok], mid[~ok]]), np.concatenate([mid[~ok], hi[~ok]])
-        if not len(lo):
-            break
-    starts, values = np.concatenate(starts), np.concatenate(values)
-    order = np.argsort(starts)
-    if err > 1e-10:
-        warnings.warn(f"the interpolated Riccati solution has relative errors up to "
-                      f"{err:.1e} inside the steps; increase nsteps", UserWarning,
-                      stacklevel=4)
-    return PiecewiseChebyshev(np.append(starts[order], period), values[order])
-
-
-def _stable_solution(Lk, Mk, n):
-    """``X_0 = V U⁻¹`` from the stable deflating subspace of the collapsed pencil."""
-    Lc, Mc = _collapse(np.asarray(Lk, float), np.asarray(Mk, float))
-    # QZ of the pencil M - μ L, stable eigenvalues first
-    _, _, alpha, beta, _, Zq = la.ordqz(Mc, Lc, sort='iuc', output='real')
-    with np.errstate(divide='ignore', invalid='ignore'):
-        mod = np.where(beta != 0, np.abs(alpha) / np.abs(beta), np.inf)
-    nstable = int(np.count_nonzero(mod < 1 - _CIRCLE_TOL))
-    if nstable != n or np.any(np.abs(mod - 1) <= _CIRCLE_TOL):
-        raise ValueError(
-            "no stabilizing periodic solution exists: the Hamiltonian has "
-            f"{int(np.count_nonzero(np.abs(mod - 1) <= _CIRCLE_TOL))} multipliers on "
-            "the unit circle (check that (A, B) is stabilizable and that Q penalizes "
-            "every mode on the stability boundary)")
-    U, V = Zq[:n, :n], Zq[n:, :n]
-    if np.linalg.cond(U) > 1e12:
-        raise ValueError("no stabilizing periodic solution exists: the stable subspace "
-                         "is not a graph over the state space (check that (A, B) is "
-                         "stabilizable)")
-    X0 = np.linalg.solve(U.T, V.T).T
-    return 0.5 * (X0 + X0.T)
-
-
-def _collapse(L, M):
-    """One pencil ``(L, M)`` with ``L⁻¹M = L_{K-1}⁻¹M_{K-1} ... L_0⁻¹M_0``.
-
-    Neighbours are merged pairwise (a balanced tree, batched): for factors
-    k, k+1 the QR factorisation of ``[L_k; -M_{k+1}]`` gives ``[Z1 Z2]``
-    with ``Z1 L_k = Z2 M_{k+1}``, and the pair becomes ``(Z2 L_{k+1}, Z1 M_k)``.
-    """
-    d = L.shape[1]
-    while len(L) > 1:
-        even = len(L) - len(L) % 2
-        q, _ = np.linalg.qr(np.concatenate([L[0:even:2], -M[1:even:2]], axis=1),
-                            mode='complete')
-        Z = np.swapaxes(q, 1, 2)[:, d:]
-        Lnew, Mnew = Z[:, :, d:] @ L[1:even:2], Z[:, :, :d] @ M[0:even:2]
-        if even < len(L):
-            Lnew, Mnew = np.concatenate([Lnew, L[-1:]]), np.concatenate([Mnew, M[-1:]])
-        L, M = Lnew, Mnew
-    return L[0], M[0]
-
-
 def _riccati_step(a, b, q, r, s, xn):
     """One backward step of the discrete Riccati map."""
     axb = a.T @ xn @ b + s
     X = a.T @ xn @ a - axb @ np.linalg.solve(r + b.T @ xn @ b, axb.T) + q
     return 0.5 * (X + X.T)
 
-
-def _graph(UV, n):
-    """``X = V U⁻¹`` for stacked ``[U; V]`` (shape (..., 2n, n)), symmetrized."""
-    U, V = UV[..., :n, :], UV[..., n:, :]
-    if UV.ndim == 2:
-        X = np.linalg.solve(U.T, V.T).T
-        return 0.5 * (X + X.T)
-    X = np.swapaxes(np.linalg.solve(np.swapaxes(U, -1, -2), np.swapaxes(V, -1, -2)), -1, -2)
-    return 0.5 * (X + np.swapaxes(X, -1, -2))
-
-
-def _stack(X):
-    """``[I; X]`` for one or many X."""
-    n = X.shape[-1]
-    ident = np.broadcast_to(np.eye(n), X.shape)
-    return np.concatenate([ident, X], axis=-2)
-
-
-def _flow(H, t0, h):
-    """Transition matrices of many steps, computed in chunks of `_FLOW_CHUNK`
-    steps so that the integrator's sub-step stacks stay bounded."""
-    t0 = np.atleast_1d(np.asarray(t0, float))
-    h = np.broadcast_to(np.asarray(h, float), t0.shape)
-    if len(t0) <= _FLOW_CHUNK:
-        return step_transitions(H, None, t0, h)[0]
-    d = H.shape[0]
-    out = np.empty((len(t0), d, d))
-    for i in range(0, len(t0), _FLOW_CHUNK):
-        out[i:i + _FLOW_CHUNK] = step_transitions(H, None, t0[i:i + _FLOW_CHUNK],
-                                                  h[i:i + _FLOW_CHUNK])[0]
-    return out
-
-
-def _table_edges(grid, breaks):
-    """Initial pieces of a gain table: the step grid when it is short, else
-    `_coarse_edges`."""
-    if len(grid) - 1 <= _GRID_STEPS:
-        return np.asarray(grid, float)
-    return _coarse_edges(grid[-1], breaks)
-
-
-def _coarse_edges(period, breaks):
-    """Initial pieces of a verified table: `_TABLE_PIECES` uniform pieces and
-    the switching instants (the solution is smooth in between, whatever the
-    step grid of the solver)."""
-    edges = np.linspace(0.0, period, _TABLE_PIECES + 1)
-    edges = np.union1d(edges, np.mod(np.asarray(breaks, float), period))
-    keep = np.concatenate([[True], np.diff(edges) > 1e-12 * period])
-    edges = edges[keep]
-    edges[-1] = period
-    return edges
-
-
-def _exponents(factors, period=None, nper=None):
-    """Floquet exponents (continuous) or per-step exponents (discrete) of the
-    closed-loop factors; raises unless every multiplier is inside the unit
-    circle (a Hamiltonian multiplier pair on the circle, split by round-off,
-    can pass the count of stable multipliers and give a non-stabilizing X)."""
-    logmod, arg = _log_multipliers(None, None, grid=None, factors=factors)
-    worst = logmod.max() if logmod.size else -np.inf
-    if not worst < -_CLOSED_LOOP_TOL[0]:
-        raise ValueError(
-            "no stabilizing periodic solution exists: the closed loop keeps a Floquet "
-            f"multiplier on the unit circle (log|mu| = {worst:.1e}); check that (A, B) "
-            "is stabilizable and that Q penalizes every mode on the stability boundary")
-    if worst >= -_CLOSED_LOOP_TOL[1]:
-        warnings.warn(
-            f"the closed loop has a Floquet multiplier with log|mu| = {worst:.1e}: at "
-            "this precision a Hamiltonian multiplier pair on the unit circle looks the "
-            "same, so the solution may not be stabilizing", UserWarning, stacklevel=3)
-    if nper is not None:
-        with np.errstate(under='ignore', over='ignore'):
-            return np.exp(logmod / nper) * np.exp(1j * arg / nper)   # log|μ| may be -inf
-    return logmod / period + 1j * (arg / period)
-
-
-def _refine(X0, sweep, passes=2):
-    """Newton refinement of the pencil's ``X_0`` on the periodicity condition.
-
-    ``sweep(X_0)`` runs the backward recursion over one period and returns
-    the samples (first: the period map ``F(X_0)``) and the closed-loop step
-    factors.  ``F(X_0 + Δ) ≈ F(X_0) + ΦᵀΔΦ`` with the closed-loop monodromy
-    Φ, so the Newton step solves the Stein equation ``Δ = ΦᵀΔΦ + F(X_0) -
-    X_0``.  The pencil's ``X_0`` is backward stable but its error is
-    amplified by the conditioning of the stable subspace; one or two steps
-    restore full accuracy.  Returns the samples with ``X[0] = X[-1]``.
-    """
-    scale = max(1.0, np.abs(X0).max())
-    for attempt in range(passes + 1):
-        Xs, factors = sweep(X0)
-        res = Xs[0] - X0
-        if attempt == passes or np.abs(res).max() <= 1e-13 * scale:
-            break
-        mono = np.eye(X0.shape[0])
-        for f in factors:
-            mono = f @ mono
-        if not np.all(np.isfinite(mono)) or np.max(np.abs(la.eigvals(mono))) >= 1:
-            break
-        delta = la.solve_discrete_lyapunov(mono.T, res)
-        X0 = X0 + 0.5 * (delta + delta.T)
-    err = np.abs(res).max() / scale
-    if not np.isfinite(err) or err > _RESIDUAL_WARN:
-        warnings.warn(f"the periodic Riccati solution has a periodicity residual of "
-                      f"{err:.1e}: the problem is ill-conditioned (closed-loop "
-                      "multipliers close to the unit circle or a badly scaled plant)",
-                      UserWarning, stacklevel=3)
-    Xs[0] = X0
-    return Xs, factors
 
 
 def _check_weights(Q, R, qname, rname):

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import ltpcontrol as ltp
-from ltpcontrol._analysis import riccati
-from ltpcontrol._analysis.riccati import _GainTable
+from ltpcontrol._analysis import gain_table
+from ltpcontrol._analysis.gain_table import _GainTable
 
 A = np.array([[0.0, 1.0], [2.0, -1.0]])
 
@@ -20,11 +20,11 @@ class riccati_untabulated:
     """Context in which gain tables are never verified (the exact gain is kept)."""
 
     def __enter__(self):
-        self.saved = riccati._GAIN_TOL, riccati._GAIN_DEPTH
-        riccati._GAIN_TOL, riccati._GAIN_DEPTH = -1.0, 0
+        self.saved = gain_table._GAIN_TOL, gain_table._GAIN_DEPTH
+        gain_table._GAIN_TOL, gain_table._GAIN_DEPTH = -1.0, 0
 
     def __exit__(self, *exc):
-        riccati._GAIN_TOL, riccati._GAIN_DEPTH = self.saved
+        gain_table._GAIN_TOL, gain_table._GAIN_DEPTH = self.saved
 B = np.array([[0.0], [1.0]])
 
 
@@ -45,8 +45,8 @@ def test_gain_is_a_table_with_a_scalar_path():
 
 
 def test_gain_not_verified_stays_untabulated(monkeypatch, tmp_path):
-    monkeypatch.setattr(riccati, '_GAIN_TOL', -1.0)
-    monkeypatch.setattr(riccati, '_GAIN_DEPTH', 1)
+    monkeypatch.setattr(gain_table, '_GAIN_TOL', -1.0)
+    monkeypatch.setattr(gain_table, '_GAIN_DEPTH', 1)
     Ap = ltp.PeriodicMatrix.from_function(lambda t: A + 1e-9 * np.cos(2 * np.pi * t), 1.0)
     with pytest.warns(UserWarning, match="could not be verified"):
         X, _, G = ltp.care(Ap, B, np.eye(2), [[1.0]])
