@@ -137,7 +137,19 @@ def test_harmonic_ss_edge_keyword():
         Hs = ltp.harmonic_ss(sys, 1, edge='ignore')
     assert np.any(Hs.modes.edge)
     with pytest.raises(ValueError, match="edge"):
-        ltp.harmonic_ss(sys, 1, edge='drop')
+        ltp.harmonic_ss(sys, 1, edge='remove')
+    # 'drop': exact modal truncation, the poles are the unmarked eigenvalues only
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        Hd = ltp.harmonic_ss(sys, 1, edge='drop')
+    m = Hd.modes
+    poles = ct.poles(Hd)
+    kept = m.eigenvalues[~m.edge]
+    assert len(poles) == len(kept) and _match(poles, kept) < 1e-9 and _match(kept, poles) < 1e-9
+    assert poles.real.max() == pytest.approx(monodromy_exponents(2.0, 3.0, 0.3).real.max(),
+                                             abs=1e-8)
+    for s in (0.3j, 1.7j):
+        np.testing.assert_allclose(Hd(s), Hs(s), rtol=0, atol=1e-8 * np.abs(Hs(s)).max())
 
 
 def test_harmonic_ss_lti_as_periodic_no_warning_and_exact():
@@ -171,3 +183,7 @@ def test_harmonic_ss_unstable_mathieu_genuine_exponent_unmarked():
     msg = " ".join(str(w.message) for w in rec)
     for z in m.eigenvalues[genuine]:
         assert f"{z:.4g}" not in msg
+    # dropping the marked eigenvalues keeps the genuine instability
+    with pytest.warns(UserWarning, match="is unstable"):
+        Hd = ltp.harmonic_ss(sys, 1, edge='drop')
+    assert ct.poles(Hd).real.max() == pytest.approx(truth.real.max(), abs=1e-8)

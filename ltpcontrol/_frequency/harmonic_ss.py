@@ -50,11 +50,12 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, edge='warn', name=N
         Harmonics -K..K of the inputs and outputs.
     internal_harmonics : int, optional
         Truncation ``K_i >= K`` of the states (default as in `htf`).
-    edge : {'warn', 'ignore'}
-        What to do when eigenvalues of the truncated state matrix in the
-        closed right half plane are not Floquet exponents of `sys` (the
-        truncation-edge artefacts of a periodic A): warn (default), or
-        only mark them in ``modes``.
+    edge : {'warn', 'ignore', 'drop'}
+        What to do with the truncation-edge eigenvalues of a periodic A:
+        'warn' (default) marks them in ``modes`` and warns when eigenvalues
+        in the closed right half plane are not Floquet exponents of `sys`;
+        'ignore' only marks them; 'drop' returns the state space without
+        their modal part (exact modal truncation, see Notes).
     name : str, optional
         Name of the result (default: the name of `sys` with '$harmonic').
 
@@ -72,19 +73,24 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, edge='warn', name=N
         ``modes.floquet_consistent`` those equal to a Floquet exponent
         modulo ``jω_p``, and ``modes.exponents`` are the system's modes.
         The attribute is not carried over by operations on the result.
+        With ``edge='drop'`` the result has the states of the kept modes
+        (named ``'x[i]'``) and ``modes`` still describes the full
+        truncation.
 
     Raises
     ------
     ValueError
-        If `sys` is discrete-time, or `edge` is not 'warn' or 'ignore'.
+        If `sys` is discrete-time, or `edge` is not 'warn', 'ignore' or
+        'drop'.
 
     Warns
     -----
     UserWarning
         With ``edge='warn'``, naming the right-half-plane eigenvalues that
-        are not Floquet exponents (or Floquet exponents the truncation does
-        not resolve); when `sys` is unstable; when the truncation of the
-        response has not converged.
+        are not Floquet exponents; Floquet exponents the truncation does
+        not resolve; when `sys` is unstable; when the truncation of the
+        response has not converged; with ``edge='drop'``, when the dropped
+        modes change the response by more than 1e-6 (relative).
 
     Notes
     -----
@@ -97,6 +103,14 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, edge='warn', name=N
     the stability of `sys`; `floquet_exponents` and `nyquist_htf` do.  The
     marks cost one eigendecomposition of the state matrix and one Floquet
     computation; a constant A has no artefact.
+
+    ``edge='drop'`` orders the real Schur form of the state matrix with the
+    kept eigenvalues first, ``[[T11, T12], [0, T22]]``, decouples the two
+    blocks exactly by the solution X of ``T11 X - X T22 + T12 = 0`` and
+    returns ``(T11, B1 - X B2, C1, D)`` in these coordinates: its poles are
+    exactly the unmarked eigenvalues, and its response differs from the
+    truncated HTF by the dropped modes' part, which is checked at two
+    frequencies (for the Mathieu example below, about 1e-10 relative).
 
     Examples
     --------
@@ -119,14 +133,20 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, edge='warn', name=N
     >>> rhp = Hs.modes.eigenvalues.real > 0
     >>> bool(rhp.any()), bool(Hs.modes.edge[rhp].all()), Hs.modes.stable
     (True, True, True)
+
+    Dropping them leaves the shifted copies of the Floquet exponents only:
+
+    >>> Hd = ltp.harmonic_ss(sys, 1, edge='drop')
+    >>> Hd.nstates, float(np.round(ct.poles(Hd).real.max(), 8))
+    (26, -0.15)
     """
     sys = as_ltp(sys, 'sys')
     if sys.isdtime():
         raise ValueError("harmonic_ss: sys is discrete-time; lift(sys) is its exact "
                          "(frequency-lifted) harmonic state space")
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
-    if edge not in ('warn', 'ignore'):
-        raise ValueError(f"edge must be 'warn' or 'ignore', got {edge!r}")
+    if edge not in ('warn', 'ignore', 'drop'):
+        raise ValueError(f"edge must be 'warn', 'ignore' or 'drop', got {edge!r}")
     hss = build(sys, K, internal_harmonics, 'auto', 'harmonic_ss', warn_unstable=False)
     # the Floquet exponents once: for the stability remark and the marks
     fl = floquet_exponents(sys) if sys.nstates else np.zeros(0, complex)
@@ -135,11 +155,43 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, edge='warn', name=N
         _warn_unstable(sys, 2)
     modes, missing = classify(sys, hss.F, hss.Ki, floquet=fl, strict=False,
                               where='harmonic_ss')
-    if edge == 'warn':
-        _warn_edge(modes, missing, hss.Ki)
+    if edge != 'ignore':
+        _warn_edge(modes, missing, hss.Ki, rhp=edge == 'warn')
     out = real_ss(hss, name or f'{sys.name}$harmonic', sys.input_labels,
                   sys.output_labels, sys.state_labels)
+    if edge == 'drop' and modes.edge.any():
+        out = _drop_edge(out, modes, sys.omega_p)
     out.modes = modes
+    return out
+
+
+def _drop_edge(Hs, modes, wp):
+    """Exact modal truncation of the marked eigenvalues of the real form `Hs`."""
+    lam, keep = modes.eigenvalues, ~modes.edge
+
+    def kept(re, im=None):
+        z = re if im is None else re + 1j * im
+        return bool(keep[np.argmin(np.abs(lam - z))])
+
+    T, Z, k = sla.schur(Hs.A, output='real', sort=kept)
+    if k != np.count_nonzero(keep):   # the marks split a conjugate pair: cannot happen
+        raise RuntimeError("harmonic_ss: the ordered Schur form does not separate "
+                           "the marked eigenvalues")   # pragma: no cover
+    X = sla.solve_sylvester(T[:k, :k], -T[k:, k:], -T[:k, k:])
+    ZB, CZ = Z.T @ Hs.B, Hs.C @ Z
+    out = ct.ss(T[:k, :k], ZB[:k] - X @ ZB[k:], CZ[:, :k], Hs.D, name=Hs.name,
+                inputs=Hs.input_labels, outputs=Hs.output_labels)
+    # the dropped part of the response, at two frequencies inside the band
+    n = Hs.nstates
+    err = 0.0
+    for s in 1j * wp * np.array([0.137, 0.61]):
+        full = Hs.C @ np.linalg.solve(s * np.eye(n) - Hs.A, Hs.B) + Hs.D
+        red = out.C @ np.linalg.solve(s * np.eye(k) - out.A, out.B) + out.D
+        err = max(err, np.abs(full - red).max() / max(np.abs(full).max(), 1e-300))
+    if err > 1e-6:
+        warnings.warn(f"harmonic_ss: dropping the {n - k} truncation-edge modes changes the "
+                      f"response by {err:.1e} (relative); increase internal_harmonics",
+                      UserWarning, stacklevel=3)
     return out
 
 
@@ -149,10 +201,11 @@ def _warn_unstable(sys, stacklevel):
                   "steady-state response", UserWarning, stacklevel=stacklevel + 1)
 
 
-def _warn_edge(modes, missing, Ki):
+def _warn_edge(modes, missing, Ki, rhp=True):
     """Warn about right-half-plane eigenvalues that are no Floquet exponents."""
     lam = modes.eigenvalues
-    bad = (lam.real >= 0) & ~modes.floquet_consistent
+    # with the marked ones dropped, only the unmarked ones remain to be named
+    bad = (lam.real >= 0) & ~modes.floquet_consistent & (rhp | ~modes.edge)
     msgs = []
     if bad.any():
         order = np.argsort(-lam[bad].real)
