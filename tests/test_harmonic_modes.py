@@ -2,6 +2,8 @@
 are marked, the modes equal the Floquet exponents of an independent
 monodromy (solve_ivp), and the sensitivities equal finite differences."""
 
+import warnings
+
 import numpy as np
 import control as ct
 import pytest
@@ -94,3 +96,94 @@ def test_bad_inputs():
         ltp.harmonic_modes(ltp.ltpss(ct.ss([[0.5]], [[1.0]], [[1.0]], 0, 0.1), period=0.2))
     with pytest.raises(ValueError, match="edge_tol"):
         ltp.harmonic_modes(mathieu(2.0, 3.0, 0.3), edge_tol=-1)
+
+
+def _match(x, y):
+    """Largest distance from an element of x to the nearest element of y."""
+    return np.abs(x[:, None] - y[None, :]).min(axis=1).max()
+
+
+def test_harmonic_ss_marks_and_warns_on_stable_mathieu():
+    sys = mathieu(2.0, 3.0, 0.3)
+    with pytest.warns(UserWarning, match="truncation edge") as rec:
+        Hs = ltp.harmonic_ss(sys, 1)
+    msg = " ".join(str(w.message) for w in rec)
+    assert "floquet_exponents" in msg and "harmonic_modes" in msg
+    m = Hs.modes
+    lam = m.eigenvalues
+    # the marked eigenvalues are the poles of the returned state space
+    poles = ct.poles(Hs)
+    assert len(poles) == len(lam) and _match(poles, lam) < 1e-9 and _match(lam, poles) < 1e-9
+    rhp = lam.real > 0
+    assert np.any(lam.real > 0.1)                 # the artefacts are there ...
+    assert np.all(m.edge[rhp])                    # ... every one is marked
+    assert not np.any(m.floquet_consistent[rhp])
+    top = lam[np.argmax(lam.real)]
+    assert f"{top:.4g}" in msg or f"{top.conjugate():.4g}" in msg   # and named
+    # the same classification as harmonic_modes at the same truncation
+    ref = ltp.harmonic_modes(sys, Hs.nstates // 4)
+    assert _match(ref.eigenvalues[ref.edge], lam[m.edge]) < 1e-9
+    assert np.count_nonzero(ref.edge) == np.count_nonzero(m.edge)
+    assert m.stable
+    truth = monodromy_exponents(2.0, 3.0, 0.3)
+    for x in m.exponents:
+        assert np.min(_same_mod(x, truth)) < 1e-8
+
+
+def test_harmonic_ss_edge_keyword():
+    sys = mathieu(2.0, 3.0, 0.3)
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        Hs = ltp.harmonic_ss(sys, 1, edge='ignore')
+    assert np.any(Hs.modes.edge)
+    with pytest.raises(ValueError, match="edge"):
+        ltp.harmonic_ss(sys, 1, edge='remove')
+    # 'drop': exact modal truncation, the poles are the unmarked eigenvalues only
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        Hd = ltp.harmonic_ss(sys, 1, edge='drop')
+    m = Hd.modes
+    poles = ct.poles(Hd)
+    kept = m.eigenvalues[~m.edge]
+    assert len(poles) == len(kept) and _match(poles, kept) < 1e-9 and _match(kept, poles) < 1e-9
+    assert poles.real.max() == pytest.approx(monodromy_exponents(2.0, 3.0, 0.3).real.max(),
+                                             abs=1e-8)
+    for s in (0.3j, 1.7j):
+        np.testing.assert_allclose(Hd(s), Hs(s), rtol=0, atol=1e-8 * np.abs(Hs(s)).max())
+
+
+def test_harmonic_ss_lti_as_periodic_no_warning_and_exact():
+    G = ct.ss([[-0.5, 5.0], [-5.0, -0.5]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.2]])
+    sys = ltp.ltpss(G, period=1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        H0 = ltp.harmonic_ss(sys, 0)
+        H2 = ltp.harmonic_ss(sys, 2)
+    for X, Y in ((H0.A, G.A), (H0.B, G.B), (H0.C, G.C), (H0.D, G.D)):
+        assert np.array_equal(X, Y)
+    for s in (0.3j, 2.0 + 1j):
+        assert H2(s)[0, 0] == pytest.approx(complex(G(s)), rel=1e-13)
+    assert not H2.modes.edge.any() and H2.modes.floquet_consistent.all()
+
+
+def test_harmonic_ss_unstable_mathieu_genuine_exponent_unmarked():
+    sys = mathieu(1.0, 2.0, 0.3)
+    with pytest.warns(UserWarning) as rec:
+        Hs = ltp.harmonic_ss(sys, 1)
+    assert any("is unstable" in str(w.message) for w in rec)
+    m = Hs.modes
+    truth = monodromy_exponents(1.0, 2.0, 0.3)
+    assert truth.real.max() > 0.1
+    assert abs(m.exponents[0].real - truth.real.max()) < 1e-8
+    # the genuine right-half-plane eigenvalues: Floquet-consistent, not at the edge
+    genuine = (m.eigenvalues.real > 0.1) & m.floquet_consistent & ~m.edge
+    assert np.any(genuine)
+    assert np.min(_same_mod(m.eigenvalues[genuine], truth.real.max())) < 1e-8
+    # and the warning names none of them as an artefact
+    msg = " ".join(str(w.message) for w in rec)
+    for z in m.eigenvalues[genuine]:
+        assert f"{z:.4g}" not in msg
+    # dropping the marked eigenvalues keeps the genuine instability
+    with pytest.warns(UserWarning, match="is unstable"):
+        Hd = ltp.harmonic_ss(sys, 1, edge='drop')
+    assert ct.poles(Hd).real.max() == pytest.approx(truth.real.max(), abs=1e-8)

@@ -30,13 +30,15 @@ from tqdm.auto import tqdm
 
 from .. import config
 from .._core.lifting import _frequency_lift, _full_harmonics, _harmonic_labels, _real_basis
+from .harmonic_eig import classify
 from .._core.coerce import as_ltp
+from .._core.floquet import floquet_exponents
 from .._core.validation import check_positive_int
 
 __all__ = ['harmonic_ss']
 
 
-def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, name=None):
+def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, edge='warn', name=None):
     """Real harmonic state space of a continuous-time LTP system.
 
     Parameters
@@ -48,6 +50,12 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, name=None):
         Harmonics -K..K of the inputs and outputs.
     internal_harmonics : int, optional
         Truncation ``K_i >= K`` of the states (default as in `htf`).
+    edge : {'warn', 'ignore', 'drop'}
+        What to do with the truncation-edge eigenvalues of a periodic A:
+        'warn' (default) marks them in ``modes`` and warns when eigenvalues
+        in the closed right half plane are not Floquet exponents of `sys`;
+        'ignore' only marks them; 'drop' returns the state space without
+        their modal part (exact modal truncation, see Notes).
     name : str, optional
         Name of the result (default: the name of `sys` with '$harmonic').
 
@@ -57,19 +65,52 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, name=None):
         ``(2K_i+1) n`` states, ``(2K+1) m`` inputs and ``(2K+1) p`` outputs,
         harmonic-major, named ``'<label>_c<n>'`` and ``'<label>_s<n>'`` (see
         the module notes); its frequency response at s is
-        ``V_y^H H(s) V_u`` with H the truncated HTF.
+        ``V_y^H H(s) V_u`` with H the truncated HTF.  Its attribute
+        ``modes`` is the `HarmonicModes` of its state matrix (as from
+        `harmonic_modes` with the same `internal_harmonics`):
+        ``modes.eigenvalues`` are its poles (``ct.poles``, up to order and
+        rounding), ``modes.edge`` marks the truncation-edge eigenvalues,
+        ``modes.floquet_consistent`` those equal to a Floquet exponent
+        modulo ``jω_p``, and ``modes.exponents`` are the system's modes.
+        The attribute is not carried over by operations on the result.
+        With ``edge='drop'`` the result has the states of the kept modes
+        (named ``'x[i]'``) and ``modes`` still describes the full
+        truncation.
 
     Raises
     ------
     ValueError
-        If `sys` is discrete-time.
+        If `sys` is discrete-time, or `edge` is not 'warn', 'ignore' or
+        'drop'.
+
+    Warns
+    -----
+    UserWarning
+        With ``edge='warn'``, naming the right-half-plane eigenvalues that
+        are not Floquet exponents; Floquet exponents the truncation does
+        not resolve; when `sys` is unstable; when the truncation of the
+        response has not converged; with ``edge='drop'``, when the dropped
+        modes change the response by more than 1e-6 (relative).
 
     Notes
     -----
     For a periodic A the state matrix is truncated: besides shifted copies
-    of the Floquet exponents, its eigenvalues (``ct.poles``) include
-    truncation-edge artefacts, which may lie in the right half plane of a
-    stable system.  `harmonic_modes` marks them and gives the modes.
+    ``λ - jkω_p`` of the Floquet exponents, its eigenvalues include
+    truncation-edge artefacts (eigenvectors reaching the outermost
+    harmonics), which may lie in the right half plane of a stable system:
+    the poles of the result and LTI stability verdicts on them
+    (``ct.poles``, ``is_stable`` of a feedback built on it) do not decide
+    the stability of `sys`; `floquet_exponents` and `nyquist_htf` do.  The
+    marks cost one eigendecomposition of the state matrix and one Floquet
+    computation; a constant A has no artefact.
+
+    ``edge='drop'`` orders the real Schur form of the state matrix with the
+    kept eigenvalues first, ``[[T11, T12], [0, T22]]``, decouples the two
+    blocks exactly by the solution X of ``T11 X - X T22 + T12 = 0`` and
+    returns ``(T11, B1 - X B2, C1, D)`` in these coordinates: its poles are
+    exactly the unmarked eigenvalues, and its response differs from the
+    truncated HTF by the dropped modes' part, which is checked at two
+    frequencies (for the Mathieu example below, about 1e-10 relative).
 
     Examples
     --------
@@ -82,15 +123,109 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, name=None):
     (5, ['u[0]_c0', 'u[0]_c1', 'u[0]_s1'])
     >>> bool(np.isclose(Hs(0.5j)[0, 0], G(0.5j)))
     True
+
+    A stable Mathieu system: the right-half-plane poles of its truncation
+    are marked as edge artefacts (and warned about unless ``edge='ignore'``):
+
+    >>> A = lambda t: np.array([[0.0, 1.0], [-(2 + 3 * np.cos(t)), -0.3]])
+    >>> sys = ltp.ltpss(A, [[0.0], [1.0]], [[1.0, 0.0]], 0, period=2 * np.pi)
+    >>> Hs = ltp.harmonic_ss(sys, 1, edge='ignore')
+    >>> rhp = Hs.modes.eigenvalues.real > 0
+    >>> bool(rhp.any()), bool(Hs.modes.edge[rhp].all()), Hs.modes.stable
+    (True, True, True)
+
+    Dropping them leaves the shifted copies of the Floquet exponents only:
+
+    >>> Hd = ltp.harmonic_ss(sys, 1, edge='drop')
+    >>> Hd.nstates, float(np.round(ct.poles(Hd).real.max(), 8))
+    (26, -0.15)
     """
     sys = as_ltp(sys, 'sys')
     if sys.isdtime():
         raise ValueError("harmonic_ss: sys is discrete-time; lift(sys) is its exact "
                          "(frequency-lifted) harmonic state space")
     K = check_positive_int(nharmonics, 'nharmonics', minimum=0)
-    hss = build(sys, K, internal_harmonics, 'auto', 'harmonic_ss')
-    return real_ss(hss, name or f'{sys.name}$harmonic', sys.input_labels,
-                   sys.output_labels, sys.state_labels)
+    if edge not in ('warn', 'ignore', 'drop'):
+        raise ValueError(f"edge must be 'warn', 'ignore' or 'drop', got {edge!r}")
+    hss = build(sys, K, internal_harmonics, 'auto', 'harmonic_ss', warn_unstable=False)
+    # the Floquet exponents once: for the stability remark and the marks
+    fl = floquet_exponents(sys) if sys.nstates else np.zeros(0, complex)
+    fl = np.atleast_1d(np.asarray(fl, complex))
+    if np.any(np.abs(np.exp(fl * (2 * np.pi / sys.omega_p))) >= 1 - 1e-10):
+        _warn_unstable(sys, 2)
+    modes, missing = classify(sys, hss.F, hss.Ki, floquet=fl, strict=False,
+                              where='harmonic_ss')
+    if edge != 'ignore':
+        _warn_edge(modes, missing, hss.Ki, rhp=edge == 'warn')
+    out = real_ss(hss, name or f'{sys.name}$harmonic', sys.input_labels,
+                  sys.output_labels, sys.state_labels)
+    if edge == 'drop' and modes.edge.any():
+        out = _drop_edge(out, modes, sys.omega_p)
+    out.modes = modes
+    return out
+
+
+def _drop_edge(Hs, modes, wp):
+    """Exact modal truncation of the marked eigenvalues of the real form `Hs`."""
+    lam, keep = modes.eigenvalues, ~modes.edge
+
+    def kept(re, im=None):
+        z = re if im is None else re + 1j * im
+        return bool(keep[np.argmin(np.abs(lam - z))])
+
+    T, Z, k = sla.schur(Hs.A, output='real', sort=kept)
+    if k != np.count_nonzero(keep):   # the marks split a conjugate pair: cannot happen
+        raise RuntimeError("harmonic_ss: the ordered Schur form does not separate "
+                           "the marked eigenvalues")   # pragma: no cover
+    X = sla.solve_sylvester(T[:k, :k], -T[k:, k:], -T[:k, k:])
+    ZB, CZ = Z.T @ Hs.B, Hs.C @ Z
+    out = ct.ss(T[:k, :k], ZB[:k] - X @ ZB[k:], CZ[:, :k], Hs.D, name=Hs.name,
+                inputs=Hs.input_labels, outputs=Hs.output_labels)
+    # the dropped part of the response, at two frequencies inside the band
+    n = Hs.nstates
+    err = 0.0
+    for s in 1j * wp * np.array([0.137, 0.61]):
+        full = Hs.C @ np.linalg.solve(s * np.eye(n) - Hs.A, Hs.B) + Hs.D
+        red = out.C @ np.linalg.solve(s * np.eye(k) - out.A, out.B) + out.D
+        err = max(err, np.abs(full - red).max() / max(np.abs(full).max(), 1e-300))
+    if err > 1e-6:
+        warnings.warn(f"harmonic_ss: dropping the {n - k} truncation-edge modes changes the "
+                      f"response by {err:.1e} (relative); increase internal_harmonics",
+                      UserWarning, stacklevel=3)
+    return out
+
+
+def _warn_unstable(sys, stacklevel):
+    warnings.warn(f"{sys.name} is unstable: its HTF is defined wherever the harmonic "
+                  "resolvent exists, but on the imaginary axis it describes no "
+                  "steady-state response", UserWarning, stacklevel=stacklevel + 1)
+
+
+def _warn_edge(modes, missing, Ki, rhp=True):
+    """Warn about right-half-plane eigenvalues that are no Floquet exponents."""
+    lam = modes.eigenvalues
+    # with the marked ones dropped, only the unmarked ones remain to be named
+    bad = (lam.real >= 0) & ~modes.floquet_consistent & (rhp | ~modes.edge)
+    msgs = []
+    if bad.any():
+        order = np.argsort(-lam[bad].real)
+        shown = ", ".join(f"{z:.4g}" for z in lam[bad][order][:6])
+        more = f" and {bad.sum() - 6} more" if bad.sum() > 6 else ""
+        msgs.append(
+            f"{int(bad.sum())} eigenvalues of the truncated harmonic state matrix in the "
+            f"closed right half plane are not Floquet exponents of the system "
+            f"({int(np.count_nonzero(bad & modes.edge))} of them marked at the truncation "
+            f"edge): {shown}{more}; they are artefacts of the truncation at "
+            f"internal_harmonics={Ki} (marked in .modes)")
+    if missing.size:
+        msgs.append("the Floquet exponents " + ", ".join(f"{z:.4g}" for z in missing)
+                    + f" have no eigenvalue of the truncation at internal_harmonics={Ki}; "
+                    "increase internal_harmonics")
+    if msgs:
+        warnings.warn("harmonic_ss: " + "; ".join(msgs) + ". Judge stability by "
+                      "ltp.floquet_exponents(sys) or ltp.harmonic_modes(sys), not by "
+                      "ct.poles of the harmonic state space (edge='ignore' silences this)",
+                      UserWarning, stacklevel=3)
 
 
 def build(sys, K, internal_harmonics, method, where, stacklevel=2, warn_unstable=True):
@@ -115,9 +250,7 @@ def build(sys, K, internal_harmonics, method, where, stacklevel=2, warn_unstable
     if method not in ('auto', 'modal', 'solve'):
         raise ValueError(f"method must be 'auto', 'modal' or 'solve', got {method!r}")
     if warn_unstable and not sys.is_stable():
-        warnings.warn(f"{sys.name} is unstable: its HTF is defined wherever the harmonic "
-                      "resolvent exists, but on the imaginary axis it describes no "
-                      "steady-state response", UserWarning, stacklevel=stacklevel + 1)
+        _warn_unstable(sys, stacklevel + 1)
     if sys.isdtime():
         N = sys.nsteps
         if 2 * K + 1 > N:
