@@ -146,8 +146,20 @@ class DelayHarmonicMargins(HarmonicMargins):
 
     delay_margin: float = float('inf')
 
-    def report(self, hz=False):
+    def report(self, Hz=False, *, hz=None):
         """The margins as a table, with the delay margin in seconds.
+
+        Parameters
+        ----------
+        Hz : bool
+            Physical frequencies in Hz instead of rad/s (python-control's
+            keyword).
+        hz : bool, optional
+            Former spelling of `Hz`, still accepted.
+
+        Returns
+        -------
+        str
 
         Examples
         --------
@@ -156,7 +168,8 @@ class DelayHarmonicMargins(HarmonicMargins):
         ...                             edge_tol=2.0).report().splitlines()[-1])
         delay [s]   0.1179
         """
-        return super().report(hz) + f"\n{'delay [s]':<11} {self.delay_margin:6.4g}"
+        return (super().report(Hz, hz=hz)
+                + f"\n{'delay [s]':<11} {self.delay_margin:6.4g}")
 
     def __repr__(self):
         return super().__repr__()[:-1] + f", delay {self.delay_margin:.4g}>"
