@@ -246,3 +246,23 @@ def test_loop_functions_take_impedance_products():
     Lh = Zh(s) @ ltp.htf(Y, 3, internal_harmonics=25)(s)
     want = np.linalg.inv(np.eye(7) + Lh)
     assert np.allclose(S(s)[2:5, 2:5], want[2:5, 2:5], atol=1e-9)
+
+
+def test_nyquist_htf_and_harmonic_margins_take_measured_factors():
+    """A loop with a measured admittance through the loop functions themselves: the
+    count and margins of the sampled loop (as impedance_nyquist/impedance_margins),
+    equal to the model loop's verdict; open_loop_unstable refused for model loops."""
+    T = 0.02
+    Y = ltp.ltpss(ct.tf([1], [2e-3, 0.1]), period=T)
+    Zg = ltp.rlc_impedance(L=5e-3, period=T, nharmonics=4)
+    w = np.arange(1, 2000) * 2 * np.pi / T / 16
+    Yd = ltp.HTFData(ltp.htf(Y, 0).components(w)[1], w, period=T)
+    sampled = ltp.nyquist_htf((Zg, Yd), 4, open_loop_unstable=0)
+    model = ltp.nyquist_htf((Zg, Y), 4)
+    assert isinstance(sampled, ltp.SampledNyquistResponse)
+    assert sampled.stable == model.stable
+    assert sampled.encirclements == ltp.impedance_nyquist((Zg, Yd), 4,
+                                                          open_loop_unstable=0).encirclements
+    assert repr(ltp.harmonic_margins((Zg, Yd), 4)) == repr(ltp.impedance_margins((Zg, Yd), 4))
+    with pytest.raises(ValueError, match='open_loop_unstable'):
+        ltp.nyquist_htf((Zg, Y), 4, open_loop_unstable=0)

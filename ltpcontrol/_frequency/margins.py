@@ -191,7 +191,9 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
         The continuous-time square loop, closed by negative feedback
         (see `nyquist_htf`).  MIMO loops: the gain margins are for a
         common real gain ``kI`` on every channel, the phase margin for a
-        common rotation ``e^{-jφ}I`` (module notes).
+        common rotation ``e^{-jφ}I`` (module notes).  A sequence holding
+        measured HTFs (`HTFData`) gives the margins of the sampled loop
+        (`impedance_margins`).
     nharmonics : int
         Truncation N of the loop HTF.
     period : float, optional

@@ -39,6 +39,7 @@ from .nyquist import HarmonicNyquistResponse, nyquist_htf, track
 from .products import harmonic_product
 from .._core.floquet import floquet_exponents
 from .._core.ltpsys import LTPStateSpace
+from .._core.registry import override
 from .._core.coerce import as_ltp
 from .._core.validation import check_positive_int, commensurate, real_array
 
@@ -580,3 +581,14 @@ def _disk(alpha, skew):
 
 def _wrap(x):
     return np.remainder(x + np.pi, 2 * np.pi) - np.pi
+
+
+# nyquist_htf and harmonic_margins of loops with measured factors: the sampled count
+@override('nyquist_htf', HTFData)
+def _nyquist_htf_measured(L, nharmonics, omega=None, **options):
+    return impedance_nyquist(L, nharmonics, omega, **options)
+
+
+@override('harmonic_margins', HTFData)
+def _harmonic_margins_measured(L, nharmonics=10, **options):
+    return impedance_margins(L, nharmonics, **options)

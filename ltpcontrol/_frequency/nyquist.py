@@ -216,7 +216,7 @@ class HarmonicNyquistResponse:
 
 def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
                 closure_tol=0.05, internal_harmonics=None, check='auto',
-                floquet_steps=None):
+                floquet_steps=None, open_loop_unstable=None):
     """Generalized Nyquist criterion for a periodic loop with negative feedback.
 
     Counts the encirclements of the origin by ``det(I + L̂_N(s))`` along the
@@ -230,7 +230,9 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
         The continuous-time loop, square (m inputs, m outputs).  A sequence
         ``(L_1, ..., L_k)`` is the product ``L_1 ... L_k`` (``L_k`` acts
         first), e.g. ``(plant, controller)``; their periods must be
-        commensurate.  An LTI loop needs `period`.
+        commensurate.  An LTI loop needs `period`.  A sequence holding
+        measured HTFs (`HTFData`, e.g. from `estimate_htf`) gives the count
+        of the sampled curve, with its caveats (`impedance_nyquist`).
     nharmonics : int
         Truncation N >= 1 of the loop HTF.
     omega : array_like, optional
@@ -262,6 +264,10 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
         `nsteps`; default: its own choice, each step integrated with the
         sub-steps its error estimate asks).  Each system's exponents are
         computed once per call.
+    open_loop_unstable : int, optional
+        Loops with measured factors only: the open-loop exponents of the
+        measured factors in the right half plane (see `impedance_nyquist`);
+        without it their count gives no verdict.
 
     Returns
     -------
@@ -310,11 +316,16 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     >>> ct.nyquist_response(ct.tf([2], [1, -1])).count == resp.count
     True
     """
-    # -- loops with delays: their own count (ltpcontrol._delays.nyquist) --
+    # -- loops with delays (ltpcontrol._delays.nyquist) or measured factors
+    # (measured_loop): their own count --
     if (own := overridden('nyquist_htf', *(L if isinstance(L, (list, tuple)) else [L]))):
+        extra = {} if open_loop_unstable is None else {'open_loop_unstable': open_loop_unstable}
         return own(L, nharmonics, omega, period=period, indent_radius=indent_radius,
                    closure_tol=closure_tol, internal_harmonics=internal_harmonics,
-                   check=check, floquet_steps=floquet_steps)
+                   check=check, floquet_steps=floquet_steps, **extra)
+    if open_loop_unstable is not None:
+        raise ValueError("nyquist_htf: open_loop_unstable is for loops with measured "
+                         "factors (HTFData); a model loop's exponents are computed")
     # --
     L = as_loop(L, 'L', period, 'nyquist_htf')
     loop = LoopHTF(L, nharmonics, internal_harmonics)
