@@ -211,7 +211,7 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     >>> sys = ltp.ltpss(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)),
     ...                 lambda t: np.array([[1 + np.cos(4 * np.pi * t)]]), 0.5)
     >>> exc = ltp.sine_experiments([1.0, 3.0], 0.5, dt=0.05, nperiods=8)
-    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
+    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs)
     >>> G = ltp.lifted_frequency_response(resp, 0.5, 1, real=False)
     >>> np.round(G.frdata[:, 0, 0].real, 6)            # G_{-1}, G_0, G_1
     array([0.5, 1. , 0.5])

@@ -456,7 +456,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     ...                 [[1.0]], 0, period=0.5)
     >>> w = np.pi / 2 * np.array([k for k in range(1, 16) if k % 4])
     >>> exc = ltp.sine_experiments(w, 0.5, dt=0.0125, nperiods=8, settle=12)
-    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
+    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs)
     >>> model = ltp.identify_ltp(resp, 0.5, 1, q=10, transient=6.0, input_hold='foh')
     >>> np.round(model.A(0.0), 4)
     array([[-2.]])
