@@ -1,12 +1,16 @@
 """What limits the hopper leg's HTF route: noise, estimator bias or the model?
 
 The leg of ``ident_leg_paths.py`` (periodic stiffness and damping, period
-0.5 s) identified with K = 2 from 2K_h + 4 phase-shifted chirp replicas
-(0-12 Hz, 20 s each) → `estimate_htf` with its defaults (K_h = 3K + 1 = 7
-harmonics, the band they reach) → `identify_ltp`.  Each row prints the
+0.5 s) identified with K harmonics (default 2) from 2K_h + 4 phase-shifted
+chirp replicas (0-12 Hz, 20 s each) → `estimate_htf` with its defaults
+(K_h = 3K + 1 harmonics, the band they reach) → `identify_ltp`.  Each row prints the
 fresh-record NRMSE (filtered noise, cut-off 2 ω_p, 60 periods):
 
-* ``noise-free``: the floor of the estimator and of the K = 2 structure;
+* ``noise-free``: the floor of the estimator and of the K-harmonic
+  structure (a plant with periodic A(t) has infinitely many harmonics in
+  Floquet form; at K = 2 this floor, 0.017 here and 0.013 from noise-free
+  lifted sine data, is what the 30 dB records reach: the noise does not
+  limit them, the structure does, and K = 3 brings it below 1e-2);
 * ``30 dB``, ``40 dB``, ``20 dB``: how the error scales with the noise
   (proportional to it when the noise limits);
 * ``30 dB, 2x longer chirps``: twice the data at the same noise;
@@ -16,7 +20,7 @@ fresh-record NRMSE (filtered noise, cut-off 2 ω_p, 60 periods):
   (`sample_models`): the prediction error any efficient estimator leaves
   at this noise level and amount of data (the Cramér-Rao spread).
 
-Run ``python examples/ident_leg_htf_floor.py`` (several minutes on one core).
+Run ``python examples/ident_leg_htf_floor.py [K]`` (several minutes on one core).
 """
 
 import sys
@@ -29,7 +33,7 @@ import ltpcontrol as ltp
 sys.path.insert(0, __file__.rsplit('/', 1)[0])
 from ident_leg_paths import DT, T, fresh, leg  # noqa: E402
 
-K = 2
+K = int(sys.argv[1]) if len(sys.argv) > 1 else 2
 
 
 def identify(plant, snr, seed=0, duration=20.0, refine=None):

@@ -74,6 +74,7 @@ from ._analysis.hinf import hinfnorm
 from ._analysis.finite_horizon import care_finite, lyap_finite, h2norm_finite
 from ._analysis.sylvester import sylvester, dsylvester
 from ._identification.validate import validate_ltp, LTPValidation
+from ._identification.joint_io import joint_io_htf
 
 __version__ = "0.1.0"
 
@@ -152,6 +153,8 @@ __all__ = [
     'care_finite', 'lyap_finite', 'h2norm_finite', 'sylvester', 'dsylvester',
     # validation of identified models on time records
     'validate_ltp', 'LTPValidation',
+    # the plant from closed-loop records
+    'joint_io_htf',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

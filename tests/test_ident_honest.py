@@ -182,5 +182,5 @@ def test_closed_loop_records_get_advice_that_applies(records):
     u = exc.inputs.copy()
     u = u + 0.1 * np.random.default_rng(0).standard_normal(u.shape)
     y = ltp.forced_response(sys, t, u).outputs
-    with pytest.raises(ValueError, match='Closed-loop records'):
+    with pytest.raises(ValueError, match='Closed-loop records.*joint_io_htf'):
         ltp.identify_ltp((t, u, y), T, 1, 1, transient=6.0, input_hold='foh')

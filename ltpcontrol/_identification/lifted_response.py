@@ -51,9 +51,8 @@ _CLOSED_LOOP = (". Closed-loop records (the input computed from the output by a 
                 "open-loop method cannot use them; give the reference as the input "
                 "(records (t, r, y) identify the closed loop from r to y), excite the "
                 "plant in open loop, or, for the plant from closed-loop records, "
-                "estimate the HTFs from r to y and to u (estimate_htf on (t, r, [y; u])) "
-                "and form G_yr G_ur^-1 from their harmonic transfer matrices (joint "
-                "input-output)")
+                "estimate the HTF from r to [y; u] (estimate_htf on (t, r, [y; u])) and "
+                "take the plant from it with joint_io_htf (joint input-output)")
 
 
 def lifted_frequency_response(response, period, nharmonics=None, *, frequencies=None,

@@ -356,7 +356,8 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     ``holdout_error`` (plus ``validation_tol``/10) is reported with a warning;
     both only beyond three standard deviations of the noise estimate.  The
     cost is one simulation of a quarter of the records (none for multisine
-    records, which hold out no whole experiment).  The relative residual is compared with the
+    records, which hold out no whole experiment, nor for ``input_hold=None``,
+    whose samples of a continuous input cannot be replayed exactly).  The relative residual is compared with the
     realization's ``fit_tol`` the same way, less the noise's share over
     all lines (a residual below the noise counts as 0 there: the fitted
     lines absorb part of their noise).
@@ -488,8 +489,9 @@ def _identify(data, period, nstates, nharmonics=1, *, q=None, conversion='refit'
             if holdout_nrmse > before:
                 # the refinement must not predict worse than its start
                 fallback, holdout_nrmse = True, before
-        if not isinstance(data, (ct.FrequencyResponseData, HTF)):
-            # the same model simulated on the held-out records themselves
+        if not isinstance(data, (ct.FrequencyResponseData, HTF)) and input_hold is not None:
+            # the same model simulated on the held-out records themselves (held inputs:
+            # samples of a continuous input cannot be replayed exactly)
             check = record_check(val['start'] if fallback else val['sys'], data, period,
                                  G.omega[held], **{k: record_options[k] for k in (
                                      'frequencies', 'transient', 'input_hold')})

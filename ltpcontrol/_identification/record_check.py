@@ -50,9 +50,10 @@ class RecordCheck:
 
 
 def record_check(model, data, period, held_lines, *, frequencies=None, transient=None,
-                 input_hold=None):
-    """The `RecordCheck` of `model` on the experiments of `data` whose lines are all
-    among `held_lines` (rad/s); ``nrecords == 0`` when there is none.
+                 input_hold='foh'):
+    """The `RecordCheck` of `model` (simulated with `input_hold`) on the experiments of
+    `data` whose lines are all among `held_lines` (rad/s); ``nrecords == 0`` when
+    there is none.
 
     Examples
     --------
@@ -81,7 +82,7 @@ def record_check(model, data, period, held_lines, *, frequencies=None, transient
     if not chosen:
         return RecordCheck()
     start = t.size - Lw
-    sim = np.asarray(forced_response(model, t, u[:, chosen], input_hold=input_hold or 'foh',
+    sim = np.asarray(forced_response(model, t, u[:, chosen], input_hold=input_hold,
                                      compute_states=False).outputs)
     sim = sim.reshape(y.shape[0], len(chosen), -1)[..., start:]
     yh = yw[:, chosen]

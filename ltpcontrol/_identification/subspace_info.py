@@ -83,7 +83,8 @@ class LTPSubspaceInfo:
         the held-out lines, simulated from rest (`forced_response`, the
         records' input hold) on the held-out records (the experiments whose
         every line is held out), in their analysis windows; NaN when no
-        experiment is held out as a whole (multisines) or for lifted data.
+        experiment is held out as a whole (multisines), for
+        ``input_hold=None`` or for lifted data.
     record_noise : float
         The noise's NRMSE over the same samples (free DFT bins).
     record_error : float
