@@ -165,3 +165,18 @@ def test_multisine_experiments_identify_htf():
     assert np.all(bins % 4 != 0) and est.omega.size >= 12
     true = system.htf(est.omega, 1)
     assert np.max(np.abs(est.components()[1] - true) / np.abs(true)) < 0.02
+
+
+def test_designs_in_channel_experiment_time_order():
+    import ltpcontrol as ltp
+    from control.exception import ControlDimension
+    sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=2.0)
+    exc = sine_experiments([1.0, 2.2], 2.0, dt=0.02, nperiods=4)
+    assert exc.inputs.shape == (1, 2, 400) and exc.signal(0.3).shape == (1, 2)
+    # forced_response takes the design as it is: one trace per experiment
+    y = ltp.forced_response(sys, exc.time, exc.inputs).outputs
+    assert np.shape(y) == (1, 2, 400)
+    # the former (experiments, samples) order is refused with the shape to give
+    old = exc.inputs[0]
+    with pytest.raises(ControlDimension, match=r"shape \(1, 2, L\)"):
+        ltp.lifted_frequency_response((exc.time, old, y[0]), 2.0, 1)
