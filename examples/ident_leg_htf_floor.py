@@ -11,7 +11,8 @@ fresh-record NRMSE (filtered noise, cut-off 2 ω_p, 60 periods):
   Floquet form; at K = 2 this floor, 0.017 here and 0.013 from noise-free
   lifted sine data, is what the 30 dB records reach: the noise does not
   limit them, the structure does; with K = 3 the noise-free floor is
-  0.0078 on this route and 0.0053 from lifted sine data);
+  0.0078 on this route and 0.0053 from lifted sine data, and 30 dB records
+  reach 0.0054-0.0062 on this route);
 * ``30 dB``, ``40 dB``, ``20 dB``: how the error scales with the noise
   (proportional to it when the noise limits);
 * ``30 dB, 2x longer chirps``: twice the data at the same noise;
