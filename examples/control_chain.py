@@ -9,8 +9,8 @@
    `band_limited_lqg`: the same kept inside the band the data excited.
 3. `push_recovery`: response to a velocity push, open and closed loop, and
    the strides taken to return within 1 % of the orbit.
-4. `record_experiments`: records of multi-experiment designs (one row per
-   experiment, e.g. multisines in several bands), each started on the orbit.
+4. `record_experiments`: records of multi-experiment designs (channels, experiments,
+   samples; e.g. multisines in several bands), each started on the orbit.
 """
 
 import control as ct
@@ -130,7 +130,7 @@ def push_study(plant, orbit, controller, mode, dv, nstrides, dt, *, progress=Fal
 def _simulate_experiment(plant, orbit, exc, row, solver):
     signal = exc.signal
     resp = ltp.simulate_hybrid(plant, exc.time, orbit.x0, orbit.mode0,
-                               inputs=lambda s: np.atleast_1d(signal(np.atleast_1d(s))[row]),
+                               inputs=lambda s: np.atleast_1d(signal(np.atleast_1d(s))[0, row]),
                                **solver)
     ybar = [plant.outfcn(tk, xk, orbit.u0, orbit.params)[0]
             for tk, xk in zip(exc.time, orbit(exc.time).T)]
@@ -140,16 +140,16 @@ def _simulate_experiment(plant, orbit, exc, row, solver):
 def record_experiments(plant, orbit, excitations, *, solver=None, n_jobs=2, progress=False):
     """Records ``(t, u, y)`` of multi-experiment designs, each row started on the orbit at t = 0.
 
-    `excitations` is a list of `ltpcontrol.Excitation` with rows of equal
+    `excitations` is a list of single-input `ltpcontrol.Excitation` of equal
     length (e.g. `ltpcontrol.multisine` in several bands); ``u`` and ``y``
-    have one row per experiment (noise-free).
+    have shape (1, experiments, samples), channels first (noise-free).
     """
     from tqdm.auto import tqdm
     solver = solver or {'rtol': 1e-8, 'atol': 1e-11}
     jobs = [(exc, row) for exc in excitations
-            for row in range(np.atleast_2d(exc.inputs).shape[0])]
+            for row in range(exc.inputs.shape[1])]
     ys = Parallel(n_jobs=n_jobs)(delayed(_simulate_experiment)(plant, orbit, exc, row, solver)
                                  for exc, row in tqdm(jobs, desc='experiments',
                                                       disable=not progress, leave=False))
-    u = np.vstack([np.atleast_2d(exc.inputs) for exc in excitations])
-    return excitations[0].time, u, np.array(ys)
+    u = np.concatenate([exc.inputs for exc in excitations], axis=1)
+    return excitations[0].time, u, np.array(ys)[np.newaxis]

@@ -5,10 +5,11 @@ Leg ``m ẍ + c(t) ẋ + k(t) x = f`` with k ±50 %, c ±30 % and an actuator
 ``tests/test_ident_leg.py``).  Paths:
 
 * lifted FRD from 38 single-sine records, with K harmonics (fewer than the
-  model produces) and with 3K + 1, noise-free and at 30 dB (seeds 0-2);
-* HTF route: 2K + 4 phase-shifted chirp replicas (0-12 Hz) at 30 dB
-  (seeds 0-2) → `estimate_htf` with K and with 3K + 1 harmonics →
-  `identify_ltp`.
+  model produces), with 3K + 1 and with the default (every harmonic the
+  sampling holds), noise-free and at 30 dB (seeds 0-2);
+* HTF route: 2K_h + 4 phase-shifted chirp replicas (0-12 Hz) at 30 dB
+  (seeds 0-2) → `estimate_htf` → `identify_ltp`, with K_h = K harmonics and
+  with K_h = 3K + 1 taken by `estimate_htf`'s defaults (harmonics and band).
 
 Every model is simulated next to the plant on a fresh record of filtered
 noise (cut-off 2 ω_p, 60 periods); the table prints ``success``, the
@@ -73,9 +74,10 @@ def main():
             for seed in (None, 0, 1, 2):
                 yn = y if seed is None else \
                     y + sigma * np.random.default_rng(seed).standard_normal(y.shape)
-                for Kd in (K, 3 * K + 1):
+                for Kd in (K, 3 * K + 1, None):
                     G = ltp.lifted_frequency_response((t, u, yn), T, Kd, transient=P * T,
                                                       input_hold='foh')
+                    Kd = 'default' if Kd is None else Kd
                     noise = 'noise-free' if seed is None else f'30 dB seed {seed}'
                     run(f"FRD K={K} data {Kd} harm. {noise}", G, K, plant)
     else:
@@ -88,10 +90,14 @@ def main():
                 yn = yc + sigma * np.random.default_rng(seed).standard_normal(yc.shape)
                 with warnings.catch_warnings():
                     warnings.simplefilter('ignore')
-                    H = ltp.estimate_htf((exc.time, exc.inputs, yn), T, Kh,
-                                         segments=exc.segments,
-                                         omega_limits=(0.0, 2 * np.pi * (12.0 + 2 * Kh)))
-                run(f"HTF K={K} data {Kh} harm. 30 dB seed {seed}", H, K, plant)
+                    if Kh == K:
+                        H = ltp.estimate_htf((exc.time, exc.inputs, yn), T, Kh,
+                                             segments=exc.segments,
+                                             omega_limits=(0.0, 2 * np.pi * (12.0 + 2 * Kh)))
+                    else:                    # the defaults: every harmonic the design holds
+                        H = ltp.estimate_htf((exc.time, exc.inputs, yn), T,
+                                             segments=exc.segments)
+                run(f"HTF K={K} data {H.nharmonics} harm. 30 dB seed {seed}", H, K, plant)
 
 
 if __name__ == '__main__':

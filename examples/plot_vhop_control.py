@@ -128,8 +128,6 @@ def with_noise(u, y, seed=NOISE_SEED):
 
 def identify(data, transient, lines):
     """Floquet-form model of the records (see step 2)."""
-    t, u, y = data
-    data = (t, np.asarray(u)[np.newaxis], np.asarray(y)[np.newaxis])  # experiments of one channel
     with warnings.catch_warnings():
         warnings.filterwarnings('ignore', message='.*refit did not converge')
         # the records sample a continuous input: first-order hold between samples

@@ -184,7 +184,7 @@ def sine_data(plant, orbit, frequencies_hz, amplitude=0.1, n_jobs=2):
     ys = Parallel(n_jobs=n_jobs)(
         delayed(_deviation)(plant, orbit, _cosine(amplitude, w), exc.time.size)
         for w in exc.frequencies)
-    return exc.frequencies, exc.time[a:b], exc.inputs[:, a:b], np.array(ys)[:, a:b]
+    return exc.frequencies, exc.time[a:b], exc.inputs[0, :, a:b], np.array(ys)[:, a:b]
 
 
 def _cosine(amplitude, omega):

@@ -77,6 +77,7 @@ from ._analysis.lyapchol import lyapchol, dlyapchol
 from ._analysis.finite_horizon import care_finite, lyap_finite, h2norm_finite
 from ._analysis.sylvester import sylvester, dsylvester
 from ._identification.validate import validate_ltp, LTPValidation
+from ._identification.joint_io import joint_io_htf
 
 __version__ = "0.1.0"
 
@@ -169,6 +170,8 @@ __all__ = [
     'sampled_loop', 'lifted_nyquist', 'LiftedNyquistResponse',
     # periodic H∞ state feedback, factored Lyapunov solutions
     'hinf_statefbk', 'HinfStateFeedbackResult', 'lyapchol', 'dlyapchol',
+    # the plant from closed-loop records
+    'joint_io_htf',
 ]
 
 # the python-control bridge (see interop): on unless ltp.config says otherwise

@@ -48,7 +48,7 @@ _SINE_PLANT = ltp.ltpss([[-2.0]], lambda t: np.array([[1 + 0.5 * np.cos(4 * np.p
                         [[1.0]], 0, 0.5)
 _SINE_EXC = ltp.sine_experiments(np.pi / 2 * np.array([k for k in range(1, 16) if k % 4]),
                                  0.5, dt=0.0125, nperiods=8, settle=12)
-_SINE_RESPONSE = ltp.forced_response(_SINE_PLANT, _SINE_EXC.time, _SINE_EXC.inputs[None])
+_SINE_RESPONSE = ltp.forced_response(_SINE_PLANT, _SINE_EXC.time, _SINE_EXC.inputs)
 H = ltp.htf(SYS, 1)
 OMEGA = np.linspace(0.5, 10.0, 20)
 G_DATA = np.zeros((3, 1, 1, OMEGA.size), complex)

@@ -68,7 +68,7 @@ def test_identify_ltp_hold_with_feedthrough():
                     lambda t: np.array([[0.8 + 0.3 * np.cos(WP * t)]]), period=T)
     w = np.pi / 2 * np.array([k for k in range(1, 40) if k % 4])
     exc = ltp.sine_experiments(w, T, dt=0.0125, nperiods=8, settle=12)
-    resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
+    resp = ltp.forced_response(sys, exc.time, exc.inputs)
     model = ltp.identify_ltp(resp, T, 1, q=10, transient=6.0, input_hold='foh')
     assert abs(model.A(0.0)[0, 0] + 2) < 1e-2
     assert np.allclose(model.D.fourier(1)[:, 0, 0], sys.D.fourier(1)[:, 0, 0], atol=2e-3)

@@ -80,9 +80,9 @@ def test_sine_experiments_whole_cycles_in_window():
     step = 2 * np.pi / (5 * T)
     assert np.allclose(exc.frequencies, np.round(np.array([1.0, 2.2, 5.0]) / step) * step)
     a, b = exc.segments[0]
-    assert (a, b) == (100, 600) and exc.inputs.shape == (3, 600)
+    assert (a, b) == (100, 600) and exc.inputs.shape == (1, 3, 600)
     for e, w in enumerate(exc.frequencies):
-        spec = np.abs(np.fft.rfft(exc.inputs[e, a:b])) / (b - a)
+        spec = np.abs(np.fft.rfft(exc.inputs[0, e, a:b])) / (b - a)
         line = int(round(w / step))
         assert spec[line] == pytest.approx(0.15)       # amplitude/2: a single line
         spec[line] = 0
@@ -118,23 +118,23 @@ def test_multisine_band_shifts_and_phases():
     step = 2 * np.pi / 4
     bins = np.round(exc.frequencies / step).astype(int)
     assert np.all(bins % 2 == 1)                       # multiples of ω_p/2 skipped
-    assert exc.inputs.shape == (R, 500)
+    assert exc.inputs.shape == (1, R, 500)
     # experiment r is experiment 0 delayed by r T / R
     t = np.linspace(0, 4, 37)
     for r in range(R):
-        assert np.allclose(exc.signal(t)[r], exc.signal(t - r * T / R)[0], atol=1e-12)
+        assert np.allclose(exc.signal(t)[0, r], exc.signal(t - r * T / R)[0, 0], atol=1e-12)
     # window spectrum: lines only at the requested frequencies
     a, b = exc.segments[0]
-    spec = np.abs(np.fft.rfft(exc.inputs[0, a:b])) / (b - a)
+    spec = np.abs(np.fft.rfft(exc.inputs[0, 0, a:b])) / (b - a)
     assert np.allclose(spec[bins], 0.05)
     spec[bins] = 0
     assert np.max(spec) < 1e-12
     # Schroeder phases give a lower crest factor than zero phases
     flat = multisine(exc.frequencies, T, dt=dt, nperiods=4, phases=np.zeros(bins.size))
     crest = lambda u: np.max(np.abs(u)) / np.sqrt(np.mean(u ** 2))
-    assert crest(exc.inputs[0, a:b]) < 0.7 * crest(flat.inputs[0])
+    assert crest(exc.inputs[0, 0, a:b]) < 0.7 * crest(flat.inputs[0, 0])
     rnd = multisine(exc.frequencies, T, dt=dt, nperiods=4, phases='random', seed=3)
-    assert np.allclose(np.abs(np.fft.rfft(rnd.inputs[0]))[bins] / 400, 0.5)
+    assert np.allclose(np.abs(np.fft.rfft(rnd.inputs[0, 0]))[bins] / 400, 0.5)
 
 
 def test_multisine_errors_and_warning():
@@ -157,7 +157,7 @@ def test_multisine_experiments_identify_htf():
     system = ScalarLTP()
     exc = multisine(('band', 0.5, 2 * np.pi * 3.0), 1.0, dt=0.01, nperiods=8,
                     nexperiments=5, settle=10, amplitude=0.05)
-    records = [(exc.time, exc.inputs[r], system.simulate(lambda s: exc.signal(s)[r],
+    records = [(exc.time, exc.inputs[0, r], system.simulate(lambda s: exc.signal(s)[0, r],
                                                           exc.time)[0])
                for r in range(5)]
     est = estimate_htf(records, 1.0, 1, segments=exc.segments)
@@ -165,3 +165,18 @@ def test_multisine_experiments_identify_htf():
     assert np.all(bins % 4 != 0) and est.omega.size >= 12
     true = system.htf(est.omega, 1)
     assert np.max(np.abs(est.components()[1] - true) / np.abs(true)) < 0.02
+
+
+def test_designs_in_channel_experiment_time_order():
+    import ltpcontrol as ltp
+    from control.exception import ControlDimension
+    sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=2.0)
+    exc = sine_experiments([1.0, 2.2], 2.0, dt=0.02, nperiods=4)
+    assert exc.inputs.shape == (1, 2, 400) and exc.signal(0.3).shape == (1, 2)
+    # forced_response takes the design as it is: one trace per experiment
+    y = ltp.forced_response(sys, exc.time, exc.inputs).outputs
+    assert np.shape(y) == (1, 2, 400)
+    # the former (experiments, samples) order is refused with the shape to give
+    old = exc.inputs[0]
+    with pytest.raises(ControlDimension, match=r"shape \(1, 2, L\)"):
+        ltp.lifted_frequency_response((exc.time, old, y[0]), 2.0, 1)

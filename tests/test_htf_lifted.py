@@ -27,7 +27,7 @@ def test_lifted_response_from_htf_equals_sine_experiments():
     sys = _plant()
     lines = np.pi / 2 * np.array([k for k in range(1, 16) if k % 4])     # off ω_p/2 multiples
     exc = ltp.sine_experiments(lines, T, dt=0.0125, nperiods=8, settle=12)
-    resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
+    resp = ltp.forced_response(sys, exc.time, exc.inputs)
     G_rec = ltp.lifted_frequency_response(resp, T, 2, transient=6.0, input_hold='foh',
                                           real=False)
     G_htf = ltp.lifted_frequency_response(_htf_data(sys, 6), T, 2, real=False)

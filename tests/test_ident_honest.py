@@ -25,7 +25,7 @@ def plant():
 def records():
     exc = ltp.sine_experiments(W, T, dt=DT, nperiods=8, settle=12)
     sys = plant()
-    return sys, exc, ltp.forced_response(sys, exc.time, exc.inputs[None])
+    return sys, exc, ltp.forced_response(sys, exc.time, exc.inputs)
 
 
 def fresh(model, sys, hold='foh'):
@@ -58,12 +58,12 @@ def test_no_silent_failure_small_study(records):
     sys = plant()
     # lines on the grid of the whole record: the transient can be left in the window
     exc = ltp.sine_experiments(W, T, dt=DT, nperiods=8, settle=8)
-    y = np.asarray(ltp.forced_response(sys, exc.time, exc.inputs[None]).outputs)
+    y = np.asarray(ltp.forced_response(sys, exc.time, exc.inputs).outputs)
     count = 0
     for seed, transient in ((0, 4.0), (1, 0.0)):
         rng = np.random.default_rng(seed)
         noisy = y + np.sqrt(np.mean(y ** 2) / 100) * rng.standard_normal(y.shape)
-        data = (exc.time, exc.inputs[None], noisy)
+        data = (exc.time, exc.inputs, noisy)
         ways = [(data, dict(transient=transient, input_hold='foh'))]
         for Kd in (1, 4):
             G = ltp.lifted_frequency_response(data, T, Kd, transient=transient,
@@ -82,9 +82,9 @@ def test_no_silent_failure_small_study(records):
 def test_noise_above_the_holdout_error_leaves_the_share_unknown():
     sys = plant()
     exc = ltp.sine_experiments(W[:12], T, dt=DT, nperiods=8, settle=12)
-    y = np.asarray(ltp.forced_response(sys, exc.time, exc.inputs[None]).outputs)
+    y = np.asarray(ltp.forced_response(sys, exc.time, exc.inputs).outputs)
     # lifted data with a std far above their actual error
-    G = ltp.lifted_frequency_response((exc.time, exc.inputs[None], y), T, 4, transient=6.0,
+    G = ltp.lifted_frequency_response((exc.time, exc.inputs, y), T, 4, transient=6.0,
                                       input_hold='foh')
     scale = 1e-6 * np.abs(G.frdata).mean()
     _, info = ltp.identify_ltp(G, T, 1, 1, std=scale, return_info=True)
@@ -102,8 +102,8 @@ def test_transient_in_the_window_is_not_noise(records):
     transient, which is not subtracted as noise."""
     sys = plant()
     exc = ltp.sine_experiments(W, T, dt=DT, nperiods=8, settle=8)
-    x0 = np.full((1, exc.inputs.shape[0]), 40.0)
-    resp = ltp.forced_response(sys, exc.time, exc.inputs[None], initial_state=x0)
+    x0 = np.full((1, exc.inputs.shape[1]), 40.0)
+    resp = ltp.forced_response(sys, exc.time, exc.inputs, initial_state=x0)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter('always')
         _, info = ltp.identify_ltp(resp, T, 1, 1, transient=0.0, input_hold='foh',
@@ -116,7 +116,7 @@ def test_transient_in_the_window_is_not_noise(records):
 def test_zoh_records_with_default_settings_warn():
     sys = plant()
     exc = ltp.sine_experiments(W[:16], T, dt=DT, nperiods=8, settle=12)
-    resp = ltp.forced_response(sys, exc.time, exc.inputs[None], input_hold='zoh')
+    resp = ltp.forced_response(sys, exc.time, exc.inputs, input_hold='zoh')
     with pytest.warns(UserWarning, match="input_hold not given"):
         model, info = ltp.identify_ltp(resp, T, 1, 1, transient=6.0, return_info=True)
     assert info.input_hold == 'foh'
@@ -162,8 +162,9 @@ def test_excitation_passed_as_it_is(records):
     _, info = ltp.identify_ltp(r, T, 1, 1, excitation=ms, input_hold='foh', return_info=True)
     assert info.success
     # scalar time for variable-step simulators
-    assert np.ndim(exc.signal(0.3)) == 1 and np.ndim(ms.signal(0.3)) == 1
-    np.testing.assert_allclose(exc.signal(exc.time[5]), exc.inputs[:, 5])
+    assert np.shape(exc.signal(0.3)) == exc.inputs.shape[:2]
+    assert np.shape(ms.signal(0.3)) == ms.inputs.shape[:2] == (1, 1)
+    np.testing.assert_allclose(exc.signal(exc.time[5]), exc.inputs[..., 5])
     chirp = ltp.chirp_replicas(T, 3, 2.0, 0.0, 5.0, dt=DT)
     with pytest.raises(ValueError, match='estimate_htf'):
         ltp.identify_ltp(resp, T, 1, 1, excitation=chirp)
@@ -178,8 +179,8 @@ def test_closed_loop_records_get_advice_that_applies(records):
     sys, exc, _ = records
     # the input of the records depends on the output (and its noise)
     t = exc.time
-    u = exc.inputs[None].copy()
+    u = exc.inputs.copy()
     u = u + 0.1 * np.random.default_rng(0).standard_normal(u.shape)
     y = ltp.forced_response(sys, t, u).outputs
-    with pytest.raises(ValueError, match='Closed-loop records'):
+    with pytest.raises(ValueError, match='Closed-loop records.*joint_io_htf'):
         ltp.identify_ltp((t, u, y), T, 1, 1, transient=6.0, input_hold='foh')

@@ -47,11 +47,11 @@ def test_joint_sines_design():
     assert np.allclose(U.conj().T @ U / np.abs(U[0, 0]) ** 2, 3 * np.eye(3))
     single = ltp.sine_experiments([2.0, 5.0], TP, dt=0.0125, nperiods=8, ninputs=1)
     plain = ltp.sine_experiments([2.0, 5.0], TP, dt=0.0125, nperiods=8)
-    assert np.array_equal(single.inputs[0], plain.inputs)
+    assert np.array_equal(single.inputs, plain.inputs)
     ms = ltp.multisine([2.0, 5.0], TP, dt=0.0125, nperiods=8, nexperiments=2, ninputs=2)
     assert ms.inputs.shape == (2, 4, ms.time.size)
     assert np.allclose(ms.inputs[0, ::2], ltp.multisine([2.0, 5.0], TP, dt=0.0125,
-                                                        nperiods=8, nexperiments=2).inputs)
+                                                        nperiods=8, nexperiments=2).inputs[0])
 
 
 def test_lti_as_periodic_equals_python_control():

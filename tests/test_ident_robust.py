@@ -142,7 +142,7 @@ def test_unusable_lines_dropped_and_skipped():
     w = np.pi / 2 * np.arange(1, 16)                   # every 4th at a multiple of ω_p/2
     with pytest.warns(UserWarning, match='multiples of omega_p/2'):
         exc = ltp.sine_experiments(w, 0.5, dt=0.0125, nperiods=8, settle=12)
-    resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
+    resp = ltp.forced_response(sys, exc.time, exc.inputs)
     with pytest.warns(UserWarning, match='skipped the lines'):
         model = ltp.identify_ltp(resp, 0.5, 1, q=10, transient=6.0, input_hold='foh')
     assert np.isclose(model.A(0.0)[0, 0], -2.0, atol=1e-3)
@@ -175,7 +175,7 @@ def test_refit_harmonic_kept_only_where_determined():
                     [[1.0]], 0, period=0.5)
     w = np.pi / 2 * np.array([k for k in range(1, 16) if k % 4])
     exc = ltp.sine_experiments(w, 0.5, dt=0.0125, nperiods=8, settle=12)
-    resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
+    resp = ltp.forced_response(sys, exc.time, exc.inputs)
     G = ltp.lifted_frequency_response(resp, 0.5, 1, transient=6.0, input_hold='foh')
     unseen = [1.1, 2.9, 7.3, 13.3, 21.7]
     wide = ltp.identify_ltp(G, 0.5, 1, 1, q=10, refit_harmonics=2)

@@ -122,8 +122,8 @@ def test_multisine_experiment_identifies(truth):
     ell = np.arange(1, 20)
     lines = ell * step + ((3 * ell) % 19) * wp           # spread over 0..230 rad/s
     exc = ltp.multisine(lines, T, dt=TS / 4, nperiods=40, settle=20)
-    y = ltp.forced_response(truth, exc.time, exc.inputs[None]).outputs
-    data = (exc.time[::4], exc.inputs[:, ::4], y[:, :, ::4])
+    y = ltp.forced_response(truth, exc.time, exc.inputs).outputs
+    data = (exc.time[::4], exc.inputs[..., ::4], y[:, :, ::4])
     G = lifted_frequency_response(data, T, 1, transient=10.0, input_hold='foh',
                                   hold_step=TS / 4)
     assert G.omega.size == 19

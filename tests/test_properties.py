@@ -439,7 +439,7 @@ def test_seeded_designs_are_reproducible(seed):
     np.testing.assert_allclose(a.signal(a.time), a.inputs, atol=1e-12)
     # experiment r is experiment 0 delayed by r T / R
     for r in range(3):
-        np.testing.assert_allclose(a.signal(a.time)[r], a.signal(a.time - r / 3)[0],
+        np.testing.assert_allclose(a.signal(a.time)[0, r], a.signal(a.time - r / 3)[0, 0],
                                    atol=1e-9)
 
 

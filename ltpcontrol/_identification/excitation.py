@@ -45,10 +45,12 @@ class Excitation(NamedTuple):
     ----------
     time : ndarray, shape (nt,)
         Sample times, starting at 0 (the phase reference of the period).
-    inputs : ndarray, shape (nt,), (nexp, nt) or (ninputs, nexp, nt)
-        Input samples; one row per experiment for multi-experiment designs,
-        and a leading input axis when several inputs are excited
-        (``ninputs`` given), as `ltpcontrol.forced_response` takes them.
+    inputs : ndarray, shape (ninputs, nexp, nt), or (nt,) for chirp replicas
+        Input samples in the one axis order of the library: channels,
+        experiments, time, as `ltpcontrol.forced_response` and the
+        identification functions take them (``ninputs`` is 1 unless given).
+        `chirp_replicas` is one record of one input: shape (nt,).  (A single
+        input used to give (nexp, nt): ``exc.inputs[0]`` is that array.)
     segments : ndarray of int, shape (nseg, 2)
         ``[start, stop)`` sample indices of the analysis windows, each an
         integer number of periods long.  Pass them to `estimate_htf`.
@@ -273,7 +275,7 @@ def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitud
             out += np.cos(w * shifted + phi + shift)
         return amplitude * out
 
-    signal = _scalar_time(single if shifts is None else _joint(single, shifts))
+    signal = _scalar_time(_one_input(single) if shifts is None else _joint(single, shifts))
     nsamp = (settle + nperiods) * nper
     time = np.arange(nsamp) * dt
     segments = np.array([[settle * nper, nsamp]])
@@ -339,6 +341,11 @@ def _input_phases(ninputs):
     return 2 * np.pi * np.outer(np.arange(m), np.arange(m)) / m
 
 
+def _one_input(signal):
+    """`signal(t)` of shape (nexp, len(t)) as one input channel: (1, nexp, len(t))."""
+    return lambda t: signal(t)[None]
+
+
 def _joint(signal, shifts):
     """Signal of m jointly excited inputs: experiment (e, i), input j gets the
     experiment e of `signal` with its phases shifted by ``shifts[i, j]``.
@@ -392,7 +399,7 @@ def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
     Returns
     -------
     Excitation
-        ``inputs`` has shape (nexp, nt), or (m, m nexp, nt) with
+        ``inputs`` has shape (1, nexp, nt), or (m, m nexp, nt) with
         `ninputs` (experiments frequency-major); ``frequencies`` holds the
         rounded frequency of every experiment (duplicates after rounding
         are removed).
@@ -402,7 +409,7 @@ def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
     >>> exc = ltp.sine_experiments([1.3, 2.2], 2 * np.pi, dt=np.pi / 50,
     ...                            nperiods=4, settle=2)
     >>> exc.frequencies.tolist(), exc.inputs.shape, exc.segments.tolist()
-    ([1.25, 2.25], (2, 600), [[200, 600]])
+    ([1.25, 2.25], (1, 2, 600), [[200, 600]])
     """
     period, dt, nperiods, settle = _check_common(period, dt, nperiods, settle)
     amplitude = float(real_array(amplitude, "amplitude", ndim=0))
@@ -427,7 +434,7 @@ def sine_experiments(frequencies, period, *, dt, nperiods, settle=0,
         return amplitude * np.cos(omega[:, None] * t[None, :] + shift)
 
     shifts = _input_phases(ninputs)
-    signal = _scalar_time(single if shifts is None else _joint(single, shifts))
+    signal = _scalar_time(_one_input(single) if shifts is None else _joint(single, shifts))
     lines = omega if shifts is None else np.repeat(omega, shifts.shape[0])
     time = np.arange((settle + nperiods) * nper) * dt
     segments = np.array([[settle * nper, time.size]])
@@ -488,7 +495,7 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=None, settle=0,
     Returns
     -------
     Excitation
-        ``inputs`` has shape (R, nt), or (m, m R, nt) with `ninputs`
+        ``inputs`` has shape (1, R, nt), or (m, m R, nt) with `ninputs`
         (experiments shift-major); ``frequencies`` holds the lines.
 
     Examples
@@ -497,8 +504,8 @@ def multisine(frequencies, period, *, dt, nperiods, nexperiments=None, settle=0,
     ...                     nperiods=4, nexperiments=3)
     >>> exc.frequencies.tolist()           # multiples of ω_p/2 = 0.5 skipped
     [0.75, 1.25]
-    >>> exc.inputs.shape
-    (3, 160)
+    >>> exc.inputs.shape                   # (inputs, experiments, samples)
+    (1, 3, 160)
     """
     period, dt, nperiods, settle = _check_common(period, dt, nperiods, settle)
     nexp = _replicas(1 if nexperiments is None and nharmonics is None else nexperiments,

@@ -460,6 +460,26 @@ def _estimate(data, period, nharmonics, segments, alpha, omega_limits, threshold
     return comps, bins * wgrid, std, labels, info
 
 
+def _default_harmonics(data, period, segments, threshold, omega_limits):
+    """The default K of `estimate_htf` (the most the windows hold with one more pair
+    to test for unmodelled harmonics) and, if not given, the output band it reaches."""
+    period = check_period(period)
+    records = _as_records(data)
+    segments = None if segments is None else np.asarray(segments)
+    nwin = len(records) * (1 if segments is None else len(segments))
+    nu = records[0][1].shape[0]
+    U, _, L, dt = _spectra(records, period, 0, segments)
+    nper = int(round(period / dt))
+    K = int(min(max((nwin // nu - 3) // 2, 0), (nper - 1) // 2))
+    if omega_limits is None:
+        power = np.max(np.abs(U[..., :U.shape[-1] // 2 + 1]) ** 2, axis=(0, 1))
+        power[0] = 0.0
+        excited = np.flatnonzero(power >= float(threshold) * power.max())
+        top = (excited.max() if excited.size else 0) * 2 * np.pi / (L * period)
+        omega_limits = (0.0, top + K * 2 * np.pi / period)
+    return K, omega_limits
+
+
 def _check_options(data, period, nharmonics, segments, alpha, threshold):
     """Validated period, K, records, segments, alpha and threshold."""
     period = check_period(period)
@@ -630,7 +650,7 @@ def _assemble(g, var, noise_var, mask, emask, cols, alpha, K, nu):
 
 
 # ------------------------------------------------------------- public API
-def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
+def estimate_htf(data, period, nharmonics=None, *, segments=None, alpha=0.0,
                  omega_limits=None, threshold=1e-2, progress=False, return_info=False,
                  name=None):
     """Estimate harmonic transfer functions from input-output data.
@@ -649,10 +669,16 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
         phase reference of the periodic system.
     period : float
         Known period T of the system.
-    nharmonics : int
+    nharmonics : int, optional
         Number K of harmonics on each side (2K+1 components).  For
-        `identify_ltp` with K_m harmonics, ``3 K_m + 1`` (every output
-        harmonic its model produces), with `omega_limits` reaching them.
+        `identify_ltp` with K_m harmonics, at least ``3 K_m + 1`` (every
+        output harmonic its model produces), with `omega_limits` reaching
+        them.  Default: as many as the windows hold with the test for
+        unmodelled harmonics, ``K = (n_w/nu - 3) // 2`` for n_w windows
+        (records times segments; ``2K_h + 4`` replicas give ``K_h``), and
+        then, without `omega_limits`, the output band ``[0, ω_u + Kω_p]`` up
+        to the highest excited input frequency ``ω_u`` shifted by K
+        harmonics (every component where its shifted input is excited).
     segments : array_like of int, shape (nseg, 2), optional
         ``[start, stop)`` sample windows applied to every record, e.g. the
         ``segments`` of `chirp_replicas`; default is the whole record.  Each
@@ -752,6 +778,9 @@ def estimate_htf(data, period, nharmonics, *, segments=None, alpha=0.0,
     >>> info.success, bool(info.identified.all())
     (True, True)
     """
+    if nharmonics is None:
+        nharmonics, omega_limits = _default_harmonics(data, period, segments, threshold,
+                                                      omega_limits)
     comps, omega, std, labels, info = _estimate(
         data, period, nharmonics, segments, alpha, omega_limits, threshold, progress)
     # NaN marks components the data leave undetermined (U(ω - kω_p) not excited);

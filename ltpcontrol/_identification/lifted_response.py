@@ -49,11 +49,13 @@ _HOLDS = (None, 'foh', 'zoh')
 _CLOSED_LOOP = (". Closed-loop records (the input computed from the output by a "
                 "controller) hold the loop's response and noise in the input: this "
                 "open-loop method cannot use them; give the reference as the input "
-                "(records (t, r, y) identify the closed loop from r to y) or excite the "
-                "plant in open loop")
+                "(records (t, r, y) identify the closed loop from r to y), excite the "
+                "plant in open loop, or, for the plant from closed-loop records, "
+                "estimate the HTF from r to [y; u] (estimate_htf on (t, r, [y; u])) and "
+                "take the plant from it with joint_io_htf (joint input-output)")
 
 
-def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
+def lifted_frequency_response(response, period, nharmonics=None, *, frequencies=None,
                               transient=0.0, input_hold=None, hold_step=None,
                               feedthrough=None, real=True, unusable='raise', batch_size=64,
                               progress=False, name=None):
@@ -90,11 +92,14 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
         `batch_size`) then do not apply.
     period : float
         Period T of the system; ``N = T/Ts`` must be an integer.
-    nharmonics : int
+    nharmonics : int, optional
         Number K of output harmonics kept (``2K+1 <= N``).  For
-        `identify_ltp` with K_m harmonics, ``3 K_m + 1``: every output
+        `identify_ltp` with K_m harmonics at least ``3 K_m + 1``: every output
         harmonic its model produces (fewer leave the model unvalidated,
-        ``success=False``).
+        ``success=False``).  Default: every harmonic the data hold, ``(N-1)/2``
+        for records (so that `identify_ltp` fits and validates whatever its
+        model produces and counts the plant's output beyond it as model
+        error), for an HTF the most harmonics it knows together on its grid.
     frequencies : array_like, optional
         Input lines in rad/s, shape ``(nexp,)`` (one line per experiment)
         or ``(nexp, nlines)``.  By default the lines are the DFT bins of
@@ -211,7 +216,7 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     >>> sys = ltp.ltpss(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)),
     ...                 lambda t: np.array([[1 + np.cos(4 * np.pi * t)]]), 0.5)
     >>> exc = ltp.sine_experiments([1.0, 3.0], 0.5, dt=0.05, nperiods=8)
-    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
+    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs)
     >>> G = ltp.lifted_frequency_response(resp, 0.5, 1, real=False)
     >>> np.round(G.frdata[:, 0, 0].real, 6)            # G_{-1}, G_0, G_1
     array([0.5, 1. , 0.5])
@@ -233,6 +238,8 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
            [1. , 2. ],
            [0.5, 0. ]])
     """
+    if nharmonics is None:
+        nharmonics = _data_harmonics(response, period)
     G, var, not_noise = _lifted_records(response, period, nharmonics, frequencies=frequencies,
                                 transient=transient, input_hold=input_hold,
                                 hold_step=hold_step, feedthrough=feedthrough, real=real,
@@ -241,6 +248,22 @@ def lifted_frequency_response(response, period, nharmonics, *, frequencies=None,
     if var is not None and not_noise is None and np.all(np.isfinite(var)):
         G.noise_std = _entry_std(var, G, real)
     return G
+
+
+def _data_harmonics(response, period):
+    """The harmonics the data hold: ``(N-1)/2`` for records of N samples per period,
+    the most an HTF knows together at some frequencies."""
+    period = check_period(period)
+    if isinstance(response, HTF):
+        for k in range(response.nharmonics, 0, -1):
+            try:
+                _htf_lifted(response, period, k, True, None)
+                return k
+            except ValueError:
+                continue
+        return 0
+    dt = as_records(response, 'response')[0].dt
+    return (steps_per_period(period, dt, 'the time step of timepts') - 1) // 2
 
 
 def _entry_std(var, G, real):

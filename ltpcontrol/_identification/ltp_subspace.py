@@ -22,18 +22,20 @@ multipliers ``e^{λ Ts}``, so inverse Tustin biases ``A`` by about
 """
 
 import warnings
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 import control as ct
 
-from .fdsubspace import fdsubspace, FDSubspaceInfo
+from .fdsubspace import fdsubspace
 from .floquet_fit import _harmonic_data, _harmonic_response
 from .._frequency.htf import HTF
 from .lifted_response import lifted_frequency_response
-from .realization import FloquetRealization, floquet_realization
-from .refine import RefineInfo, _harmonics, refine_ltp
+from .realization import floquet_realization
+from .refine import _harmonics, refine_ltp
 from .refit import _refit, _to_continuous
+from .subspace_info import LTPSubspaceInfo
+from .record_check import RecordCheck, record_check, verdict
 from .ident_data import (_assumed_hold, _check_lifted_data, _enough_lines, _from_excitation,
                          _lifted_data)
 from .holdout import (_checked_noise, _model_share, _noise_nrmse, _nrmse, _produced_harmonics,
@@ -50,99 +52,6 @@ _NOT_NOISE_SHARE = 0.3
 #: a valid model whose held-out share exceeds this many times the noise's (and a
 #: tenth of validation_tol) is reported as underfitting
 _UNDERFIT = 3.0
-
-
-@dataclass(frozen=True)
-class LTPSubspaceInfo:
-    """Diagnostics returned by `identify_ltp` with ``return_info=True``.
-
-    The first fields follow `scipy.optimize.OptimizeResult`.
-
-    Attributes
-    ----------
-    success : bool
-        The model is trustworthy: it predicts its held-out lines
-        (``holdout_error <= validation_tol``; with validation); with
-        'refit', its relative residual (less the noise's share when the
-        noise is known) is at most the realization's ``fit_tol``
-        (default 0.05) and the least-squares refit converged
-        or was validated; with 'log' or 'tustin', the Floquet realization
-        succeeded with all K harmonics; with ``refine='ml'`` also the
-        refinement converged or was validated; the model is stable.
-    message : str
-        Description of the outcome.
-    nfev : int
-        Model evaluations of the refit and the refinement (0 for 'log' and
-        'tustin' without refinement).
-    data : control.FrequencyResponseData
-        Real lifted frequency response used for identification.
-    lifted : control.StateSpace
-        Identified real lifted LTI model (discrete time, order ``(2K+1) n_p``).
-    subspace : FDSubspaceInfo
-        Diagnostics of the subspace step (singular values, q, residual).
-    realization : FloquetRealization
-        Diagnostics of `ltpcontrol.floquet_realization` on `lifted`: the
-        structure distance (eq. 4.105), the similarity and the ``success``
-        flag.
-    conversion : str
-        Continuous-time conversion used ('refit', 'log' or 'tustin').
-    relative_residual : float
-        ``‖G - Ĝ‖ / ‖G‖`` of the continuous-time model on the continuous
-        harmonic response ``G_n(jΩ)`` (all lines, inputs and harmonics
-        -K..K; those of the model for 'log' and 'tustin').
-    realized_harmonics : int
-        Harmonics of the realized lifted model: K, or fewer when the
-        K-harmonic model had no eigenvalue ladders.
-    refinement : RefineInfo or None
-        With ``refine='ml'``: the `RefineInfo` of the refinement
-        (parameters, covariance, ``realize``; e.g. for `sample_models`).
-    holdout_nrmse : float
-        Normalized RMS error of the model identified without the held-out
-        lines on those lines (time-domain steady-state output, all
-        harmonics of the data; see `identify_ltp`); NaN without validation.
-    holdout_noise : float
-        NRMSE of the noise alone on the held-out entries (see
-        `identify_ltp`); NaN when the noise is unknown.
-    holdout_error : float
-        The model's share of the held-out NRMSE, ``sqrt(holdout_nrmse² -
-        holdout_noise²)`` (``holdout_nrmse`` when the noise is unknown; NaN
-        when the noise level exceeds ``holdout_nrmse``): compared with
-        ``validation_tol``.
-    holdout_lines : ndarray
-        The held-out lines (rad/s); empty without validation.
-    data_harmonics : int
-        Harmonics ``K_d`` of the data fitted by the refit and refinement.
-    refine_fallback : bool
-        True when the ML refinement predicted the held-out lines worse than
-        its start and the start was kept.
-    input_hold : str or None
-        The input hold of the records used (time records; None for lifted
-        data or an HTF).
-
-    Examples
-    --------
-    >>> LTPSubspaceInfo.__dataclass_fields__.keys() >= {'success', 'lifted', 'realization'}
-    True
-    """
-
-    success: bool
-    message: str
-    nfev: int
-    data: ct.FrequencyResponseData
-    lifted: ct.StateSpace
-    subspace: FDSubspaceInfo
-    realization: FloquetRealization
-    conversion: str
-    relative_residual: float
-    realized_harmonics: int
-    refinement: RefineInfo = None
-    holdout_nrmse: float = np.nan
-    holdout_noise: float = np.nan
-    holdout_error: float = np.nan
-    holdout_lines: np.ndarray = None
-    data_harmonics: int = 0
-    refine_fallback: bool = False
-    input_hold: str = None
 
 
 def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='refit',
@@ -331,7 +240,9 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         free DFT bins of the records hold a transient or lines rather than
         noise; if a valid model's share exceeds 3 times the noise's (and a
         tenth of `validation_tol`: the structure underfits); with
-        ``input_hold='auto'`` when the assumed hold matters.  With
+        ``input_hold='auto'`` when the assumed hold matters; if the model
+        simulated on the held-out records misses them by more than its
+        held-out lines show (see Notes).  With
         'refit': if the returned model misses the data by more than
         the realization's ``fit_tol`` (default 0.05, relative residual less
         the noise's share) or the refit stops before converging without a
@@ -432,7 +343,21 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     over the window (a transient) or that has lines (nonlinear or event
     distortion) is not used (module ``noise_check``; broadband stationary
     distortion passes as noise: simulate the model on fresh records with
-    `validate_ltp`).  The relative residual is compared with the
+    `validate_ltp`).
+
+    From time records the held-out figure is also checked in the time
+    domain: the model identified without the held-out lines is simulated
+    from rest (`forced_response`, the records' input hold) on the records
+    whose every line is held out, and ``info.record_nrmse`` is its NRMSE in
+    their analysis windows, ``info.record_error`` its share less the noise's
+    (free DFT bins, ``info.record_noise``).  It sees the whole output:
+    harmonics beyond ``K_d``, a transient, inputs off the DFT grid.  A
+    share above ``validation_tol`` makes ``success`` False; one above twice
+    ``holdout_error`` (plus ``validation_tol``/10) is reported with a warning;
+    both only beyond three standard deviations of the noise estimate.  The
+    cost is one simulation of a quarter of the records (none for multisine
+    records, which hold out no whole experiment, nor for ``input_hold=None``,
+    whose samples of a continuous input cannot be replayed exactly).  The relative residual is compared with the
     realization's ``fit_tol`` the same way, less the noise's share over
     all lines (a residual below the noise counts as 0 there: the fitted
     lines absorb part of their noise).
@@ -456,7 +381,7 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
     ...                 [[1.0]], 0, period=0.5)
     >>> w = np.pi / 2 * np.array([k for k in range(1, 16) if k % 4])
     >>> exc = ltp.sine_experiments(w, 0.5, dt=0.0125, nperiods=8, settle=12)
-    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs[None])
+    >>> resp = ltp.forced_response(sys, exc.time, exc.inputs)
     >>> model = ltp.identify_ltp(resp, 0.5, 1, q=10, transient=6.0, input_hold='foh')
     >>> np.round(model.A(0.0), 4)
     array([[-2.]])
@@ -552,6 +477,7 @@ def _identify(data, period, nstates, nharmonics=1, *, q=None, conversion='refit'
                refine_options=refine_options, realization=realization, seed=seed,
                progress=progress, realization_options=realization_options)
     holdout_nrmse, holdout_noise, fallback, nfev = np.nan, np.nan, False, 0
+    check = RecordCheck()
     if held.any():
         # 2-6 without the held-out lines; their prediction validates the structure
         val = _identify_lines(G, ~held, ctx, htf=None)
@@ -563,6 +489,12 @@ def _identify(data, period, nstates, nharmonics=1, *, q=None, conversion='refit'
             if holdout_nrmse > before:
                 # the refinement must not predict worse than its start
                 fallback, holdout_nrmse = True, before
+        if not isinstance(data, (ct.FrequencyResponseData, HTF)) and input_hold is not None:
+            # the same model simulated on the held-out records themselves (held inputs:
+            # samples of a continuous input cannot be replayed exactly)
+            check = record_check(val['start'] if fallback else val['sys'], data, period,
+                                 G.omega[held], **{k: record_options[k] for k in (
+                                     'frequencies', 'transient', 'input_hold')})
         if conversion == 'refit' and refit_a:
             # the validated model, refitted on all lines
             ctx_all = dict(ctx, refine=None if fallback else refine)
@@ -638,6 +570,21 @@ def _identify(data, period, nstates, nharmonics=1, *, q=None, conversion='refit'
             warnings.warn(f"the identified model does not predict its held-out lines: "
                           f"{figure} > validation_tol {validation_tol:g}; try other "
                           "nstates, nharmonics or more data", UserWarning, stacklevel=2)
+    figure = holdout_nrmse if np.isnan(holdout_error) else holdout_error
+    disagrees, fails = verdict(check, figure, validation_tol)
+    if disagrees or fails:
+        # simulated on the records, the model misses them by more than the harmonics show
+        message += (f"; simulated on the {check.nrecords} held-out records: NRMSE "
+                    f"{check.nrmse:.3g}, model error {check.error:.3g}")
+        success = success and not fails
+    if disagrees or (fails and validated):
+        warnings.warn(f"the model simulated on the {check.nrecords} held-out records "
+                      f"misses them by NRMSE {check.nrmse:.3g} (noise {check.noise:.3g}, "
+                      f"model error {check.error:.3g}{' > validation_tol' if fails else ''})"
+                      f", more than its held-out lines show ({figure:.3g}): the records "
+                      "hold output the analysed harmonics do not (harmonics beyond "
+                      f"|n| <= {Kd}, a transient, inputs off the DFT grid)", UserWarning,
+                      stacklevel=2)
     if success and np.isfinite(holdout_error) and np.isfinite(holdout_noise) and \
             holdout_error > max(_UNDERFIT * holdout_noise, validation_tol / 10):
         # valid, but the data determine more than the structure explains
@@ -663,7 +610,8 @@ def _identify(data, period, nstates, nharmonics=1, *, q=None, conversion='refit'
         relative_residual=relres, realized_harmonics=Kr, refinement=ml,
         holdout_nrmse=float(holdout_nrmse), holdout_noise=float(holdout_noise),
         holdout_error=float(holdout_error), holdout_lines=G.omega[held],
-        data_harmonics=Kd, refine_fallback=fallback)
+        data_harmonics=Kd, refine_fallback=fallback, record_nrmse=check.nrmse,
+        record_noise=check.noise, record_error=check.error)
 
 
 def _fit_args(ctx):

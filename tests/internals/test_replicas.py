@@ -22,6 +22,6 @@ def test_replicas_default_and_alias_warning():
     exc = ltp.chirp_replicas(1.0, None, 2.0, 0.0, 5.0, dt=0.01, nharmonics=1)
     assert exc.segments.shape == (4, 2)
     assert ltp.multisine([4.0, 8.0], 1.0, dt=0.01, nperiods=4, nharmonics=1,
-                         plant_harmonics=1).inputs.shape[0] == 3
+                         plant_harmonics=1).inputs.shape[1] == 3
     with pytest.raises(ValueError, match='nharmonics'):
         ltp.chirp_replicas(1.0, None, 2.0, 0.0, 5.0, dt=0.01)
