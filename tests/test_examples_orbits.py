@@ -143,8 +143,7 @@ class TestMathieu:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize('script, png', [('plot_hopper_return_map.py', 'hopper_return_map.png'),
-                                         ('plot_vhop_limit_cycle.py', 'vhop_limit_cycle.png')])
+@pytest.mark.parametrize('script, png', [('plot_hopper_return_map.py', 'hopper_return_map.png')])
 def test_gallery_script(script, png, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     run_script(script, run_name='__main__')
