@@ -121,18 +121,7 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *,
     if return_states and not compute_states:
         raise ValueError("return_states=True needs compute_states=True")
     x, y = _simulate(sys, t, u, x0, method, input_hold, rtol, bool(compute_states))
-    if x is None:                               # no states: an empty signal array
-        x = np.empty((0,) + y.shape[1:])
-    multi = u.shape[1] > 1 or np.ndim(inputs) == 3
-    if not multi:
-        x, y, u = x[:, 0], y[:, 0], u[:, 0]
-    return ct.TimeResponseData(
-        t, y, x, u, issiso=sys.issiso() and not multi, output_labels=sys.output_labels,
-        input_labels=sys.input_labels, state_labels=sys.state_labels if len(x) else [],
-        title="Forced response for " + sys.name, transpose=transpose,
-        return_x=return_states, squeeze=squeeze, multi_trace=multi,
-        trace_types=['forced'] * u.shape[1] if multi else None,
-        sysname=sys.name, plot_inputs=True)
+    return forced_result(sys, t, x, y, u, inputs, transpose, return_states, squeeze)
 
 
 @_aliases
@@ -379,6 +368,35 @@ def _outputs(sys, t, x, u):
 #
 # Argument processing
 #
+
+def forced_result(sys, t, x, y, u, inputs, transpose, return_states, squeeze):
+    """The `TimeResponseData` of a forced response (x None: no states).
+
+    ``x``, ``y``, ``u`` are (signals, traces, time); one trace of a 2-D
+    `inputs` comes back as a single response.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.timeresp import forced_result
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> t = np.linspace(0, 1, 3)
+    >>> u = np.ones((1, 1, 3))
+    >>> forced_result(sys, t, None, u, u, u[:, 0], False, False, None).outputs.shape
+    (3,)
+    """
+    if x is None:                               # no states: an empty signal array
+        x = np.empty((0,) + y.shape[1:])
+    multi = u.shape[1] > 1 or np.ndim(inputs) == 3
+    if not multi:
+        x, y, u = x[:, 0], y[:, 0], u[:, 0]
+    return ct.TimeResponseData(
+        t, y, x, u, issiso=sys.issiso() and not multi, output_labels=sys.output_labels,
+        input_labels=sys.input_labels, state_labels=sys.state_labels if len(x) else [],
+        title="Forced response for " + sys.name, transpose=transpose,
+        return_x=return_states, squeeze=squeeze, multi_trace=multi,
+        trace_types=['forced'] * u.shape[1] if multi else None,
+        sysname=sys.name, plot_inputs=True)
+
 
 def forced_arguments(sys, timepts, inputs, initial_state, method, methods, input_hold,
                      rtol=None):

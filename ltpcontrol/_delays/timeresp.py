@@ -22,7 +22,7 @@ import numpy as np
 import control as ct
 
 from .._core.registry import override
-from .._core.timeresp import forced_arguments
+from .._core.timeresp import forced_arguments, forced_result
 from .._core.validation import check_kwargs, real_array
 from . import terms as tm
 from .ltpdsys import LTPDelayStateSpace
@@ -210,18 +210,8 @@ def forced_response(sys, timepts=None, inputs=0.0, initial_state=0.0, *, method=
                       f"accurate to about {err / big:.1e} (relative)", UserWarning,
                       stacklevel=3)
     y = y2
-    multi = u.shape[1] > 1 or np.ndim(inputs) == 3
-    if not compute_states:
-        x = np.empty((0,) + y.shape[1:])
-    if not multi:
-        x, y, u = x[:, 0], y[:, 0], u[:, 0]
-    return ct.TimeResponseData(
-        t, y, x, u, issiso=sys.issiso() and not multi, output_labels=sys.output_labels,
-        input_labels=sys.input_labels, state_labels=sys.state_labels if len(x) else [],
-        title="Forced response for " + sys.name, transpose=transpose,
-        return_x=return_states, squeeze=squeeze, multi_trace=multi,
-        trace_types=['forced'] * u.shape[1] if multi else None,
-        sysname=sys.name, plot_inputs=True)
+    return forced_result(sys, t, x if compute_states else None, y, u, inputs, transpose,
+                         return_states, squeeze)
 
 
 @override('initial_response', LTPDelayStateSpace)
