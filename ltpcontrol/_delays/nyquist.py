@@ -25,14 +25,12 @@ approximation):
   closed delayed loop ``feedback(L, I)`` (a warning on disagreement).
 """
 
-import warnings
-
 import numpy as np
 
 from .._core.registry import override
 from .._core.validation import check_positive, real_array
 from .._frequency.contour import EDGE_OFFSET, path_phase, strip_closure
-from .._frequency.nyquist import HarmonicNyquistResponse, contour_points, track
+from .._frequency.nyquist import contour_points, counted_response
 from .connect import Delay
 from .loop import DelayLoop, as_delayed_loop, check_steps, closed_loop_unstable, open_loop
 from .ltpdsys import LTPDelayStateSpace
@@ -82,40 +80,13 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     P, axis_w = open_loop(L)
     w = _initial_grid(omega, wp, axis_w, r)
     w, s, logabs, phase, eig, edge = _axis(loop, w, axis_w, r)
-    axis_turn = float(_wrap(np.diff(phase)).sum())
-    closing = _wrap(phase[0] - phase[-1])
-    with np.errstate(over='ignore', under='ignore'):
-        gap = float(np.abs(np.exp(logabs[0] - logabs[-1] + 1j * closing) - 1))
-        det = np.exp(logabs + 1j * phase)
     edge_turn, resolved = _close(loop, axis_w, r)
-    total = (axis_turn + edge_turn) / (2 * np.pi)
-    encirclements = int(np.round(total))
-    resolved &= abs(total - encirclements) < 0.05
     sv = np.linalg.svd(np.eye(loop.size) + loop(s[::max(1, len(s) // 2000)]),
                        compute_uv=False)
-    dist = float(sv[:, -1].min())
     Zf = closed_loop_unstable(cl) if do_check else None
-    if Zf is not None and Zf != P - encirclements:
-        warnings.warn(f"nyquist_htf: the count of the loop HTF truncated to nharmonics="
-                      f"{loop.N} (Z = {P - encirclements}) contradicts the closed delayed "
-                      f"loop's multipliers (Z = {Zf}): increase nharmonics",
-                      UserWarning, stacklevel=3)
-    elif Zf is None and edge > closure_tol:
-        warnings.warn(f"nyquist_htf: the loop HTF is not small at its truncation edge "
-                      f"(|L̂ - D̂| up to {edge:.2g} in harmonics ±{loop.N} > closure_tol="
-                      f"{closure_tol:g}) and no check was made: the count is exact for the "
-                      "truncated loop only; increase nharmonics or pass check=True",
-                      UserWarning, stacklevel=3)
-    if dist < 1e-8 or not resolved:
-        warnings.warn("nyquist_htf: the contour passes through a closed-loop exponent "
-                      f"(min singular value of I + L̂ = {dist:.1e}): the loop is at a "
-                      "stability boundary and the count is not reliable", UserWarning,
-                      stacklevel=3)
-    return HarmonicNyquistResponse(
-        encirclements=encirclements, open_loop_unstable=P, closure_gap=gap,
-        min_distance=dist, omega=w, contour=s, det=det, eigenloci=track(eig),
-        nharmonics=loop.N, omega_p=wp, sysname=L.name,
-        edge_turns=float(edge_turn / (2 * np.pi)), floquet_unstable=Zf)
+    return counted_response(L.name, loop.N, wp, w, s, logabs, phase, eig, edge, edge_turn,
+                            resolved, P, float(sv[:, -1].min()), Zf, closure_tol,
+                            "closed delayed loop's multipliers", "check", stacklevel=4)
 
 
 def _initial_grid(omega, wp, axis_w, r):

@@ -343,39 +343,62 @@ def nyquist_htf(L, nharmonics, omega=None, *, period=None, indent_radius=None,
     w = _initial_grid(omega, wp, axis_w, r, (lam_open, lam_closed))
 
     w, s, logabs, phase, eig, edge, smin = _refined_contour(loop, w, axis_w, r)
+    edge_turn, resolved = _close_strip(loop, axis_w, r)
+    Zf = None if lam_closed is None else closed_loop_unstable_count(L, lam=lam_closed)
+    return counted_response(L.name, loop.N, wp, w, s, logabs, phase, eig, edge, edge_turn,
+                            resolved, P, float(smin.min()), Zf, closure_tol,
+                            "closed loop's Floquet exponents", "Floquet check")
+
+
+
+def counted_response(name, N, wp, w, s, logabs, phase, eig, edge, edge_turn, resolved, P,
+                     dist, Zf, closure_tol, truth, check_name, stacklevel=3):
+    """Encirclements of the contour's ``det(I + L̂)``, its diagnostics and the response.
+
+    ``logabs``, ``phase`` along the imaginary-axis part ``s`` (frequencies
+    `w`), `edge_turn` the phase turned along the strip's closure; `Zf` the
+    closed loop's unstable count from `truth` (None: no check), `dist` the
+    smallest singular value of ``I + L̂`` met.  Used by the counts of loops
+    with and without delays.
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.nyquist import counted_response
+    >>> w = np.linspace(-0.5, 0.5, 5)
+    >>> r = counted_response('L', 1, 1.0, w, 1j * w, np.zeros(5), np.zeros(5),
+    ...                      np.zeros((5, 1)), 0.0, 0.0, True, 0, 1.0, None, 0.05,
+    ...                      'closed loop', 'check')
+    >>> r.encirclements, r.stable
+    (0, True)
+    """
     axis_turn = float(_wrap(np.diff(phase)).sum())
     closing = _wrap(phase[0] - phase[-1])
     with np.errstate(over='ignore', under='ignore'):
         gap = float(np.abs(np.exp(logabs[0] - logabs[-1] + 1j * closing) - 1))
         det = np.exp(logabs + 1j * phase)
-    edge_turn, resolved = _close_strip(loop, axis_w, r)
     total = (axis_turn + edge_turn) / (2 * np.pi)
     encirclements = int(np.round(total))
     resolved &= abs(total - encirclements) < 0.05
-    dist = float(smin.min())
-    Zf = None if lam_closed is None else closed_loop_unstable_count(L, lam=lam_closed)
     if Zf is not None and Zf != P - encirclements:
         warnings.warn(f"nyquist_htf: the count of the loop HTF truncated to nharmonics="
-                      f"{loop.N} (Z = {P - encirclements}) contradicts the closed loop's "
-                      f"Floquet exponents (Z = {Zf}): increase nharmonics",
-                      UserWarning, stacklevel=2)
+                      f"{N} (Z = {P - encirclements}) contradicts the {truth} (Z = {Zf}): "
+                      "increase nharmonics", UserWarning, stacklevel=stacklevel)
     elif Zf is None and edge > closure_tol:
         warnings.warn(f"nyquist_htf: the loop HTF is not small at its truncation edge "
-                      f"(|L̂ - D̂| up to {edge:.2g} in harmonics ±{loop.N} > closure_tol="
-                      f"{closure_tol:g}) and no Floquet check was made: the count is exact "
+                      f"(|L̂ - D̂| up to {edge:.2g} in harmonics ±{N} > closure_tol="
+                      f"{closure_tol:g}) and no {check_name} was made: the count is exact "
                       "for the truncated loop only; increase nharmonics or pass check=True",
-                      UserWarning, stacklevel=2)
+                      UserWarning, stacklevel=stacklevel)
     if dist < 1e-8 or not resolved:
         warnings.warn("nyquist_htf: the contour passes through a closed-loop exponent "
                       f"(min singular value of I + L̂ = {dist:.1e}): the loop is at a "
                       "stability boundary and the count is not reliable", UserWarning,
-                      stacklevel=2)
+                      stacklevel=stacklevel)
     return HarmonicNyquistResponse(
         encirclements=encirclements, open_loop_unstable=P, closure_gap=gap,
         min_distance=dist, omega=w, contour=s, det=det, eigenloci=track(eig),
-        nharmonics=loop.N, omega_p=wp, sysname=L.name,
+        nharmonics=N, omega_p=wp, sysname=name,
         edge_turns=float(edge_turn / (2 * np.pi)), floquet_unstable=Zf)
-
 
 def closed_loop_exponents(L, nsteps=None):
     """Characteristic exponents of ``feedback(L, I)`` (one Floquet computation).
