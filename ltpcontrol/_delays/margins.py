@@ -19,8 +19,8 @@ from scipy.optimize import brentq, minimize_scalar
 from .._core.floquet import floquet_multipliers, is_stable
 from .._core.registry import override
 from .._core.validation import check_positive_int
-from .._frequency.loop import fold
-from .._frequency.margins import HarmonicMargins, MarginPoint
+from .._frequency.margins import (HarmonicMargins, MarginPoint, _disk_gain_phase as _disk,
+                                  _point, _refine, _sign_changes as _changes, _unique)
 from .._frequency.nyquist import track
 from .._core.ltpsys import LTPStateSpace
 from .connect import Delay, feedback, series
@@ -277,59 +277,6 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
         delay_margin=float(dm))
 
 
-def _changes(x):
-    """Intervals [i, i+1] over which x changes sign (a zero at a grid point once)."""
-    sg = np.sign(x)
-    strict = np.nonzero(sg[:-1] * sg[1:] < 0)[0]
-    zero = np.nonzero(sg[1:-1] == 0)[0] + 1
-    through = zero[sg[zero - 1] * sg[zero + 1] < 0] - 1
-    return np.union1d(strict, through)
-
-
-def _refine(loop, w0, w1, ref0, ref1, fun):
-    """Root of fun(λ(ω)) on [w0, w1] along the eigenvalue branch from ref0 to ref1."""
-    def nearest(w):
-        t = (w - w0) / (w1 - w0)
-        lam, V = np.linalg.eig(loop(1j * w)[0])
-        i = np.argmin(np.abs(lam - (ref0 + t * (ref1 - ref0))))
-        return lam[i], V[:, i]
-
-    g0, g1 = fun(nearest(w0)[0]), fun(nearest(w1)[0])
-    if not (np.isfinite(g0) and np.isfinite(g1)) or g0 * g1 > 0:
-        return None
-    wr = brentq(lambda w: fun(nearest(w)[0]), w0, w1, xtol=1e-15 * loop.omega_p,
-                rtol=1e-15)
-    lam, v = nearest(wr)
-    return wr, lam, v
-
-
-def _point(loop, value, hit, odd=False):
-    """The margin at a crossing, folded into the strip; `odd` for a phase."""
-    w, _, v = hit
-    n = loop.dominant_harmonic(v)
-    wp = loop.omega_p
-    k = int(np.round((w - fold(w, wp)) / wp))
-    if abs(w - k * wp + wp / 2) <= 1e-9 * wp:
-        k -= 1
-    w, n = w - k * wp, n + k
-    f = w + n * wp
-    if f < 0:                       # the mirrored crossing (-ω, -n) of a real loop
-        w, n, f = -w, -n, -f
-        value = -value if odd else value
-    if abs(w + wp / 2) <= 1e-9 * wp:
-        w, n = w + wp, n - 1
-    return MarginPoint(float(value), float(w), int(n), float(f))
-
-
-def _unique(points, wp):
-    out = []
-    for p in sorted(points, key=lambda p: p.frequency):
-        if not any(abs(p.frequency - q.frequency) <= 1e-5 * wp
-                   and abs(p.value - q.value) <= 1e-5 * max(1.0, abs(q.value)) for q in out):
-            out.append(p)
-    return out
-
-
 def _extremum(loop, w, Lh, fun, kind):
     sign = 1.0 if kind == 'min' else -1.0
     vals = np.array([fun(M) for M in Lh])
@@ -340,19 +287,6 @@ def _extremum(loop, w, Lh, fun, kind):
     wbest, vbest = (res.x, sign * res.fun) if res.fun < sign * vals[i] else (w[i], vals[i])
     _, _, Vh = np.linalg.svd(np.eye(loop.size) + loop(1j * wbest)[0])
     return _point(loop, float(vbest), (wbest, None, Vh[-1].conj()))
-
-
-def _disk(alpha, skew):
-    """Gain interval and phase (deg) of the disk of radius α (control.disk_margins)."""
-    with np.errstate(divide='ignore', invalid='ignore'):
-        gmin = (1 - 0.5 * alpha * (1 - skew)) / (1 + 0.5 * alpha * (1 + skew))
-        gmax = (1 + 0.5 * alpha * (1 - skew)) / (1 - 0.5 * alpha * (1 + skew))
-        if gmax < 0 or not np.isfinite(gmax):
-            gmax = float('inf')
-        c = (1 + gmin * gmax) / (gmin + gmax) if np.isfinite(gmax) else None
-    phase = 90.0 if c is None else (float(np.degrees(np.arccos(c))) if abs(c) < 1
-                                    else float('inf'))
-    return (float(gmin), float(gmax)), phase
 
 
 def _verify(L, upper, lower, delta=1e-3):
