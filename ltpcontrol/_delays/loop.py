@@ -27,7 +27,7 @@ from control.exception import ControlArgument, ControlDimension
 from .._core.periodic_matrix import PeriodicMatrix
 from .._core.validation import check_positive_int
 from .._core.wellposed import check_well_posed
-from .._frequency.loop import fold, open_loop_exponents
+from .._frequency.loop import HarmonicLoop, fold, open_loop_exponents
 from .connect import Delay, feedback, series, _convert
 from .htf import DelayHTF
 from .ltpdsys import LTPDelayStateSpace
@@ -84,7 +84,7 @@ def as_delayed_loop(L, name='L', period=None, where=None):
     return L, cl
 
 
-class DelayLoop:
+class DelayLoop(HarmonicLoop):
     """``L̂_N(s)`` of a delayed loop at many points, shape ``(points, M, M)``, M = (2N+1)m.
 
     Examples
@@ -116,20 +116,6 @@ class DelayLoop:
         s = np.atleast_1d(np.asarray(s, complex))
         D = self.H._operator('D', s)
         return D[:, self._keep][:, :, self._keep]
-
-    def logdet(self, s):
-        """``(log|f|, arg f)`` of ``f = det(I + L̂_N(s))`` at the points `s`."""
-        sign, logabs = np.linalg.slogdet(np.eye(self.size) + self(s))
-        return logabs, np.angle(sign)
-
-    @property
-    def size(self):
-        return (2 * self.N + 1) * self.m
-
-    def dominant_harmonic(self, v):
-        """Harmonic n whose block carries most of the vector v."""
-        blocks = np.abs(v.reshape(2 * self.N + 1, self.m)) ** 2
-        return int(np.argmax(blocks.sum(axis=1))) - self.N
 
     def sigma_bound(self):
         """An abscissa σ beyond which f has neither zeros nor poles (module notes).

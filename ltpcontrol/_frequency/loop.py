@@ -77,7 +77,36 @@ def as_loop(L, name='L', period=None, where=None):
     return L
 
 
-class LoopHTF:
+class HarmonicLoop:
+    """What the Nyquist and margin computations ask of a loop HTF ``L̂_N``: a
+    subclass sets ``N`` and ``m`` (channels) and evaluates ``self(s)`` as
+    ``(points, M, M)``, ``M = (2N+1) m``, harmonic-major.
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.loop import LoopHTF
+    >>> P = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> loop = LoopHTF(P, 2)
+    >>> loop.size, loop.dominant_harmonic(np.array([0, 0, 0, 1.0, 0]))
+    (5, 1)
+    """
+
+    def logdet(self, s):
+        """``(log|f|, arg f)`` of ``f = det(I + L̂_N(s))`` at the points `s`."""
+        sign, logabs = np.linalg.slogdet(np.eye(self.size) + self(s))
+        return logabs, np.angle(sign)
+
+    @property
+    def size(self):
+        return (2 * self.N + 1) * self.m
+
+    def dominant_harmonic(self, v):
+        """Harmonic n whose block carries most of the vector v."""
+        blocks = np.abs(v.reshape(2 * self.N + 1, self.m)) ** 2
+        return int(np.argmax(blocks.sum(axis=1))) - self.N
+
+
+class LoopHTF(HarmonicLoop):
     """``L̂_N(s)`` evaluated at many points, shape ``(points, M, M)``.
 
     ``M = (2N+1) m`` with m loop channels, harmonic-major (Conventions).
@@ -101,20 +130,6 @@ class LoopHTF:
     def __call__(self, s):
         s = np.atleast_1d(np.asarray(s, complex))
         return self.hss.evaluate(s)
-
-    def logdet(self, s):
-        """``(log|f|, arg f)`` of ``f = det(I + L̂_N(s))`` at the points `s`."""
-        sign, logabs = np.linalg.slogdet(np.eye(self.size) + self(s))
-        return logabs, np.angle(sign)
-
-    @property
-    def size(self):
-        return (2 * self.N + 1) * self.m
-
-    def dominant_harmonic(self, v):
-        """Harmonic n whose block carries most of the vector v."""
-        blocks = np.abs(v.reshape(2 * self.N + 1, self.m)) ** 2
-        return int(np.argmax(blocks.sum(axis=1))) - self.N
 
 
 def loop_exponents(L, nsteps=None):
