@@ -90,21 +90,42 @@ def stiff_log_multipliers(A, norm):
     >>> float(logmod[-1] / (2 * np.pi))
     -10000.0
     """
-    T, n = A.period, A.shape[0]
-    scale = _balancing(A, n, n)
+    n = A.shape[0]
+    M, scale = graded_steps(A, norm)
     ratio = None if scale is None else scale[None, :] / scale[:, None]
-    M = int(max(64, np.ceil(T * norm / SPREAD)))
-    while True:
-        grid = _grid(A, M)
-        if M >= _MAX_STEPS or _probe_error(A, grid, ratio) <= _RTOL:
-            break
-        M *= 2
+    grid = _grid(A, M)
     check_allocation((len(grid) - 1, n, n), f"the {len(grid) - 1} graded Floquet factors "
                      f"of {n} states", copies=2)
     H = graded_cycle(A, grid, ratio)
     with small_blas(n):
         logmod, arg, _ = _product_qr(H, min_sweeps=2)
     return logmod, arg
+
+
+def graded_steps(A, norm):
+    """Number of graded steps meeting the accuracy of the exponents, and the balancing.
+
+    ``M >= max(64, T norm / 512)``, doubled until the probe steps'
+    estimated error is below 1e-8 of the largest ``|Re λ|``.  Returns
+    ``(M, scale)``: the balanced matrix is ``A_ij s_j / s_i`` (scale None:
+    no balancing).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.graded import graded_steps
+    >>> A = ltp.PeriodicMatrix.from_function(lambda t: np.array(
+    ...     [[-1.0 + 0.1 * np.cos(t), 0.0], [1.0, -1e4]]), 2 * np.pi)
+    >>> M, scale = graded_steps(A, 1e4)
+    >>> M >= 2 * np.pi * 1e4 / 512
+    True
+    """
+    T, n = A.period, A.shape[0]
+    scale = _balancing(A, n, n)
+    ratio = None if scale is None else scale[None, :] / scale[:, None]
+    M = int(max(64, np.ceil(T * norm / SPREAD)))
+    while M < _MAX_STEPS and _probe_error(A, _grid(A, M), ratio) > _RTOL:
+        M *= 2
+    return M, scale
 
 
 def _grid(A, M):
@@ -184,8 +205,13 @@ def ordered_schur(X, band=_BAND):
     return S, U
 
 
-def graded_cycle(A, grid, ratio=None):
+def graded_cycle(A, grid, ratio=None, keep=None):
     """The cyclic graded factors of the Magnus steps of `grid` (module notes), (M, n, n).
+
+    With `keep` (step indices), also the Schur bases ``U_{k-1}`` of those
+    grid points (``U_{-1} = U_{M-1}``), as a dict: the state at ``t_k`` is
+    ``U_{k-1} z_k`` in the coordinates in which ``z_{k+1} = H_k z_k``
+    (balanced coordinates when `ratio` is given).
 
     Examples
     --------
@@ -204,7 +230,7 @@ def graded_cycle(A, grid, ratio=None):
         for c0 in range(0, M, chunk):
             c1 = min(M, c0 + chunk)
             yield _omegas(A, grid[c0:c1], grid[c0 + 1:c1 + 1], ratio)
-    return _cycle(omegas(), M, A.shape[0])
+    return _cycle(omegas(), M, A.shape[0], keep)
 
 
 def graded_cycle_of(omegas):
@@ -222,9 +248,11 @@ def graded_cycle_of(omegas):
     return _cycle([omegas], len(omegas), omegas.shape[1])
 
 
-def _cycle(chunks, M, n):
-    """``H_k = E_k (U_kᵀ U_{k-1})`` from chunks of Magnus exponents."""
+def _cycle(chunks, M, n, keep=None):
+    """``H_k = E_k (U_kᵀ U_{k-1})`` from chunks of Magnus exponents (and kept bases)."""
     H = np.empty((M, n, n))
+    wanted = set() if keep is None else {(int(k) - 1) % M for k in keep}
+    bases = {}
     U_prev = U_first = None
     c0 = 0
     for Om in chunks:
@@ -233,6 +261,8 @@ def _cycle(chunks, M, n):
         U = np.empty_like(Om)
         for j in range(len(Om)):
             Om[j], U[j] = ordered_schur(Om[j])
+            if c0 + j in wanted:
+                bases[(c0 + j + 1) % M] = U[j].copy()
         E = expm_batch(Om)
         del Om
         if U_first is None:
@@ -245,4 +275,4 @@ def _cycle(chunks, M, n):
         U_prev = U[-1].copy()
         c0 = c1
     H[0] = H[0] @ (U_first.T @ U_prev)
-    return H
+    return H if keep is None else (H, bases)
