@@ -31,7 +31,7 @@ from .ltpsys import ltpss
 from .periodic_matrix import PeriodicMatrix
 from .periodic_schur import product_eigenvalues
 from .pm_ops import register_func
-from .steps import floquet_grid, floquet_norm
+from .steps import floquet_grid, floquet_norm, step_grid
 from .graded import STIFF, stiff_log_multipliers
 from .fastform import constant_value, fast_form
 from .memory import check_allocation
@@ -47,6 +47,8 @@ __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
 _COND_MAX = 1e10
 # degree of the Chebyshev interpolant of P(t) on each grid interval
 _CHEB_DEG = 24
+# entries of the step factors accumulated at once by `monodromy`
+_CHUNK_ENTRIES = 2 ** 17
 
 
 @method_alias
@@ -67,8 +69,10 @@ def monodromy(sys, nsteps=None):
         are badly scaled) clipped to [16, 4096] and to a memory budget of
         512 MB for the factors, so that every factor is well conditioned.
         Each factor is integrated with the sub-steps its error estimate
-        asks for (fourth-order Magnus, relative accuracy 1e-12), so the
-        memory is O(nsteps n²) whatever the stiffness.  A matrix that is
+        asks for (fourth-order Magnus, relative accuracy 1e-12).  The
+        factors are accumulated in chunks of steps, so the memory is
+        O(n²) whatever `nsteps` and the stiffness, and the time linear in
+        the steps.  A matrix that is
         constant to 1e-10 of its size (e.g. an isotropic rotor in
         multi-blade coordinates read from linearization files) is taken as
         its mean.
@@ -77,11 +81,14 @@ def monodromy(sys, nsteps=None):
     -------
     ndarray, shape (n, n)
 
-    Notes
+    Warns
     -----
-    For stiff systems the product loses the small multipliers to rounding;
-    use `floquet_multipliers` and `floquet_exponents`, which do not form
-    the product.
+    UserWarning
+        For a stiff system (``T max‖A(t)‖ > 4096``, `nsteps` not given):
+        the formed product loses the multipliers far below the largest
+        (``e^{-6e4}`` underflows; below about 1e-16 of the largest they
+        are rounding noise).  `floquet_multipliers`, `floquet_exponents`
+        and `floquet_modes` keep them without forming the product.
 
     Examples
     --------
@@ -91,10 +98,44 @@ def monodromy(sys, nsteps=None):
     """
     if (own := overridden('monodromy', sys)) is not None:      # systems with delays
         return own(sys, nsteps)
-    _, factors = _factors(sys, nsteps)
-    out = np.eye(factors.shape[1])
-    for phi in factors:
-        out = phi @ out
+    sys = as_ltp(sys)
+    if sys.dt or sys.nstates == 0:
+        _, factors = _factors(sys, nsteps)
+        out = np.eye(factors.shape[1])
+        for phi in factors:
+            out = phi @ out
+        return out
+    A, n = fast_form(sys.A), sys.nstates
+    if nsteps is not None:
+        grid = step_grid(A, nsteps=check_positive_int(nsteps, 'nsteps'))
+    else:
+        norm = floquet_norm(A)
+        stiff = sys.period * norm > STIFF
+        with warnings.catch_warnings():
+            if stiff:       # announced below, once
+                warnings.simplefilter('ignore', UserWarning)
+            grid = floquet_grid(A)
+        if stiff:
+            warnings.warn(f"sys is stiff (T max‖A(t)‖ = {sys.period * norm:.3g}): its formed "
+                          "monodromy cannot hold the multipliers far below the largest "
+                          "(they underflow or drown in rounding); floquet_exponents, "
+                          "floquet_multipliers and floquet_modes keep them without forming "
+                          "it", UserWarning, stacklevel=2)
+    # accumulate in chunks of steps: memory O(chunk n²) whatever the step count
+    mean = constant_value(A)
+    h = np.diff(grid)
+    chunk = max(512, _CHUNK_ENTRIES // max(n * n, 1))
+    check_allocation((min(chunk, len(h)), n, n), f"a chunk of step factors of {n} states",
+                     copies=3)
+    out = np.eye(n)
+    for c0 in range(0, len(h), chunk):
+        c1 = min(len(h), c0 + chunk)
+        if mean is not None:
+            factors = expm_batch(h[c0:c1, None, None] * mean)
+        else:
+            factors = uniform_transitions(A, grid[c0:c1], h[c0:c1])
+        for phi in factors:
+            out = phi @ out
     return out
 
 
@@ -318,6 +359,17 @@ def floquet_transform(sys, real=True, nsteps=None):
     time only when N is even) and the returned system has period 2T, which
     is announced by a warning.
 
+    Size and stiffness.  P(t) is stored as Chebyshev values of degree 24
+    on every step of the Floquet grid: ``25 M n²`` numbers for M steps
+    (the memory needed is checked first and a MemoryError names it; give
+    a smaller `nsteps` for large models).  The time is linear in M.  For
+    a stiff system the grid is the capped one of `monodromy` (a warning
+    says when its factors cannot hold the stiffest multipliers);
+    `floquet_exponents` and `floquet_modes` are the tools for the
+    exponents and mode shapes of large stiff models, which a constant-F
+    model does not make easier to use: ``B_F = P^{-1}(t) B(t)`` is then
+    dominated by the stiff modes.
+
     P(t) is computed from the periodic Floquet vectors (see the module
     notes), so the transform is accurate for stiff systems; if the
     monodromy is defective or has repeated multipliers it falls back to
@@ -387,6 +439,13 @@ def floquet_transform(sys, real=True, nsteps=None):
     nstates = factors.shape[1]
     if nstates == 0:
         raise ValueError("sys has no states; there is nothing to transform")
+    if not sys.dt:
+        # P(t) is a table of Chebyshev values on every step, with the short-step
+        # transitions that produce them and the sparse cyclic factorisation
+        check_allocation((len(grid) - 1, _CHEB_DEG + 1, nstates, nstates),
+                         f"the Floquet transformation P(t) of {nstates} states on "
+                         f"{len(grid) - 1} steps (Chebyshev values of degree {_CHEB_DEG}; "
+                         "fewer steps with nsteps=)", copies=3)
     if sys.dt:
         # x[k] = P[k] z[k] needs an invertible period map: every A[k] regular
         sv = np.linalg.svd(factors, compute_uv=False)

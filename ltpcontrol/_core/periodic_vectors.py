@@ -40,7 +40,7 @@ from .threads import small_blas
 
 __all__ = []
 
-#: row-relative couplings of W below this are neglected (block triangular)
+#: row-relative couplings of W below this are always neglected (block triangular)
 _SPLIT_TOL = 1e-14
 #: largest spread of log-moduli inside a block whose product is formed
 _BLOCK_SPREAD = 8.0
@@ -87,7 +87,7 @@ def schur_sweeps(F, keep=(), max_sweeps=None):
                 d = np.sum(np.log(np.abs(np.diagonal(R, axis1=1, axis2=2))), axis=0) \
                     + np.log(np.abs(np.diag(W)))
             last = W @ R[-1]
-            blocks = _partition(last)
+            blocks = _partition(last, d)
             spread = max(float(np.ptp(d[a:b])) if np.all(np.isfinite(d[a:b])) else np.inf
                          for a, b in blocks)
             if spread <= _BLOCK_SPREAD or sweep + 1 == max_sweeps:
@@ -97,17 +97,29 @@ def schur_sweeps(F, keep=(), max_sweeps=None):
     return R, saved, blocks
 
 
-def _partition(last):
-    """Blocks of the last factor, split where the couplings below are negligible per row."""
+def _partition(last, d):
+    """Blocks of the last factor, split where the couplings below are negligible per row.
+
+    A coupling c of W (relative to its row of the last factor, whose rows
+    are graded) perturbs one factor by c; a merged block forms its product
+    and loses about ``1e-16 e^{gap}`` on its smaller multipliers (gap: the
+    difference of log-moduli ``d`` across the split).  Split when ``c <=
+    max(1e-14, min(1e-8, 1e-15 e^{gap}))``.
+    """
     n = len(last)
     rowscale = np.abs(last).max(axis=1)
     rel = np.abs(np.tril(last, -1)) / np.where(rowscale > 0, rowscale, 1.0)[:, None]
-    # below[i, j] = max_{r >= i} rel[r, j]
+    # below[i, j] = max_{r >= i} rel[r, j];  top[i] = max d[i:]
     below = np.maximum.accumulate(rel[::-1], axis=0)[::-1]
+    top = np.maximum.accumulate(d[::-1])[::-1]
     blocks, start = [], 0
     for split in range(1, n + 1):
-        if split < n and float(below[split, start:split].max()) > _SPLIT_TOL:
-            continue
+        if split < n:
+            gap = float(d[start:split].min()) - float(top[split])
+            gap = 0.0 if gap != gap else gap
+            limit = max(_SPLIT_TOL, min(1e-8, 1e-15 * np.exp(min(gap, 700.0))))
+            if float(below[split, start:split].max()) > limit:
+                continue
         blocks.append((start, split))
         start = split
     return blocks
