@@ -15,7 +15,10 @@ linearization, tabulated at 36 azimuths (Fourier interpolation, as
 
 Rows (n = 38, 120, 300):
 
-* ours: ``ltp.floquet_exponents`` and ``ltp.floquet_modes`` (default call).
+* ours: ``ltp.floquet_exponents`` and ``ltp.floquet_modes`` (default call,
+  own rows ``P14-modes-n``: exponents as below, the structural mode vectors
+  against the independent structural monodromy, ``‖Φ_s v - μ v‖/‖v‖``, and
+  the stiff modes' shapes against the unit lag vectors, see `modes_errors`).
 * peer: the 20-line hand-written product a user writes: N midpoint
   ``scipy.linalg.expm`` steps ``Φ = Π e^{A((k+½)h) h}`` then ``eig``,
   with N = 720 (the smallest N of the form 36 * 2^j whose structural
@@ -66,10 +69,10 @@ T = 1.0
 OMEGA = 2 * np.pi / T
 NAZ = 36
 TOL = 1e-8
-FULL = dict(sizes=(38, 120, 300), bar=True, modes=False, stiff=1e4, htf=(20, 10, 1000),
+FULL = dict(sizes=(38, 120, 300), bar=True, modes=True, stiff=1e4, htf=(20, 10, 1000),
             campbell=True, fine=(12000, 400))
 # CI smoke: a 12-state model with lags at -100 Ω
-QUICK = dict(sizes=(12,), bar=False, modes=False, stiff=1e2, htf=(4, 5, 200),
+QUICK = dict(sizes=(12,), bar=False, modes=True, stiff=1e2, htf=(4, 5, 200),
              campbell=False, fine=(2000, 400))
 
 
@@ -119,14 +122,15 @@ def peer_exponents(sys, N):
         return np.log(np.abs(mu)) / T + 1j * np.angle(mu) / T
 
 
-def reference_exponents(n, N, seed=0, stiff=1e4):
+def reference_exponents(n, N, seed=0, stiff=1e4, with_monodromy=False):
     """Independent exponents: the lag rates and a converged structural product.
 
     The structural block alone (no stiffness) is integrated by midpoint
     products at N and 2N steps, Richardson-extrapolated (order 2) on 36
     groups of steps, and the group factors go through the periodic Schur
     form (no product is formed).  The stiff exponents are the lag rates
-    exactly (the lags do not feed back).
+    exactly (the lags do not feed back).  With `with_monodromy`, also the
+    structural block's monodromy (product of the group factors, not stiff).
     """
     from ltpcontrol._core.periodic_schur import product_eigenvalues
     sys = rotor_model(n, seed, stiff)
@@ -148,7 +152,10 @@ def reference_exponents(n, N, seed=0, stiff=1e4):
             out.append(P)
         factors.append((4 * out[1] - out[0]) / 3)
     logmod, arg = product_eigenvalues(np.array(factors))
-    return np.concatenate([logmod / T + 1j * arg / T, lags.astype(complex)]), k
+    ref = np.concatenate([logmod / T + 1j * arg / T, lags.astype(complex)])
+    if not with_monodromy:
+        return ref, k
+    return ref, k, np.linalg.multi_dot(factors[::-1])
 
 
 def real_error(lam, ref, keep=None, scale=None):
@@ -159,6 +166,37 @@ def real_error(lam, ref, keep=None, scale=None):
     with np.errstate(invalid='ignore'):
         err = np.max(np.abs(a - b)) / scale
     return float(err) if np.isfinite(err) else np.inf
+
+
+def modes_errors(modes, ref, k, Phi_s, scale):
+    """Accuracy of `floquet_modes` against independent truths.
+
+    * exponents: as `real_error` (every exponent, relative to the largest
+      ``|Re λ|``);
+    * structural mode vectors: the lags do not feed back, so the structural
+      part ``v_s`` of a structural mode's vector is an eigenvector of the
+      structural block's monodromy (independent Richardson product):
+      ``max ‖Φ_s v_s - μ v_s‖ / ‖v_s‖``;
+    * stiff mode shapes: a lag that does not feed back has the unit lag
+      vector as its periodic shape at every sample instant: the largest
+      deviation of the normalised shapes.
+    """
+    lam = modes.strip_exponents
+    err_exp = real_error(lam, ref, scale=scale)
+    order = np.argsort(lam.real)
+    nlag = len(lam) - k
+    stiff, slow = order[:nlag], order[nlag:]
+    v = modes.vectors[:k, slow]
+    mu = np.exp(lam[slow] * T)
+    resid = np.linalg.norm(Phi_s @ v - v * mu, axis=0) / np.linalg.norm(v, axis=0)
+    shape_err = 0.0
+    for i in stiff:
+        s = modes.shapes[:, i, :]
+        j = int(np.argmax(np.abs(s[:, 0])))
+        unit = np.zeros(len(lam))
+        unit[j] = 1.0
+        shape_err = max(shape_err, float(np.abs(s / s[j] - unit[:, None]).max()))
+    return err_exp, float(resid.max()), shape_err
 
 
 def measure(fn, *args):
@@ -377,17 +415,14 @@ def run(quick=False, log=print):
         t_peer, lam_peer, peak_peer = measure(peer_exponents, sys, N)
         # the reference: Richardson of 2N and 4N steps (N and 2N above 150 states,
         # still fourth order against the peer's second)
-        t_ref, (ref, k) = timed(reference_exponents, n, 2 * N if n <= 150 else N, 0,
-                                cfg['stiff'])
+        t_ref, (ref, k, Phi_s) = timed(reference_exponents, n, 2 * N if n <= 150 else N, 0,
+                                       cfg['stiff'], True)
         scale = np.max(np.abs(ref.real))
         err_ours = real_error(lam, ref, scale=scale)
         err_peer = real_error(lam_peer, ref, scale=scale)
         struct_scale = np.max(np.abs(np.sort(ref.real)[::-1][:k]))
         err_struct = real_error(lam, ref, k, scale=struct_scale)
         err_struct_peer = real_error(lam_peer, ref, k, scale=struct_scale)
-        t_modes = peak_modes = None
-        if modes:
-            t_modes, _, peak_modes = measure(ltp.floquet_modes, sys)
         rows.append(row(
             f'P14-{n}', f'floquet_exponents, {n}-state rotor, 36 azimuths, lags at -{cfg["stiff"]:.0e} Omega',
             ours='floquet_exponents', peer=f'{N} midpoint expm product + eig',
@@ -398,14 +433,32 @@ def run(quick=False, log=print):
             matched=err_ours <= TOL and err_peer <= TOL,
             notes=f'peak {peak / 1e6:.0f} MB (peer {peak_peer / 1e6:.0f} MB); structural '
                   f'exponents rel. their largest |Re|: ours {err_struct:.1e}, peer '
-                  f'{err_struct_peer:.1e}; floquet_modes '
-                  + ('-' if t_modes is None else f'{t_modes:.1f} s, {peak_modes / 1e6:.0f} MB'),
+                  f'{err_struct_peer:.1e}',
             extra=dict(peak_ours=peak, peak_peer=peak_peer, err_struct=err_struct,
-                       err_struct_peer=err_struct_peer, t_modes=t_modes,
-                       peak_modes=peak_modes, t_reference=t_ref)))
+                       err_struct_peer=err_struct_peer, t_reference=t_ref)))
         log(f"  ours {t_ours:.1f} s {peak / 1e6:.0f} MB err {err_ours:.1e} (structural "
             f"{err_struct:.1e}); peer {t_peer:.1f} s err {err_peer:.1e} (structural "
-            f"{err_struct_peer:.1e}); modes {t_modes} s {peak_modes}")
+            f"{err_struct_peer:.1e})")
+        if modes:
+            t_modes, fm, peak_modes = measure(ltp.floquet_modes, sys)
+            err_m, resid, shape_err = modes_errors(fm, ref, k, Phi_s, scale)
+            ratio = t_modes / t_peer
+            rows.append(row(
+                f'P14-modes-{n}', f'floquet_modes (default call), {n}-state rotor, 36 '
+                f'azimuths, lags at -{cfg["stiff"]:.0e} Omega',
+                ours='floquet_modes', peer=f'{N} midpoint expm product + eig',
+                t_ours=t_modes, t_peer=t_peer, metric='time/peer', value=ratio,
+                target='<= 2x peer time, <= 1 GB',
+                target_met=ratio <= 2 and peak_modes <= 1e9, err_ours=err_m, tol=TOL,
+                checks={'exponents <= tol (all, rel. largest |Re|)': err_m <= TOL,
+                        'structural vectors: |Phi_s v - mu v|/|v| <= 1e-5': resid <= 1e-5,
+                        'stiff shapes = unit lag vectors (1e-6)': shape_err <= 1e-6},
+                notes=f'peak {peak_modes / 1e6:.0f} MB; structural vector residual '
+                      f'{resid:.1e} (independent Richardson monodromy of the structural '
+                      f'block); stiff shapes {shape_err:.1e}; {len(fm.times)} samples',
+                extra=dict(peak_ours=peak_modes, resid=resid, shape_err=shape_err)))
+            log(f"  modes {t_modes:.1f} s ({ratio:.2f}x peer) {peak_modes / 1e6:.0f} MB, "
+                f"exponents {err_m:.1e}, vectors {resid:.1e}, stiff shapes {shape_err:.1e}")
     if cfg['htf']:
         rows.append(htf_row(*cfg['htf'], log=log))
     if cfg['fine']:
@@ -421,7 +474,7 @@ if __name__ == '__main__':
     import sys as _sys
     args = _sys.argv[1:]
     FULL['bar'] = 'bar' in args
-    FULL['modes'] = 'modes' in args
+    FULL['modes'] = 'nomodes' not in args
     FULL['sizes'] = tuple(int(a) for a in args if a.isdigit())
     if 'nohtf' in args:
         FULL['htf'] = None

@@ -497,12 +497,14 @@ def _continuous_modes(sys, nharmonics, nsteps):
     K = _harmonic_count_of(sys, nharmonics, np.linalg.eigvals(probe).ravel(),
                            stiff=stiff)
     S = 2 * K + 1
-    samples = np.arange(S) * T / S
     if stiff:
         M, scale = graded_steps(A, norm)
-        # a multiple of S steps: the sample instants are grid points
-        base = step_grid(A, nsteps=S * -(-M // S))
-    else:
+        # the sample instants on the grid: M a multiple of S
+        M, S = _aligned(M, S, nharmonics is None)
+        K = (S - 1) // 2
+        base = step_grid(A, nsteps=M)
+    samples = np.arange(S) * T / S
+    if not stiff:
         base = floquet_grid(A, nsteps=nsteps)
     # drop base points too close to a sample instant, then merge
     near = np.min(np.abs(base[:, None] - samples[None, :]), axis=1) < 1e-9 * T
@@ -538,6 +540,29 @@ def _continuous_modes(sys, nharmonics, nsteps):
     elif not np.all(bad):
         left[:, ~bad] = np.linalg.pinv(V[:, ~bad]).conj().T
     return strip, logmod, arg, samples, X, left, K
+
+
+def _aligned(M, S, free):
+    """Steps ``M' >= M`` and odd samples ``S' >= S`` (``S' = S`` unless `free`) with S' | M'.
+
+    Each extra graded step costs a Schur form and an exponential: the
+    least ``M'`` within 5 % of M that has an odd divisor in ``[S, 1.5 S]``
+    (more harmonics than asked), else the next multiple of S.
+
+    Examples
+    --------
+    >>> from ltpcontrol._analysis.floquet_modes import _aligned
+    >>> _aligned(184, 53, True)
+    (189, 63)
+    >>> _aligned(184, 53, False)
+    (212, 53)
+    """
+    if free:
+        for m in range(M, int(M * 1.05) + 1):
+            for s in range(S, int(1.5 * S) + 1, 2):
+                if m % s == 0:
+                    return m, s
+    return S * -(-M // S), S
 
 
 def _defective(V, logmod, arg):

@@ -178,7 +178,8 @@ def cyclic_eigenvectors(F, keep, bases=None):
     logmod, arg : ndarray, shape (n,)
         ``log|μ|`` and ``arg μ`` of every eigenvalue, in block order.
     vectors : ndarray of complex, shape (n, len(keep), n)
-        ``vectors[i, s]`` is ``x_{keep[s]}`` of eigenvalue i scaled so that
+        NaN for an eigenvalue repeated across blocks of the Schur form (a
+        defective multiplier).  ``vectors[i, s]`` is ``x_{keep[s]}`` of eigenvalue i scaled so that
         ``F_k x_k = c_k x_{k+1}`` with ``c_k = e^{ℓ_k}``, where
         ``scales[i, s] = Σ_{j < keep[s]} ℓ_j`` is the second output below.
     logscales : ndarray, shape (n, len(keep))
@@ -254,6 +255,14 @@ def _chunk(R, blk, owner, cols, logmod, arg):
     return Y
 
 
+def _tri_solve(T, rhs):
+    """Upper triangular solve; NaN when singular (a multiplier repeated across blocks)."""
+    try:
+        return la.solve_triangular(T, rhs, check_finite=False)
+    except np.linalg.LinAlgError:
+        return np.full(len(rhs), np.nan, complex)
+
+
 def _earlier(R, A_, f, sig, lm, ag, scale_b, backward):
     """Rows of an earlier block: the cyclic affine recurrence, in its contracting direction.
 
@@ -275,8 +284,7 @@ def _earlier(R, A_, f, sig, lm, ag, scale_b, backward):
         rhs = A_.Z.conj().T @ y
         y0 = np.empty_like(y)
         for j in range(w):
-            Tj = A_.T - e[j] * np.eye(m)
-            y0[:, j] = A_.Z @ la.solve_triangular(Tj, A_.T @ rhs[:, j], check_finite=False)
+            y0[:, j] = A_.Z @ _tri_solve(A_.T - e[j] * np.eye(m), A_.T @ rhs[:, j])
         y = y0 * d
         for k in range(M - 1, -1, -1):
             y = A_.solve(R, k, y * sig[k] - f[k])
@@ -292,8 +300,7 @@ def _earlier(R, A_, f, sig, lm, ag, scale_b, backward):
     rhs = A_.Z.conj().T @ (y / d)
     y = np.empty_like(rhs)
     for j in range(w):
-        y[:, j] = A_.Z @ la.solve_triangular(np.eye(m) - A_.T * inv_e[j], rhs[:, j],
-                                            check_finite=False)
+        y[:, j] = A_.Z @ _tri_solve(np.eye(m) - A_.T * inv_e[j], rhs[:, j])
     for k in range(M):
         out[k] = y
         y = (R[k, a:b, a:b] @ y + f[k]) / sig[k]
