@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from ltpcontrol import PeriodicMatrix, floquet_exponents, floquet_modes, ltpss, monodromy
+from ltpcontrol import (PeriodicMatrix, floquet_exponents, floquet_modes, floquet_transform,
+                        ltpss, monodromy)
 
 T = 1.0
 W = 2 * np.pi / T
@@ -209,3 +210,15 @@ def test_stiff_monodromy_warns_and_points_to_the_exponents(stiff_case):
     sys = stiff_case[0]
     with pytest.warns(UserWarning, match='floquet_exponents'):
         monodromy(sys)
+
+
+def test_floquet_transform_refuses_a_table_that_cannot_fit_before_any_work():
+    rng = np.random.default_rng(4)
+    n = 10
+    A0, A1 = rng.standard_normal((2, n, n))
+    Ap = PeriodicMatrix.from_function(
+        lambda t: A0 + np.cos(W * np.atleast_1d(t))[:, None, None] * A1, T, (n, n),
+        check=False)
+    sys = ltpss(Ap, np.zeros((n, 0)), np.zeros((0, n)), np.zeros((0, 0)), period=T)
+    with pytest.raises(MemoryError, match='GB'):
+        floquet_transform(sys, nsteps=10 ** 7)

@@ -48,6 +48,8 @@ __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
 _COND_MAX = 1e10
 # degree of the Chebyshev interpolant of P(t) on each grid interval
 _CHEB_DEG = 24
+# bytes of the P(t) table of `floquet_transform` above which the default grid is refused
+_TABLE_BUDGET = 2e9
 # entries of the step factors accumulated at once by `monodromy`
 _CHUNK_ENTRIES = 2 ** 17
 
@@ -361,9 +363,12 @@ def floquet_transform(sys, real=True, nsteps=None):
     is announced by a warning.
 
     Size and stiffness.  P(t) is stored as Chebyshev values of degree 24
-    on every step of the Floquet grid: ``25 M n²`` numbers for M steps
-    (the memory needed is checked first and a MemoryError names it; give
-    a smaller `nsteps` for large models).  The time is linear in M.  For
+    on every step of the Floquet grid: ``25 M n²`` numbers for M steps.
+    The memory needed is checked first: with the default grid a table (and
+    its working copies) above 2 GB raises a MemoryError naming the size,
+    and any size above the memory available does; give a smaller `nsteps`
+    for large models.  The time is linear in M (periodic Schur form and
+    back-substitution, O(M n³)).  For
     a stiff system the grid is the capped one of `monodromy` (a warning
     says when its factors cannot hold the stiffest multipliers);
     `floquet_exponents` and `floquet_modes` are the tools for the
@@ -436,17 +441,29 @@ def floquet_transform(sys, real=True, nsteps=None):
     """
     if not isinstance(real, (bool, np.bool_)):
         raise ControlArgument(f"real must be True or False, got {real!r}")
-    grid, factors = _factors(sys, nsteps)
-    nstates = factors.shape[1]
+    sys = as_ltp(sys)
+    nstates = sys.nstates
     if nstates == 0:
         raise ValueError("sys has no states; there is nothing to transform")
     if not sys.dt:
-        # P(t) is a table of Chebyshev values on every step, with the short-step
-        # transitions that produce them and the sparse cyclic factorisation
-        check_allocation((len(grid) - 1, _CHEB_DEG + 1, nstates, nstates),
+        # P(t) is a table of Chebyshev values on every step (with the short-step
+        # transitions that produce them): check its size before any work
+        A = fast_form(sys.A)
+        steps = len(floquet_grid(A, nsteps=nsteps)) - 1
+        table = 8.0 * 3 * steps * (_CHEB_DEG + 1) * nstates ** 2
+        if nsteps is None and table > _TABLE_BUDGET:
+            raise MemoryError(
+                f"the Floquet transformation P(t) of {nstates} states on {steps} "
+                f"steps needs {table / 1e9:.1f} GB (Chebyshev values of degree {_CHEB_DEG} "
+                f"on every step; the step count keeps the factors of T max‖A(t)‖ = "
+                f"{sys.period * floquet_norm(A):.3g} well conditioned): give "
+                "a smaller nsteps (the stiffest modes then lose accuracy), or use "
+                "floquet_modes / floquet_exponents, which handle large stiff models")
+        check_allocation((steps, _CHEB_DEG + 1, nstates, nstates),
                          f"the Floquet transformation P(t) of {nstates} states on "
-                         f"{len(grid) - 1} steps (Chebyshev values of degree {_CHEB_DEG}; "
+                         f"{steps} steps (Chebyshev values of degree {_CHEB_DEG}; "
                          "fewer steps with nsteps=)", copies=3)
+    grid, factors = _factors(sys, nsteps)
     if sys.dt:
         # x[k] = P[k] z[k] needs an invertible period map: every A[k] regular
         sv = np.linalg.svd(factors, compute_uv=False)
