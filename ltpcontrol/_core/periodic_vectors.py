@@ -72,7 +72,7 @@ def schur_sweeps(F, keep=(), max_sweeps=None):
     M, n = F.shape[0], F.shape[1]
     if max_sweeps is None:
         max_sweeps = 60 if n <= 48 else 12
-    keep = sorted(set(int(k) for k in keep) | {0})
+    keep = set(int(k) for k in keep) | {0}
     R = np.empty_like(F)
     Q0 = np.eye(n)
     with small_blas(n):
@@ -128,12 +128,16 @@ def _partition(last, d):
 class _Block:
     """One diagonal block: step scales, normalised product, its eigen and Schur forms."""
 
-    def __init__(self, R, a, b):
+    def __init__(self, R, a, b, keep=()):
         self.a, self.b = a, b
         M, m = R.shape[0], b - a
         logsig = np.empty(M)
         P = np.eye(m)
+        #: normalised running products at the kept indices (``y_k = P_k s``)
+        self.kept = {}
         for k in range(M):
+            if k in keep:
+                self.kept[k] = P.copy()
             P = R[k, a:b, a:b] @ P
             s = float(np.abs(P).max())
             if not s > 0 or not np.isfinite(s):
@@ -156,8 +160,11 @@ class _Block:
         if b - a == 1:
             return rhs / R[k, a, a]
         if k < len(R) - 1:
-            return la.solve_triangular(R[k, a:b, a:b], rhs, check_finite=False)
-        return np.linalg.solve(R[k, a:b, a:b], rhs)
+            solve = lambda x: la.solve_triangular(R[k, a:b, a:b], x, check_finite=False)
+        else:
+            solve = lambda x: np.linalg.solve(R[k, a:b, a:b], x)
+        # real factor, complex right-hand side: two real solves
+        return solve(rhs.real) + 1j * solve(rhs.imag)
 
 
 def cyclic_eigenvectors(F, keep, bases=None):
@@ -178,12 +185,12 @@ def cyclic_eigenvectors(F, keep, bases=None):
     logmod, arg : ndarray, shape (n,)
         ``log|μ|`` and ``arg μ`` of every eigenvalue, in block order.
     vectors : ndarray of complex, shape (n, len(keep), n)
-        NaN for an eigenvalue repeated across blocks of the Schur form (a
-        defective multiplier).  ``vectors[i, s]`` is ``x_{keep[s]}`` of eigenvalue i scaled so that
-        ``F_k x_k = c_k x_{k+1}`` with ``c_k = e^{ℓ_k}``, where
-        ``scales[i, s] = Σ_{j < keep[s]} ℓ_j`` is the second output below.
+        ``vectors[i, s]`` is ``x_{keep[s]}`` of eigenvalue i, scaled so
+        that ``F_k x_k = e^{ℓ_k} x_{k+1}``; NaN for an eigenvalue repeated
+        across blocks of the Schur form (a defective multiplier).
     logscales : ndarray, shape (n, len(keep))
-        The accumulated log-scales of the vectors at the kept indices.
+        ``Σ_{j < keep[s]} ℓ_j`` of each vector: ``x_k e^{logscales}`` is the
+        vector propagated by the factors from ``x_0``.
 
     Examples
     --------
@@ -199,7 +206,8 @@ def cyclic_eigenvectors(F, keep, bases=None):
     M, n = F.shape[0], F.shape[1]
     keep = [int(k) for k in keep]
     R, Q, blocks = schur_sweeps(F, keep)
-    blk = [_Block(R, a, b) for a, b in blocks]
+    # the first block's vectors are needed at the kept indices only
+    blk = [_Block(R, a, b, set(keep) if i == 0 else ()) for i, (a, b) in enumerate(blocks)]
     owner = np.concatenate([[i] * (b - a) for i, (a, b) in enumerate(blocks)]).astype(int)
     logmod = np.concatenate([B.logmod for B in blk])
     arg = np.concatenate([B.arg for B in blk])
@@ -213,7 +221,7 @@ def cyclic_eigenvectors(F, keep, bases=None):
             Y = _chunk(R, blk, owner, cols, logmod, arg)
             rows = blk[owner[cols[-1]]].b
             for s, k in enumerate(keep):
-                vectors[cols, s] = (C[k][:, :rows] @ Y[k, :rows]).T
+                vectors[cols, s] = _rmul(C[k][:, :rows], Y[k, :rows]).T
             for j in cols:
                 logscales[j] = blk[owner[j]].cumlog[keep]
     return logmod, arg, vectors, logscales
@@ -229,9 +237,14 @@ def _chunk(R, blk, owner, cols, logmod, arg):
         B = blk[bi]
         sel = np.flatnonzero(owner[cols] == bi)
         y = B.S[:, cols[sel] - B.a].astype(complex)
+        if bi == 0:
+            # no earlier block needs them at every step
+            for k, P in B.kept.items():
+                Y[k, B.a:B.b][:, sel] = _rmul(P, y)
+            continue
         for k in range(M):
             Y[k, B.a:B.b][:, sel] = y
-            y = (R[k, B.a:B.b, B.a:B.b] @ y) / np.exp(B.logsig[k])
+            y = _rmul(R[k, B.a:B.b, B.a:B.b], y) / np.exp(B.logsig[k])
     # earlier blocks, last to first
     for ai in range(owner[cols[-1]] - 1, -1, -1):
         A_ = blk[ai]
@@ -240,7 +253,7 @@ def _chunk(R, blk, owner, cols, logmod, arg):
             continue
         a, b = A_.a, A_.b
         top = blk[owner[cols[sel[-1]]]].b
-        f = np.matmul(R[:, a:b, b:top], Y[:, b:top][:, :, sel])          # (M, m, w)
+        f = _rmul(R[:, a:b, b:top], Y[:, b:top][:, :, sel])              # (M, m, w)
         sig = np.exp(np.array([blk[owner[cols[j]]].logsig for j in sel]).T)   # (M, w)
         lm, ag = logmod[cols[sel]], arg[cols[sel]]
         amin, amax = A_.logmod.min(), A_.logmod.max()
@@ -253,6 +266,11 @@ def _chunk(R, blk, owner, cols, logmod, arg):
                                             ag[part], [blk[owner[cols[j]]].logscale
                                                        for j in sel[part]], direction)
     return Y
+
+
+def _rmul(F, Y):
+    """``F @ Y`` for real F and complex Y as two real products (half the flops)."""
+    return np.matmul(F, Y.real) + 1j * np.matmul(F, Y.imag)
 
 
 def _tri_solve(T, rhs):
@@ -293,7 +311,7 @@ def _earlier(R, A_, f, sig, lm, ag, scale_b, backward):
     # forward: y_{k+1} = (F_aa y_k + f_k) / σ_k, from y_0 = 0 to β_M
     a, b = A_.a, A_.b
     for k in range(M):
-        y = (R[k, a:b, a:b] @ y + f[k]) / sig[k]
+        y = (_rmul(R[k, a:b, a:b], y) + f[k]) / sig[k]
     # d y_0 = c P̃_a y_0 + β_M, c = Π σ_a / Π σ_b  ⇔  (I - P̃_a / e) y_0 = β_M / d
     with np.errstate(under='ignore', over='ignore'):
         inv_e = np.exp(np.minimum(A_.logscale - lm, 700.0)) * np.exp(-1j * ag)
@@ -303,5 +321,5 @@ def _earlier(R, A_, f, sig, lm, ag, scale_b, backward):
         y[:, j] = A_.Z @ _tri_solve(np.eye(m) - A_.T * inv_e[j], rhs[:, j])
     for k in range(M):
         out[k] = y
-        y = (R[k, a:b, a:b] @ y + f[k]) / sig[k]
+        y = (_rmul(R[k, a:b, a:b], y) + f[k]) / sig[k]
     return out
