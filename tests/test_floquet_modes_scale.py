@@ -208,8 +208,11 @@ def test_monodromy_memory_does_not_grow_with_the_steps():
 
 def test_stiff_monodromy_warns_and_points_to_the_exponents(stiff_case):
     sys = stiff_case[0]
-    with pytest.warns(UserWarning, match='floquet_exponents'):
-        monodromy(sys)
+    # the warning comes before the product is formed (raised here: nothing else runs)
+    with warnings.catch_warnings():
+        warnings.simplefilter('error', UserWarning)
+        with pytest.raises(UserWarning, match='floquet_exponents'):
+            monodromy(sys)
 
 
 def test_floquet_transform_refuses_a_table_that_cannot_fit_before_any_work():
@@ -222,3 +225,13 @@ def test_floquet_transform_refuses_a_table_that_cannot_fit_before_any_work():
     sys = ltpss(Ap, np.zeros((n, 0)), np.zeros((0, n)), np.zeros((0, 0)), period=T)
     with pytest.raises(MemoryError, match='GB'):
         floquet_transform(sys, nsteps=2 * 10 ** 6)
+
+
+def test_floquet_transform_warns_when_its_factors_cannot_hold_the_stiff_modes(stiff_case):
+    sys = stiff_case[0]
+    # 64 steps: h max‖A‖ ~ 1e3, far beyond what a plain factor holds; the warning
+    # comes before any work (raised here, so that nothing else runs)
+    with warnings.catch_warnings():
+        warnings.simplefilter('error', UserWarning)
+        with pytest.raises(UserWarning, match='floquet_modes keep them'):
+            floquet_transform(sys, nsteps=64)

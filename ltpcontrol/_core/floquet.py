@@ -48,6 +48,8 @@ __all__ = ['monodromy', 'floquet_multipliers', 'floquet_exponents',
 _COND_MAX = 1e10
 # degree of the Chebyshev interpolant of P(t) on each grid interval
 _CHEB_DEG = 24
+# log-spread h‖A‖ of a plain factor whose small multipliers stay above rounding
+_LOG_SPREAD = 36.0
 # bytes of the P(t) table of `floquet_transform` above which the default grid is refused
 _TABLE_BUDGET = 2e9
 # entries of the step factors accumulated at once by `monodromy`
@@ -459,6 +461,14 @@ def floquet_transform(sys, real=True, nsteps=None):
                 f"{sys.period * floquet_norm(A):.3g} well conditioned): give "
                 "a smaller nsteps (the stiffest modes then lose accuracy), or use "
                 "floquet_modes / floquet_exponents, which handle large stiff models")
+        spread = sys.period * floquet_norm(A) / steps
+        if nsteps is not None and spread > _LOG_SPREAD:
+            warnings.warn(f"the {steps} Floquet factors of sys have h max‖A(t)‖ up to "
+                          f"{spread:.3g}: each holds its multipliers only down to about "
+                          f"e^-{_LOG_SPREAD:.0f} of its largest, so exponents below about "
+                          f"{-_LOG_SPREAD * steps / sys.period:.3g} (stiff modes) and their "
+                          "columns of F and P(t) are lost to rounding; floquet_exponents and "
+                          "floquet_modes keep them", UserWarning, stacklevel=2)
         check_allocation((steps, _CHEB_DEG + 1, nstates, nstates),
                          f"the Floquet transformation P(t) of {nstates} states on "
                          f"{steps} steps (Chebyshev values of degree {_CHEB_DEG}; "
