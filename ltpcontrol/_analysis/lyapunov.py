@@ -20,7 +20,9 @@ periodic Schur form of the factors.  Values between grid points come from
 the step formula over the partial step.
 """
 
+import math
 import warnings
+from fractions import Fraction
 
 import numpy as np
 import scipy.sparse as sp
@@ -36,6 +38,7 @@ from .._core.subperiods import on_common_period, tile_steps
 from .tvlyap import is_varying, tv_dlyap
 from .._core.tvsystem import DiscreteLTPSystem
 from .tvdesign import tv_gram
+from .sylvester import dsylvester
 
 __all__ = ['lyap', 'dlyap', 'gram']
 
@@ -102,30 +105,45 @@ def lyap(A, Q, *, adjoint=False, period=None, nsteps=None):
     return periodic_solution(A, Q, grid, X, adjoint)
 
 
-def dlyap(A, Q, *, adjoint=False):
+def dlyap(A, Q, C=None, E=None, *, adjoint=False):
     """Periodic solution of a discrete-time periodic Lyapunov equation.
 
     Forward (default) ``X[k+1] = A[k] X[k] A[k]ᵀ + Q[k]``; adjoint
     ``X[k] = A[k]ᵀ X[k+1] A[k] + Q[k]``, indices modulo N.  An LTI
-    ``A, Q`` gives `control.dlyap`.
+    ``A, Q`` gives `control.dlyap`, and the arguments follow its order:
+    ``dlyap(A, Q, C)`` solves the periodic Sylvester equation
+    ``X[k+1] = A[k] X[k] Q[k]ᵀ + C[k]`` (`control.dlyap`'s
+    ``A X Qᵀ − X + C = 0``), and ``dlyap(A, Q, None, E)`` the generalized
+    equation ``E[k] X[k+1] E[k]ᵀ = A[k] X[k] A[k]ᵀ + Q[k]``
+    (``A X Aᵀ − E X Eᵀ + Q = 0``) for invertible ``E[k]``.
 
     Parameters
     ----------
-    A : array_like, shape (N, n, n) or (n, n)
-        The N matrices of one period (a 2D array: N = 1, or N from `Q`).
-    Q : array_like, shape (N, n, n) or (n, n)
+    A : array_like, shape (N, n, n) or (n, n), or PeriodicMatrix
+        The N matrices of one period (a 2D array: N = 1, or N from `Q`).  A
+        `PeriodicMatrix` held piecewise constant on N equal steps (the ``A``
+        of a discrete-time `LTPStateSpace`) gives its N step matrices; a
+        constant one counts as one step.
+    Q : array_like, shape (N, n, n) or (n, n), or PeriodicMatrix
         Symmetric weights (a 2D array is the same at every step).  `A` and
         `Q` may repeat with different numbers of steps: the equation is then
         solved on the least common multiple (A of 3 steps, Q of 2: N = 6).
         Lists of matrices whose dimensions vary with k (``A[k]`` of shape
-        ``n_{k+1} x n_k``) are accepted (time-varying dimensions).
+        ``n_{k+1} x n_k``) are accepted (time-varying dimensions).  With `C`:
+        the second factor of the Sylvester equation, shape (N, m, m).
+    C : array_like, shape (N, n, m) or (n, m), or PeriodicMatrix, optional
+        Right-hand side of the Sylvester equation (`ltpcontrol.dsylvester`).
+    E : array_like, shape (N, n, n) or (n, n), or PeriodicMatrix, optional
+        Invertible descriptor matrices of the generalized equation.
     adjoint : bool, optional
-        Solve the adjoint (backward) equation.
+        Solve the adjoint (backward) equation (not with `C` or `E`).
 
     Returns
     -------
-    X : ndarray, shape (N, n, n)
-        ``X[k]`` for k = 0..N−1 (a list for time-varying dimensions).
+    X : ndarray, shape (N, n, n), or PeriodicMatrix
+        ``X[k]`` for k = 0..N−1 (a list for time-varying dimensions).  When
+        `A` or `Q` is a `PeriodicMatrix` of period T: the solution held on
+        the steps, ``X(k T/N) = X[k]`` (``X.sample(N)`` gives the stack).
 
     Raises
     ------
@@ -141,8 +159,31 @@ def dlyap(A, Q, *, adjoint=False):
     >>> X = ltp.dlyap(A, np.eye(2))
     >>> np.allclose(X[1], A[0] @ X[0] @ A[0].T + np.eye(2))
     True
+
+    The matrices of a discrete-time system are taken as they are stored:
+
+    >>> sysd = ltp.ltpss(A, [[1.0], [0.5]], [[1.0, 0.0]], 0, period=2.0, dt=1.0)
+    >>> P = ltp.dlyap(sysd.A, sysd.B @ sysd.B.T)
+    >>> bool(np.allclose(P.sample(2), ltp.gram(sysd, 'c').sample(2)))
+    True
     """
     _check_bool(adjoint, 'adjoint')
+    period = _held_period(A, Q, C, E)
+    if period is not None:
+        A, Q, C, E = _held_steps([A, Q, C, E], ['A', 'Q', 'C', 'E'], period)
+        X = dlyap(A, Q, C, E, adjoint=adjoint)
+        return PeriodicMatrix.from_samples(X, period, kind='hold')
+    if C is not None:
+        if E is not None:
+            raise ControlArgument("dlyap: give C (Sylvester equation) or E (generalized "
+                                  "Lyapunov equation), not both")
+        if adjoint:
+            raise ControlArgument("dlyap: adjoint=True is not defined for the Sylvester "
+                                  "equation (C given)")
+        Q = real_array(Q, 'Q', ndim=(2, 3))
+        return dsylvester(A, np.swapaxes(Q, -1, -2), C)
+    if E is not None:
+        return _generalized_dlyap(A, Q, E, adjoint)
     # time-varying dimensions and sub-periods (ltpcontrol._analysis.tvlyap)
     if is_varying(A) or is_varying(Q):
         return tv_dlyap(A, Q, adjoint=adjoint)
@@ -162,6 +203,67 @@ def dlyap(A, Q, *, adjoint=False):
     Q = np.broadcast_to(Q, (N, n, n))
     _check_symmetric(Q, 'Q')
     return cyclic_lyap(A, Q, adjoint)
+
+
+def _held_period(*mats):
+    """Period of the `PeriodicMatrix` among `mats` (None if there is none)."""
+    periods = [M.period for M in mats if isinstance(M, PeriodicMatrix)]
+    if not periods:
+        return None
+    if any(abs(p - periods[0]) > 1e-12 * periods[0] for p in periods):
+        raise ValueError(f"dlyap: the periodic matrices have different periods {periods}")
+    return periods[0]
+
+
+def _held_steps(mats, names, period):
+    """The step matrices ``(N, r, c)`` of held (discrete-time) periodic matrices.
+
+    Examples
+    --------
+    >>> from ltpcontrol._analysis.lyapunov import _held_steps
+    >>> P = ltp.PeriodicMatrix.from_samples(np.arange(3.0).reshape(3, 1, 1), 3.0, kind='hold')
+    >>> _held_steps([P, None], ['A', 'C'], 3.0)[0][:, 0, 0]
+    array([0., 1., 2.])
+    """
+    out = []
+    for M, name in zip(mats, names):
+        if isinstance(M, PeriodicMatrix):
+            if not M._piecewise_constant:
+                raise ControlArgument(
+                    f"dlyap: {name} is a PeriodicMatrix that is not held piecewise constant "
+                    f"on steps (the form of a discrete-time system's matrices); give its "
+                    f"step matrices, e.g. {name}.sample(N)")
+            # the fewest equal steps whose instants hold every switching instant
+            frac = [Fraction(float(t) / period).limit_denominator(1 << 20)
+                    for t in np.unique(M.breakpoints)]
+            N = math.lcm(*[f.denominator for f in frac]) if frac else 1
+            if any(abs(float(f) - t / period) > 1e-9 for f, t in
+                   zip(frac, np.unique(M.breakpoints))) or N > 1 << 20:
+                raise ControlArgument(
+                    f"dlyap: {name} switches at {np.unique(M.breakpoints)}, not on equal "
+                    f"steps of the period {period}")
+            M = M.sample(N)
+        out.append(M)
+    return out
+
+
+def _generalized_dlyap(A, Q, E, adjoint):
+    """``E[k] X[k+1] E[k]ᵀ = A[k] X[k] A[k]ᵀ + Q[k]`` through ``E⁻¹A``, ``E⁻¹QE⁻ᵀ``."""
+    if adjoint:
+        raise ControlArgument("dlyap: adjoint=True is not defined for the generalized "
+                              "equation (E given)")
+    A = real_array(A, 'A', ndim=(2, 3))
+    Q = real_array(Q, 'Q', ndim=(2, 3))
+    E = real_array(E, 'E', ndim=(2, 3))
+    A, Q, E = tile_steps([A, Q, E], ['A', 'Q', 'E'])
+    if E.shape[-2:] != A.shape[-2:]:
+        raise ControlDimension(f"E must hold matrices of the shape {A.shape[-2:]} of A, "
+                               f"got shape {E.shape}")
+    if np.any(np.linalg.svd(E, compute_uv=False).min(axis=-1)
+              <= 1e-13 * np.linalg.norm(E, 2, axis=(-2, -1))):
+        raise ValueError("dlyap: E must be invertible at every step")
+    Ei = np.linalg.inv(E)
+    return dlyap(Ei @ A, Ei @ Q @ np.swapaxes(Ei, -1, -2))
 
 
 def gram(sys, type):
