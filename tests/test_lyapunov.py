@@ -229,3 +229,28 @@ def test_dlyap_lti_as_periodic_equals_python_control():
     smooth = ltp.PeriodicMatrix.from_function(lambda t: 0.5 * np.cos(t) * np.eye(2), 2 * np.pi)
     with pytest.raises(ct.ControlArgument, match='A is a PeriodicMatrix that is not held'):
         ltp.dlyap(smooth, np.eye(2))
+
+
+@pytest.mark.parametrize('N', [7, 8])
+def test_dlyap_memory_scales_as_steps_times_states_squared(N):
+    # 30 states: the Kronecker form would hold N·30⁴ entries (≈ 50-200 MB);
+    # the solution itself is N·30² numbers
+    import tracemalloc
+    rng = np.random.default_rng(N)
+    n = 30
+    A = np.stack([0.95 * np.linalg.qr(rng.normal(size=(n, n)))[0] @ np.diag(
+        rng.uniform(0.1, 1.0, n)) for _ in range(N)])
+    A[N // 2] *= 1.5                  # one expanding step, the period still contracts
+    Q = rng.normal(size=(N, n, 2))
+    Q = Q @ np.swapaxes(Q, 1, 2)
+    tracemalloc.start()
+    X = ltp.dlyap(A, Q)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 5e6
+    Xn = np.roll(X, -1, axis=0)
+    assert np.abs(Xn - A @ X @ np.swapaxes(A, 1, 2) - Q).max() <= 1e-12 * np.abs(X).max()
+    assert np.abs(X - _lifted_dlyap(A, Q)).max() <= 1e-11 * np.abs(X).max()
+    Xa = ltp.dlyap(A, Q, adjoint=True)
+    At = np.swapaxes(A, 1, 2)
+    assert np.abs(Xa - At @ np.roll(Xa, -1, axis=0) @ A - Q).max() <= 1e-12 * np.abs(Xa).max()

@@ -25,6 +25,7 @@ import warnings
 from fractions import Fraction
 
 import numpy as np
+import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from control.exception import ControlArgument, ControlDimension
@@ -46,6 +47,8 @@ __all__ = ['lyap', 'dlyap', 'gram']
 # and below which it is reported as ill-conditioned
 _SINGULAR = 1e-10
 _ILLCOND = 1e-6
+# M n⁴ above which `cyclic_lyap` leaves the sparse Kronecker solve (about 100 MB)
+_SPARSE_LIMIT = 4e6
 
 
 def lyap(A, Q, *, adjoint=False, period=None, nsteps=None):
@@ -322,7 +325,7 @@ def gram(sys, type):
 # Shared solvers (also used by the norms)
 #
 
-def cyclic_lyap(Phi, W, adjoint=False, check=True):
+def cyclic_lyap(Phi, W, adjoint=False, check=True, method='auto'):
     """Solve the cyclic periodic discrete Lyapunov equation (module notes).
 
     ``X_{k+1} = Φ_k X_k Φ_kᵀ + W_k`` (forward) or ``X_k = Φ_kᵀ X_{k+1}
@@ -330,16 +333,30 @@ def cyclic_lyap(Phi, W, adjoint=False, check=True):
     ``check=False`` skips the uniqueness test (for callers that know the
     factors are stable).
 
+    ``method='sparse'`` solves the M n² x M n² cyclic Kronecker system by a
+    sparse LU (exact also for unstable factors, but O(M n⁴) memory);
+    ``'monodromy'`` solves the one-period Stein equation ``X_0 = ΨX_0Ψᵀ +
+    W̄`` of the monodromy Ψ by a Schur method and propagates the steps,
+    O(M n³) time and O(M n²) memory (`_monodromy_lyap`).  ``'auto'`` takes
+    the sparse LU while its Kronecker blocks stay small (M n⁴ <= 4e6).
+
     Examples
     --------
     >>> from ltpcontrol._analysis.lyapunov import cyclic_lyap
     >>> X = cyclic_lyap(np.array([[[0.5]], [[3.0]]]), np.ones((2, 1, 1)))
     >>> X[:, 0, 0]          # X1 = X0/4 + 1, X0 = 9 X1 + 1
     array([-8., -1.])
+    >>> cyclic_lyap(np.array([[[0.5]], [[3.0]]]), np.ones((2, 1, 1)),
+    ...             method='monodromy')[:, 0, 0]
+    array([-8., -1.])
     """
     M, n = Phi.shape[0], Phi.shape[1]
     if n == 0:
         return np.zeros((M, 0, 0))
+    if method not in ('auto', 'sparse', 'monodromy'):
+        raise ValueError(f"method must be 'auto', 'sparse' or 'monodromy', got {method!r}")
+    if method == 'monodromy' or (method == 'auto' and M * n ** 4 > _SPARSE_LIMIT):
+        return _monodromy_lyap(Phi, W, adjoint, check)
     if check:
         check_unique(Phi)
     nn = n * n
@@ -368,6 +385,86 @@ def cyclic_lyap(Phi, W, adjoint=False, check=True):
     return 0.5 * (X + np.swapaxes(X, 1, 2))
 
 
+def _monodromy_lyap(Phi, W, adjoint, check=True):
+    """The cyclic equation through the monodromy's Stein equation, O(M n³).
+
+    Forward: ``Ψ = Φ_{M−1}…Φ_0`` and ``W̄ = Σ_k Φ(M, k+1) W_k Φ(M, k+1)ᵀ``
+    accumulated over one period, ``X_0 = ΨX_0Ψᵀ + W̄`` (`stein`), then
+    ``X_{k+1} = Φ_kX_kΦ_kᵀ + W_k``; adjoint the same backwards with the
+    transposed factors.  Propagating amplifies the error of X_0 along
+    unstable directions: the last step, which returns to X_0, measures it,
+    and a mismatch above 1e-8 warns.  ``check`` tests uniqueness on the
+    Schur form of Ψ (``1 − μ_i conj(μ_j)``, the same set as ``1 − μ_iμ_j``
+    for a real Ψ).
+
+    Examples
+    --------
+    >>> from ltpcontrol._analysis.lyapunov import _monodromy_lyap
+    >>> X = _monodromy_lyap(np.array([[[0.5]], [[3.0]]]), np.ones((2, 1, 1)), False)
+    >>> X[:, 0, 0]
+    array([-8., -1.])
+    """
+    M, n = Phi.shape[0], Phi.shape[1]
+    PhiT = np.swapaxes(Phi, 1, 2)
+    order = range(M - 1, -1, -1) if adjoint else range(M)
+    Psi, Wbar = np.eye(n), np.zeros((n, n))
+    for k in order:
+        if adjoint:
+            Wbar = PhiT[k] @ Wbar @ Phi[k] + W[k]
+            Psi = Psi @ Phi[k]
+        else:
+            Wbar = Phi[k] @ Wbar @ PhiT[k] + W[k]
+            Psi = Phi[k] @ Psi
+    X = np.empty((M, n, n))
+    X[0] = stein(Psi.T if adjoint else Psi, Wbar, check=check)
+    prev = X[0]
+    for k in (range(M - 1, 0, -1) if adjoint else range(M - 1)):
+        nxt = k if adjoint else k + 1
+        prev = (PhiT[k] @ prev @ Phi[k] if adjoint else Phi[k] @ prev @ PhiT[k]) + W[k]
+        X[nxt] = prev = 0.5 * (prev + prev.T)
+    last = PhiT[0] @ X[1 % M] @ Phi[0] + W[0] if adjoint else \
+        Phi[M - 1] @ X[M - 1] @ PhiT[M - 1] + W[M - 1]
+    scale = max(np.abs(X[0]).max(), np.abs(last).max(), 1e-300)
+    mismatch = np.abs(last - X[0]).max() / scale
+    if mismatch > 1e-8:
+        warnings.warn(f"the periodic Lyapunov solution lost accuracy over the period "
+                      f"(relative mismatch {mismatch:.1e} after one period; unstable "
+                      f"Floquet multipliers amplify the error)", UserWarning, stacklevel=3)
+    return X
+
+
+def stein(Psi, W, check=True):
+    """Solution of the Stein equation ``X = Ψ X Ψᵀ + W`` by a complex Schur form.
+
+    With ``Ψ = U S Uᴴ`` (S upper triangular) and ``Y = UᴴXU``, column j of
+    ``Y − S Y Sᴴ = UᴴWU`` is a triangular solve with ``I − conj(S_jj) S``
+    once the columns l > j are known: O(n³).  ``check`` raises (or warns)
+    as `check_unique` when ``1 − μ_i conj(μ_j)`` (nearly) vanishes.
+
+    Examples
+    --------
+    >>> from ltpcontrol._analysis.lyapunov import stein
+    >>> A = np.array([[0.5, 1.0], [-0.3, 0.2]])
+    >>> X = stein(A, np.eye(2))
+    >>> bool(np.allclose(X, ct.dlyap(A, np.eye(2))))
+    True
+    """
+    n = Psi.shape[0]
+    S, U = scipy.linalg.schur(Psi.astype(complex), output='complex')
+    if check:
+        mu = np.diag(S)
+        _uniqueness_verdict(np.abs(1 - mu[:, None] * np.conj(mu[None, :])).min(), stacklevel=6)
+    R = U.conj().T @ W @ U
+    Y = np.zeros((n, n), complex)
+    acc = np.zeros((n, n), complex)            # column j: Σ_{l>j} Y[:, l] conj(S[j, l])
+    for j in range(n - 1, -1, -1):
+        rhs = R[:, j] + S @ acc[:, j]
+        Y[:, j] = scipy.linalg.solve_triangular(np.eye(n) - np.conj(S[j, j]) * S, rhs)
+        acc[:, :j] += np.outer(Y[:, j], np.conj(S[:j, j]))
+    X = (U @ Y @ U.conj().T).real
+    return 0.5 * (X + X.T)
+
+
 def check_unique(Phi):
     """Raise if ``μ_i μ_j = 1`` for two multipliers of ``Φ_{M−1} ... Φ_0``.
 
@@ -383,7 +480,11 @@ def check_unique(Phi):
     s = logmod[:, None] + logmod[None, :]
     with np.errstate(over='ignore', invalid='ignore'):
         gap = np.abs(np.exp(np.minimum(s, 50.0) + 1j * (arg[:, None] + arg[None, :])) - 1)
-    worst = np.min(np.where(np.isnan(gap), np.inf, gap))
+    _uniqueness_verdict(np.min(np.where(np.isnan(gap), np.inf, gap)))
+
+
+def _uniqueness_verdict(worst, stacklevel=4):
+    """Raise or warn for the smallest ``|μ_i μ_j − 1|`` (see `check_unique`)."""
     if worst <= _SINGULAR:
         raise ValueError("the periodic Lyapunov equation has no unique periodic solution: "
                          "two Floquet multipliers satisfy mu_i mu_j = 1 "
@@ -391,7 +492,7 @@ def check_unique(Phi):
     if worst <= _ILLCOND:
         warnings.warn("the periodic Lyapunov equation is ill-conditioned: two Floquet "
                       f"multipliers nearly satisfy mu_i mu_j = 1 (|mu_i mu_j - 1| = "
-                      f"{worst:.1e})", UserWarning, stacklevel=3)
+                      f"{worst:.1e})", UserWarning, stacklevel=stacklevel)
 
 
 def periodic_solution(A, Q, grid, X, adjoint):
