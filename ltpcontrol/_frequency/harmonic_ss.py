@@ -312,7 +312,8 @@ class _HarmonicStateSpace:
         self.band = None
         if band is not None and method in ('auto', 'solve'):
             self.band = (band, band, _band_storage(-F, band, band))
-        if floquet_A is not None and method in ('auto', 'modal'):
+        # (no states: a static gain J, nothing to diagonalise)
+        if floquet_A is not None and floquet_A[0].size and method in ('auto', 'modal'):
             # Floquet form: F = blkdiag(A - jnω_p I) has eigenvalues λ_i - jnω_p
             # and eigenvectors blkdiag(W) from ONE eigendecomposition A = W Λ W^{-1}
             A, w = floquet_A
