@@ -187,3 +187,22 @@ def test_harmonic_ss_unstable_mathieu_genuine_exponent_unmarked():
     with pytest.warns(UserWarning, match="is unstable"):
         Hd = ltp.harmonic_ss(sys, 1, edge='drop')
     assert ct.poles(Hd).real.max() == pytest.approx(truth.real.max(), abs=1e-8)
+
+
+def test_htf_to_ss_marks_edges_as_harmonic_ss():
+    sys = mathieu(2.0, 3.0, 0.3)
+    H = ltp.htf(sys, 1)
+    with pytest.warns(UserWarning, match="not Floquet exponents") as rec:
+        Hs = H.to_ss()
+    assert rec[0].filename == __file__                       # points at the user's call
+    ref = ltp.harmonic_ss(sys, 1, edge='ignore')
+    assert np.array_equal(Hs.A, ref.A) and np.array_equal(Hs.modes.edge, ref.modes.edge)
+    assert Hs.modes.edge.any()
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        Hd = H.to_ss(edge='drop')
+    drop = ltp.harmonic_ss(sys, 1, edge='drop')
+    assert Hd.nstates == drop.nstates < Hs.nstates
+    assert _match(ct.poles(Hd), ct.poles(drop)) < 1e-9
+    with pytest.raises(ValueError, match="edge"):
+        H.to_ss(edge='remove')

@@ -1,5 +1,7 @@
 """Harmonic state space, lifting from any start step, LTI-only requests."""
 
+import warnings
+
 import numpy as np
 import pytest
 import control as ct
@@ -69,3 +71,25 @@ def test_lti_only_requests_name_the_htf():
         ct.frequency_response(sys, [1.0])
     with pytest.raises(TypeError, match="ltp.htf"):
         ct.dcgain(sys)
+
+
+def test_harmonic_ss_of_static_periodic_gain():
+    # a zero-state system: its HTF is the Toeplitz matrix of D(t) at every s
+    K = ltp.PeriodicMatrix.from_function(
+        lambda t: np.array([[1 + 0.5 * np.cos(2 * np.pi * t), 0.2 * np.sin(4 * np.pi * t)]]),
+        1.0)
+    gain = ltp.ltpss(K)
+    Kh = 2
+    c = K.fourier(2 * Kh)
+    harm = np.arange(-Kh, Kh + 1)
+    toeplitz = c[harm[:, None] - harm[None, :] + 2 * Kh].transpose(0, 2, 1, 3).reshape(
+        (2 * Kh + 1), 2 * (2 * Kh + 1))
+    assert np.allclose(ltp.htf(gain, Kh)(0.3j), toeplitz, rtol=0, atol=1e-14)
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        Hs = ltp.harmonic_ss(gain, Kh)
+    assert Hs.nstates == 0 and Hs.modes.eigenvalues.size == 0 and Hs.modes.stable
+    # the same gain with a decoupled state goes through the dynamic path
+    ref = ltp.harmonic_ss(ltp.ltpss([[-1.0]], np.zeros((1, 2)), [[0.0]], K, period=1.0), Kh)
+    assert np.allclose(Hs.D, ref.D, rtol=0, atol=1e-14)
+    assert Hs.input_labels == ref.input_labels and Hs.output_labels == ref.output_labels

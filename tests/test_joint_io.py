@@ -78,3 +78,26 @@ def test_bad_input():
             ltp.joint_io_htf(H, inputs=bad)
     with pytest.raises(ValueError, match='nharmonics'):
         ltp.joint_io_htf(H, inputs=1, nharmonics=3)
+
+
+def test_joint_io_std_equals_monte_carlo_spread():
+    # exact closed-loop HTF components plus complex noise of known std: the
+    # propagated std equals the spread of the plant estimates over 200 draws
+    T = 1.0
+    loop = ltp.ltpss(lambda t: -2 - b(t), b, [[1.0], [-1.0]], [[0.0], [1.0]], period=T)
+    K, L = 2, 8
+    omega = 2 * np.pi / L * np.arange(1, 3 * L)
+    _, comps = ltp.htf(loop, K).components(omega)
+    std = np.broadcast_to(0.01 * np.abs(comps).max() * (1 + np.arange(omega.size) / omega.size),
+                          comps.shape).copy()
+    P0 = ltp.joint_io_htf(ltp.HTFData(comps, omega, T, std=std), inputs=1)
+    assert ltp.joint_io_htf(ltp.HTFData(comps, omega, T), inputs=1).std is None
+    known = np.isfinite(P0.std)
+    assert known.sum() >= 30
+    rng = np.random.default_rng(0)
+    draws = np.array([ltp.joint_io_htf(ltp.HTFData(
+        comps + std * (rng.normal(size=comps.shape) + 1j * rng.normal(size=comps.shape))
+        / np.sqrt(2), omega, T), inputs=1).components()[1] for _ in range(200)])
+    spread = np.sqrt(np.mean(np.abs(draws - P0.components()[1]) ** 2, axis=0))
+    ratio = spread[known] / P0.std[known]
+    assert 0.8 < ratio.min() and ratio.max() < 1.2

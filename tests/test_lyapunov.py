@@ -180,3 +180,77 @@ def test_dlyap_single_step_equals_python_control(adjoint):
     ref = ct.dlyap(A.T, Q) if adjoint else ct.dlyap(A, Q)
     X = ltp.dlyap(A[None], Q[None], adjoint=adjoint)
     assert np.abs(X[0] - ref).max() <= 1e-12 * np.abs(ref).max()
+
+
+def _lifted_dlyap(A, Q):
+    """Independent solution of X[k+1] = A[k]X[k]A[k]ᵀ + Q[k]: the one-period
+    Stein equation of the monodromy (Kronecker form), then the steps."""
+    N, n = A.shape[0], A.shape[1]
+    Psi, W = np.eye(n), np.zeros((n, n))
+    for k in range(N):
+        Psi, W = A[k] @ Psi, A[k] @ W @ A[k].T + Q[k]
+    X0 = np.linalg.solve(np.eye(n * n) - np.kron(Psi, Psi), W.ravel()).reshape(n, n)
+    X = [X0]
+    for k in range(N - 1):
+        X.append(A[k] @ X[-1] @ A[k].T + Q[k])
+    return np.array(X)
+
+
+@pytest.mark.parametrize('N', [7, 8])
+def test_dlyap_of_discrete_system_matrices(N):
+    # the PeriodicMatrix A and Q of a discrete-time system (held steps) are
+    # taken as they are stored; Q varies on a sub-period (2 of the N steps)
+    rng = np.random.default_rng(N)
+    n = 3
+    A = 0.6 * rng.normal(size=(N, n, n)) / np.sqrt(n)
+    B = rng.normal(size=(N, n, 1))
+    sysd = ltp.ltpss(A, B, np.ones((1, n)), 0, period=2.0 * N, dt=2.0)
+    X = ltp.dlyap(sysd.A, sysd.B @ sysd.B.T)
+    assert isinstance(X, ltp.PeriodicMatrix) and X.period == sysd.period
+    ref = _lifted_dlyap(A, B @ np.swapaxes(B, 1, 2))
+    assert np.abs(X.sample(N) - ref).max() <= 1e-12 * np.abs(ref).max()
+    assert np.allclose(X.sample(N), ltp.dlyap(A, B @ np.swapaxes(B, 1, 2)), rtol=1e-14, atol=0)
+
+
+def test_dlyap_lti_as_periodic_equals_python_control():
+    G = ct.drss(4, 2, 2, dt=0.5)
+    G.A *= 0.9 / max(1.0, np.abs(np.linalg.eigvals(G.A)).max())
+    sysd = ltp.ltpss(G, period=1.5)
+    X = ltp.dlyap(sysd.A, sysd.B @ sysd.B.T)
+    assert np.allclose(X.sample(3), ct.dlyap(G.A, G.B @ G.B.T), rtol=1e-12, atol=1e-13)
+    # python-control's Sylvester and generalized forms, same argument order
+    Q, C = np.diag([1.0, 0.5, 0.3, 0.2]), np.arange(16.0).reshape(4, 4)
+    E = np.eye(4) + 0.1 * np.ones((4, 4))
+    assert np.allclose(ltp.dlyap(G.A, Q, C), ct.dlyap(G.A, Q, C), rtol=1e-12, atol=1e-12)
+    assert np.allclose(ltp.dlyap(G.A, Q, None, E), ct.dlyap(G.A, Q, None, E),
+                       rtol=1e-12, atol=1e-12)
+    with pytest.raises(ValueError, match='E must be invertible'):
+        ltp.dlyap(G.A, Q, None, np.zeros((4, 4)))
+    smooth = ltp.PeriodicMatrix.from_function(lambda t: 0.5 * np.cos(t) * np.eye(2), 2 * np.pi)
+    with pytest.raises(ct.ControlArgument, match='A is a PeriodicMatrix that is not held'):
+        ltp.dlyap(smooth, np.eye(2))
+
+
+@pytest.mark.parametrize('N', [7, 8])
+def test_dlyap_memory_scales_as_steps_times_states_squared(N):
+    # 30 states: the Kronecker form would hold N·30⁴ entries (≈ 50-200 MB);
+    # the solution itself is N·30² numbers
+    import tracemalloc
+    rng = np.random.default_rng(N)
+    n = 30
+    A = np.stack([0.95 * np.linalg.qr(rng.normal(size=(n, n)))[0] @ np.diag(
+        rng.uniform(0.1, 1.0, n)) for _ in range(N)])
+    A[N // 2] *= 1.5                  # one expanding step, the period still contracts
+    Q = rng.normal(size=(N, n, 2))
+    Q = Q @ np.swapaxes(Q, 1, 2)
+    tracemalloc.start()
+    X = ltp.dlyap(A, Q)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 5e6
+    Xn = np.roll(X, -1, axis=0)
+    assert np.abs(Xn - A @ X @ np.swapaxes(A, 1, 2) - Q).max() <= 1e-12 * np.abs(X).max()
+    assert np.abs(X - _lifted_dlyap(A, Q)).max() <= 1e-11 * np.abs(X).max()
+    Xa = ltp.dlyap(A, Q, adjoint=True)
+    At = np.swapaxes(A, 1, 2)
+    assert np.abs(Xa - At @ np.roll(Xa, -1, axis=0) @ A - Q).max() <= 1e-12 * np.abs(Xa).max()

@@ -209,7 +209,7 @@ def classify(sys, F, Ki, edge_tol=1e-3, tol=1e-6, floquet_steps=None, *, floquet
     nb = 2 * Ki + 1
     lam, V = np.linalg.eig(F)
     W = np.linalg.inv(V).conj().T                  # left eigenvectors, wᴴ v = 1
-    energy = (np.abs(V) ** 2).reshape(nb, n, -1).sum(axis=1)
+    energy = (np.abs(V) ** 2).reshape(nb, n, len(lam)).sum(axis=1)     # (no states: empty)
     energy /= energy.sum(axis=0, keepdims=True)
     outer = max(1, Ki // 5)
     edge_energy = np.maximum(energy[:outer].sum(axis=0), energy[-outer:].sum(axis=0))
@@ -243,7 +243,7 @@ def classify(sys, F, Ki, edge_tol=1e-3, tol=1e-6, floquet_steps=None, *, floquet
     phys = lam[chosen] + 1j * dominant[chosen] * wp
     order = np.lexsort((-phys.imag, -np.round(phys.real, 12)))
     chosen, phys, fl = chosen[order], phys[order], fl[order]
-    pf = np.abs(V[:, chosen] * W[:, chosen].conj()).reshape(nb, n, -1)
+    pf = np.abs(V[:, chosen] * W[:, chosen].conj()).reshape(nb, n, len(chosen))
     per_state = pf.sum(axis=0)
     per_harm = pf.sum(axis=1)
     with np.errstate(invalid='ignore'):

@@ -148,24 +148,43 @@ def harmonic_ss(sys, nharmonics, *, internal_harmonics=None, edge='warn', name=N
     if edge not in ('warn', 'ignore', 'drop'):
         raise ValueError(f"edge must be 'warn', 'ignore' or 'drop', got {edge!r}")
     hss = build(sys, K, internal_harmonics, 'auto', 'harmonic_ss', warn_unstable=False)
+    return marked_ss(sys, hss, edge, name, stacklevel=3)
+
+
+def marked_ss(sys, hss, edge, name, stacklevel=3):
+    """Real form of `hss` with its truncation-edge eigenvalues marked in ``.modes``
+    (warned about or dropped as `edge` says); shared by `harmonic_ss` and
+    `HTFModel.to_ss`.  `stacklevel` counts the frames from here to the user's
+    call (3 from a public function that calls this one).
+
+    Examples
+    --------
+    >>> from ltpcontrol._frequency.harmonic_ss import build, marked_ss
+    >>> sys = ltp.ltpss(ct.ss([[-1.0]], [[1.0]], [[1.0]], 0), period=1.0)
+    >>> Hs = marked_ss(sys, build(sys, 1, None, 'auto', 'x'), 'warn', None)
+    >>> Hs.nstates, Hs.modes.stable
+    (3, True)
+    """
+    if edge not in ('warn', 'ignore', 'drop'):
+        raise ValueError(f"edge must be 'warn', 'ignore' or 'drop', got {edge!r}")
     # the Floquet exponents once: for the stability remark and the marks
     fl = floquet_exponents(sys) if sys.nstates else np.zeros(0, complex)
     fl = np.atleast_1d(np.asarray(fl, complex))
     if np.any(np.abs(np.exp(fl * (2 * np.pi / sys.omega_p))) >= 1 - 1e-10):
-        _warn_unstable(sys, 2)
+        _warn_unstable(sys, stacklevel)
     modes, missing = classify(sys, hss.F, hss.Ki, floquet=fl, strict=False,
                               where='harmonic_ss')
     if edge != 'ignore':
-        _warn_edge(modes, missing, hss.Ki, rhp=edge == 'warn')
+        _warn_edge(modes, missing, hss.Ki, rhp=edge == 'warn', stacklevel=stacklevel + 1)
     out = real_ss(hss, name or f'{sys.name}$harmonic', sys.input_labels,
                   sys.output_labels, sys.state_labels)
     if edge == 'drop' and modes.edge.any():
-        out = _drop_edge(out, modes, sys.omega_p)
+        out = _drop_edge(out, modes, sys.omega_p, stacklevel + 1)
     out.modes = modes
     return out
 
 
-def _drop_edge(Hs, modes, wp):
+def _drop_edge(Hs, modes, wp, stacklevel=3):
     """Exact modal truncation of the marked eigenvalues of the real form `Hs`."""
     lam, keep = modes.eigenvalues, ~modes.edge
 
@@ -191,7 +210,7 @@ def _drop_edge(Hs, modes, wp):
     if err > 1e-6:
         warnings.warn(f"harmonic_ss: dropping the {n - k} truncation-edge modes changes the "
                       f"response by {err:.1e} (relative); increase internal_harmonics",
-                      UserWarning, stacklevel=3)
+                      UserWarning, stacklevel=stacklevel)
     return out
 
 
@@ -201,7 +220,7 @@ def _warn_unstable(sys, stacklevel):
                   "steady-state response", UserWarning, stacklevel=stacklevel + 1)
 
 
-def _warn_edge(modes, missing, Ki, rhp=True):
+def _warn_edge(modes, missing, Ki, rhp=True, stacklevel=3):
     """Warn about right-half-plane eigenvalues that are no Floquet exponents."""
     lam = modes.eigenvalues
     # with the marked ones dropped, only the unmarked ones remain to be named
@@ -225,7 +244,7 @@ def _warn_edge(modes, missing, Ki, rhp=True):
         warnings.warn("harmonic_ss: " + "; ".join(msgs) + ". Judge stability by "
                       "ltp.floquet_exponents(sys) or ltp.harmonic_modes(sys), not by "
                       "ct.poles of the harmonic state space (edge='ignore' silences this)",
-                      UserWarning, stacklevel=3)
+                      UserWarning, stacklevel=stacklevel)
 
 
 def build(sys, K, internal_harmonics, method, where, stacklevel=2, warn_unstable=True):
@@ -312,7 +331,8 @@ class _HarmonicStateSpace:
         self.band = None
         if band is not None and method in ('auto', 'solve'):
             self.band = (band, band, _band_storage(-F, band, band))
-        if floquet_A is not None and method in ('auto', 'modal'):
+        # (no states: a static gain J, nothing to diagonalise)
+        if floquet_A is not None and floquet_A[0].size and method in ('auto', 'modal'):
             # Floquet form: F = blkdiag(A - jnω_p I) has eigenvalues λ_i - jnω_p
             # and eigenvectors blkdiag(W) from ONE eigendecomposition A = W Λ W^{-1}
             A, w = floquet_A

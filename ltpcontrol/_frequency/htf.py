@@ -22,7 +22,7 @@ import control as ct
 from control.exception import ControlArgument, ControlDimension
 
 from .. import config
-from .harmonic_ss import build, real_ss
+from .harmonic_ss import build, marked_ss
 from .._core.coerce import as_ltp
 from .._core.validation import check_period, check_positive_int, real_array
 from .._core.registry import aliased, method_alias, overridden
@@ -379,17 +379,21 @@ class HTFModel(HTF):
         # user -> htf -> HTFModel -> build
         self._hss = build(sys, K, internal_harmonics, method, 'htf', stacklevel=3)
 
-    def to_ss(self, name=None):
+    def to_ss(self, name=None, *, edge='warn'):
         """Real harmonic state space; see `ltpcontrol.harmonic_ss`.
 
         Parameters
         ----------
         name : str, optional
             Name of the result (default ``'<name>$harmonic'``).
+        edge : {'warn', 'ignore', 'drop'}
+            The truncation-edge eigenvalues, as in `ltpcontrol.harmonic_ss`:
+            marked in ``.modes`` and warned about, marked only, or removed.
 
         Returns
         -------
         control.StateSpace
+            With ``.modes`` (`HarmonicModes`), as `ltpcontrol.harmonic_ss`.
 
         Examples
         --------
@@ -399,8 +403,7 @@ class HTFModel(HTF):
         """
         if self.isdtime():
             raise ValueError("to_ss: the HTF is discrete-time; lift() the system instead")
-        return real_ss(self._hss, name or f'{self.name}$harmonic', self.input_labels,
-                       self.output_labels, self._states)
+        return marked_ss(self._source[0], self._hss, edge, name)
 
     def _evaluate(self, s, progress):
         return self._hss.evaluate(s, progress=progress)

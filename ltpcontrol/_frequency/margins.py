@@ -276,7 +276,7 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     # near a pole on the axis every harmonic row is large: not a truncation effect
     far = (np.min(np.abs(w[:, None] - poles[None, :]), axis=1) > wp / 20 if poles.size
            else np.ones(len(w), bool))
-    _check_edge(loop, Lh[far] - loop.hss.J, edge_tol)     # the feedthrough is exact
+    edge = _edge_size(loop, Lh[far] - loop.hss.J)     # the feedthrough is exact
     eig = _tracked(Lh)
 
     gains, phases = [], []
@@ -325,8 +325,8 @@ def harmonic_margins(L, nharmonics=10, *, period=None, omega_num=801, skew=0.0,
     alpha = 1 / peak.value
     disk = peak._replace(value=alpha)
     dgain, dphase = _disk_gain_phase(alpha, skew)
-    if check:
-        _verify(L, loop, upper, lower, k_lo, k_hi, nsteps=nsteps)
+    confirmed = check and _verify(L, loop, upper, lower, k_lo, k_hi, nsteps=nsteps)
+    _check_edge(loop, edge, edge_tol, confirmed)
     return HarmonicMargins(gain_upper=upper, gain_lower=lower, phase=phase,
                            stability=stability, disk=disk, disk_gain=dgain,
                            disk_phase=dphase, gain_crossings=gains,
@@ -530,7 +530,8 @@ def _verify(L, loop, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3, nsteps=Non
     exponent in the right half plane).  So each finite margin costs one
     Floquet computation; only when a check fails is the closed loop itself
     computed, and the warning given when it is stable (the margins of an
-    unstable closed loop are not margins).
+    unstable closed loop are not margins).  Returns True when at least one
+    finite margin was checked and every check agreed.
     """
     eye = np.eye(L.ninputs)
     wp = L.omega_p
@@ -562,10 +563,11 @@ def _verify(L, loop, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3, nsteps=Non
             out |= np.abs(gap.real + 1j * fold(gap.imag, wp)) <= 0.9 * ds
         return out
 
-    bad = []
+    bad, checked = [], 0
     for m, step in ((upper, 1 + delta), (lower, 1 - delta)):
         if not (np.isfinite(m.value) and m.value > 0):
             continue
+        checked += 1
         beyond = m.value * step
         if m.frequency == np.inf or not k_lo < beyond < k_hi:
             # a margin set by an ill-posed gain: just inside must be stable
@@ -581,14 +583,34 @@ def _verify(L, loop, upper, lower, k_lo=0.0, k_hi=np.inf, delta=1e-3, nsteps=Non
                       f"the gains {bad} contradict the gain margins ({lower.value:.6g}, "
                       f"{upper.value:.6g}): a crossing was missed between grid points; "
                       "increase omega_num", UserWarning, stacklevel=3)
+    return checked > 0 and not bad
 
 
-def _check_edge(loop, Lh, tol):
-    """Warn when the outermost harmonic blocks of L̂_N are not small."""
-    m, N = loop.m, loop.N
-    edge = max(np.abs(Lh[:, :m, :]).max(), np.abs(Lh[:, -m:, :]).max(),
+def _edge_size(loop, Lh):
+    """Largest |L̂| in the outermost harmonic blocks of the stack `Lh`."""
+    m = loop.m
+    return max(np.abs(Lh[:, :m, :]).max(), np.abs(Lh[:, -m:, :]).max(),
                np.abs(Lh[:, :, :m]).max(), np.abs(Lh[:, :, -m:]).max())
-    if edge > tol:
+
+
+def _check_edge(loop, Lh, tol, confirmed=False):
+    """Warn when the outermost harmonic blocks of L̂_N are not small.
+
+    `Lh` is the stack of L̂_N or the size `_edge_size` found in it.  When the
+    Floquet check `confirmed` the gain margins, the warning says so and
+    restricts its doubt to the margins that check does not cover.
+    """
+    N = loop.N
+    edge = Lh if np.ndim(Lh) == 0 else _edge_size(loop, Lh)
+    if edge <= tol:
+        return
+    if confirmed:
         warnings.warn(f"the loop HTF is not small at its truncation edge (|L̂| up to "
-                      f"{edge:.2g} in harmonics ±{N}): margins beyond them may be "
-                      "missed; increase nharmonics", UserWarning, stacklevel=3)
+                      f"{edge:.2g} in harmonics ±{N}); the gain margins are confirmed by "
+                      "the Floquet exponents of the closed loop, the phase, stability and "
+                      "disk margins are not: increase nharmonics to confirm them",
+                      UserWarning, stacklevel=3)
+        return
+    warnings.warn(f"the loop HTF is not small at its truncation edge (|L̂| up to "
+                  f"{edge:.2g} in harmonics ±{N}): margins beyond them may be "
+                  "missed; increase nharmonics", UserWarning, stacklevel=3)

@@ -22,6 +22,17 @@ mostly their outer rows and columns, and the result keeps the harmonics
 ``|k| <= nharmonics`` (default ``K_t``) of the central row.  The entry
 ``(n, m)`` needs the input excited at ``ω + mω_p``: the result is known
 where ``ω ± K_t ω_p`` lie in the excited band.
+
+Standard deviations (when the estimate has ``std``): to first order, with
+``𝒢_y = 𝒫 𝒢_u`` at the true values, ``δ𝒫 = (δ𝒢_y − 𝒫 δ𝒢_u) 𝒢_u⁺``
+(also for the pseudo-inverse: the term of ``δ(𝒢_u⁺)`` outside the range
+of ``𝒢_u`` is multiplied by ``𝒢_y (I − 𝒢_u⁺𝒢_u) = 0``).  With
+``A = [I, −𝒫]`` acting on the rows ``[y; u]`` and ``B = 𝒢_u⁺``, and the
+HTM entries' errors taken as independent with variances ``σ²`` (the
+``std`` of the estimate), ``var 𝒫[r, s] = Σ_ij |A_ri|² σ_ij² |B_js|²``.
+Entries of `estimate_htf` at one frequency come from one least-squares
+fit and may be correlated, so this is an estimate of the spread, like
+the ``std`` it starts from.
 """
 
 import numpy as np
@@ -58,7 +69,9 @@ def joint_io_htf(htf, inputs, nharmonics=None, *, name=None):
     HTFData
         ``P_k(jω)``, ``|k| <= nharmonics``, on the frequencies of `htf` at
         which every shifted component the HTMs need is known (NaN
-        elsewhere), with the input and output labels of `htf`'s outputs.
+        elsewhere), with the input and output labels of `htf`'s outputs;
+        ``std`` propagated to first order from that of `htf` (module
+        notes), None when `htf` has none.
 
     Raises
     ------
@@ -117,31 +130,60 @@ def joint_io_htf(htf, inputs, nharmonics=None, *, name=None):
     where = {b: i for i, b in enumerate(bins)}
     ny, nu = yidx.size, idx.size
     out = np.full((2 * Kp + 1, ny, nu, omega.size), np.nan + 0j)
+    std = None if htf.std is None else np.full(out.shape, np.nan)
     harm = np.arange(-Kt, Kt + 1)
+    H = 2 * Kt + 1
+    # the central row's columns m = -k, k = -Kp..Kp
+    cols = slice(Kt + Kp, Kt - Kp - 1 if Kt - Kp else None, -1)
     for i, b in enumerate(bins):
         # G_k(j(ω + nω_p)) for every n: the grid at b + nL, or conj G_{-k} at -(b + nL)
-        at = []
+        at, sd = [], []
         for n in harm:
             c = b + n * L
             j = where.get(abs(c))
             if j is None:
                 break
             at.append(comps[:, :, :, j] if c >= 0 else np.conj(comps[::-1, :, :, j]))
+            if std is not None:
+                sd.append(htf.std[:, :, :, j] if c >= 0 else htf.std[::-1, :, :, j])
         if len(at) < harm.size:
             continue
-        H = 2 * Kt + 1
-        G = np.zeros((H * nz, H * nr), complex)
-        for a, n in enumerate(harm):
-            for c, m in enumerate(harm):
-                G[a * nz:(a + 1) * nz, c * nr:(c + 1) * nr] = at[a][n - m + K]
+        G = _htm(at, harm, K, nz, nr)
         if not np.all(np.isfinite(G)):
             continue
         rows = G.reshape(H, nz, -1)
         Gy = rows[:, yidx].reshape(H * ny, -1)
         Gu = rows[:, idx].reshape(H * nu, -1)
-        P = Gy @ np.linalg.pinv(Gu)                       # H ny x H nu
+        Gui = np.linalg.pinv(Gu)
+        P = Gy @ Gui                                       # H ny x H nu
         centre = P[Kt * ny:(Kt + 1) * ny].reshape(ny, H, nu)     # columns m = -k
-        out[..., i] = centre[:, Kt + Kp:Kt - Kp - 1 if Kt - Kp else None:-1].transpose(1, 0, 2)
+        out[..., i] = centre[:, cols].transpose(1, 0, 2)
+        if std is not None:
+            # δ𝒫 = A δ𝒢 B, A = [I, -𝒫] on the rows [y; u], B = 𝒢_u⁺ (module notes)
+            S2 = _htm(sd, harm, K, nz, nr) ** 2
+            A = _row_map(P, H, ny, nu, nz, yidx, idx)[Kt * ny:(Kt + 1) * ny]
+            var = (np.abs(A) ** 2) @ S2 @ (np.abs(Gui) ** 2)       # ny x H nu
+            std[..., i] = np.sqrt(var.reshape(ny, H, nu)[:, cols].transpose(1, 0, 2).real)
     labels = list(htf.output_labels)
-    return HTFData(out, omega, htf.period, name=name or f"{htf.name}_plant",
+    return HTFData(out, omega, htf.period, std=std, name=name or f"{htf.name}_plant",
                    inputs=[labels[j] for j in idx], outputs=[labels[j] for j in yidx])
+
+
+def _htm(at, harm, K, nz, nr):
+    """Harmonic transfer matrix ``𝒢[n, m] = at[n][n - m + K]`` (blocks nz x nr)."""
+    H = harm.size
+    G = np.zeros((H * nz, H * nr), np.result_type(*at))
+    for a, n in enumerate(harm):
+        for c, m in enumerate(harm):
+            G[a * nz:(a + 1) * nz, c * nr:(c + 1) * nr] = at[a][n - m + K]
+    return G
+
+
+def _row_map(P, H, ny, nu, nz, yidx, idx):
+    """``A = S_y − 𝒫 S_u`` (H ny x H nz): the rows y of the HTM minus 𝒫 times its rows u."""
+    Sy = np.zeros((H, ny, H, nz))
+    Su = np.zeros((H, nu, H, nz))
+    for a in range(H):
+        Sy[a, np.arange(ny), a, yidx] = 1.0
+        Su[a, np.arange(nu), a, idx] = 1.0
+    return Sy.reshape(H * ny, H * nz) - P @ Su.reshape(H * nu, H * nz)

@@ -118,6 +118,16 @@ def lifted_frequency_response(response, period, nharmonics=None, *, frequencies=
         ``U sinc²(ΩTs/2)`` or ``U sinc(ΩTs/2) e^{-jΩTs/2}``, which removes the
         hold's gain and phase from the response (its spectral images remain
         as a small error).
+        The default differs from `identify_ltp`'s ``'auto'`` on purpose: this
+        estimator, like `estimate_htf`, reports what the recorded samples
+        say and assumes nothing about the signal between them (exact for
+        the samples of a continuous input, and for a static or direct path,
+        whose output samples see the input samples, as in the examples
+        below), while `identify_ltp` fits and simulates a continuous-time
+        plant and must decide what input it saw.  For records of
+        `ltpcontrol.forced_response` (linear interpolation) pass
+        ``input_hold='foh'`` (and `feedthrough` when D ≠ 0) to get the
+        data `identify_ltp` fits.
     hold_step : float, optional
         Step (s) of the input hold; default the step ``Ts`` of `timepts`.
         Give it when the records were decimated from a finer simulation

@@ -158,7 +158,9 @@ def identify_ltp(data, period, nstates, nharmonics=1, *, q=None, conversion='ref
         the wrong hold can fit them better than under the right one (a
         modulated first-order plant from ZOH records: relative residual
         1.2e-3 taken as 'foh', 3.6e-3 as 'zoh', yet fresh ZOH records
-        predicted with NRMSE 0.23 and 0.009).  With an `input_hold` and 'refit', the
+        predicted with NRMSE 0.23 and 0.009).  (`lifted_frequency_response`
+        defaults to None: as an estimator it reports the samples' response;
+        see there.)  With an `input_hold` and 'refit', the
         data are recomputed with the fitted ``D(t)`` as their `feedthrough`
         and refitted once, which removes the hold's bias on the direct
         term.
