@@ -12,16 +12,15 @@ its own calls A and B at two Gauss points of every Magnus sub-step, over
 and over (``_core/transition.py``).  Here A and B are sampled once per
 piece of k cells, at G Chebyshev points of the first kind (interior
 points, so a switching instant at a piece's edge is never sampled), and
-their values at the Gauss points of the fourth-order Magnus sub-steps
+their values at the three Gauss points of sixth-order Magnus steps of the augmented matrix
 
-    Ω = δ/2 (M1 + M2) + √3/12 δ² [M2, M1],   M = [[A, B, σB], [0, 0, 0], [0, 0, 0]]
+    M = [[A, B, σB], [0, 0, 0], [0, 0, 0]]
 
-(``σ = (τ - a)/(b - a)``) come from the piece's polynomial interpolant:
+(``σ = (τ - a)/(b - a)``, `_magnus6`) come from the piece's polynomial interpolant:
 one matrix product per cell position, since the Gauss points sit at the
 same fractions of every piece.  The number of calls of A and B is G per
-piece, whatever the cells, degrees and sub-steps.  Both sub-step counts
-m/2 and m are integrated and Richardson-extrapolated, as the adaptive
-integrator does.
+piece, whatever the cells, degrees and steps.  The exponentials of the short
+steps are Taylor series (no linear solves).
 
 `CellSamples.tail` measures how well the interpolant resolves A and B on
 every piece (the last Chebyshev coefficients, relative to the largest
@@ -37,7 +36,10 @@ from .transition import _balancing, _tree_product, expm_batch
 
 __all__ = []
 
-_C1, _C2 = 0.5 - np.sqrt(3) / 6, 0.5 + np.sqrt(3) / 6
+#: Gauss-Legendre points of [0, 1] with three nodes
+_GAUSS3 = np.array([0.5 - np.sqrt(15) / 10, 0.5, 0.5 + np.sqrt(15) / 10])
+#: largest 1-norm of the exponents taken by Taylor series (else scaling and squaring)
+_TAYLOR_NORM = 0.25
 #: entries of the working arrays of one chunk of cells
 _CHUNK_ENTRIES = 2 ** 19
 
@@ -54,6 +56,41 @@ def chebyshev_first_kind(G):
     """
     theta = np.pi * (2 * np.arange(G) + 1) / (2 * G)
     return 0.5 - 0.5 * np.cos(theta), (-1.0) ** np.arange(G) * np.sin(theta)
+
+
+def _magnus6(M1, M2, M3, h):
+    """Sixth-order Magnus exponent from M at the three Gauss points of a step h.
+
+    With ``α1 = h M2``, ``α2 = √15/3 h (M3 - M1)``, ``α3 = 10/3 h (M3 - 2 M2 + M1)``:
+    ``Ω = α1 + α3/12 + [-20 α1 - α3 + C1, α2 + C2]/240``, ``C1 = [α1, α2]``,
+    ``C2 = -[α1, 2 α3 + C1]/60`` (Blanes, Casas and Ros).
+    """
+    a1 = h * M2
+    a2 = (np.sqrt(15) / 3) * h * (M3 - M1)
+    a3 = (10 / 3) * h * (M3 - 2 * M2 + M1)
+    C1 = a1 @ a2 - a2 @ a1
+    X = 2 * a3 + C1
+    C2 = -(a1 @ X - X @ a1) / 60
+    L, R = -20 * a1 - a3 + C1, a2 + C2
+    return a1 + a3 / 12 + (L @ R - R @ L) / 240
+
+
+def _expm_small(X):
+    """e^X of a stack; Taylor series when every 1-norm is at most 0.25."""
+    norms = np.abs(X).sum(axis=-2).max(axis=-1)
+    top = float(norms.max()) if len(norms) else 0.0
+    if top > _TAYLOR_NORM:
+        return expm_batch(X)
+    # the truncation error top^(K+1)/(K+1)! below 2^-54
+    K, term = 1, top
+    while term > 2.0 ** -54 and K < 30:
+        K += 1
+        term *= top / K
+    eye = np.eye(X.shape[-1])
+    E = eye + X / K
+    for j in range(K - 1, 0, -1):
+        E = eye + (X @ E) / j
+    return E
 
 
 def barycentric_matrix(x, nodes, weights):
@@ -151,22 +188,19 @@ class CellSamples:
         vals = self.values.reshape(len(self.values), self.G, n, n + self.m)[..., :n]
         return np.repeat(np.abs(vals).max(axis=(1, 2, 3)), self.k)
 
-    def interval_data(self, fractions, nsub, cells=None, extrapolate=True):
+    def interval_data(self, fractions, nsub, cells=None):
         """(Φ, W, Z) of the sub-intervals ``[x_k, x_{k+1}]`` of the cells.
+
+        Sixth-order Magnus steps (module notes), `nsub` per sub-interval.
 
         Parameters
         ----------
         fractions : ndarray, shape (D + 1,)
             Increasing fractions of the cell length, from 0 to 1.
         nsub : int
-            Magnus sub-steps per sub-interval.
+            Magnus steps per sub-interval.
         cells : ndarray of int, optional
             The cells (default: all).
-        extrapolate : bool
-            Also integrate with half the sub-steps and return the
-            Richardson-extrapolated value ``E + (E - E_half)/15`` (the
-            error of a fourth-order step scales as its length to the fifth),
-            as the adaptive integrator does; costs no more calls of A or B.
 
         Returns
         -------
@@ -177,26 +211,20 @@ class CellSamples:
         d = n + 2 * m
         cells = np.arange(len(self.lens)) if cells is None else np.asarray(cells)
         D = len(fractions) - 1
-        # Gauss points of every sub-step of every sub-interval, as cell fractions
+        # Gauss points of every step of every sub-interval, as cell fractions
         width = np.diff(fractions)                                      # (D,)
-        counts = (nsub // 2, nsub) if extrapolate and nsub > 1 else (nsub,)
-        # sub-steps of all resolutions side by side: nsub / 2 then nsub
-        sub = np.concatenate([(np.arange(c)[:, None] + np.array([_C1, _C2])) / c
-                              for c in counts])                          # (S, 2)
-        frac = fractions[:-1, None, None] + width[:, None, None] * sub  # (D, S, 2)
-        S = len(sub)
+        sub = (np.arange(nsub)[:, None] + _GAUSS3) / nsub               # (nsub, 3)
+        frac = fractions[:-1, None, None] + width[:, None, None] * sub  # (D, nsub, 3)
         # as fractions of the pieces, for the k positions of a cell in its piece
-        Q = D * S * 2
-        at = (np.arange(self.k)[:, None] + frac.ravel()) / self.k              # (k, Q)
+        Q = D * nsub * 3
+        at = (np.arange(self.k)[:, None] + frac.ravel()) / self.k      # (k, Q)
         P = barycentric_matrix(at.ravel(), self.nodes, self.weights).reshape(self.k, Q, -1)
         sigma = np.broadcast_to(sub, frac.shape).ravel()
-        # the step length of every sub-step, relative to its sub-interval
-        rel = np.concatenate([np.full(c, 1.0 / c) for c in counts])
         ratio = None if self.scale is None else self.scale[None, :] / self.scale[:, None]
         Nc = len(cells)
         Phi = np.empty((Nc, D, n, n))
         W, Z = np.empty((Nc, D, n, m)), np.empty((Nc, D, n, m))
-        chunk = max(1, _CHUNK_ENTRIES // (D * S * 2 * d * d))
+        chunk = max(1, _CHUNK_ENTRIES // (Q * d * d))
         with small_blas(d):
             for c0 in range(0, Nc, chunk):
                 sel = cells[c0:c0 + chunk]
@@ -207,19 +235,11 @@ class CellSamples:
                 M[..., :n, n + m:] = sigma[:, None, None] * vals[..., n:]
                 if ratio is not None:
                     M *= ratio
-                M = M.reshape(k, D, S, 2, d, d)
-                M1, M2 = M[:, :, :, 0], M[:, :, :, 1]
-                delta = (self.lens[sel, None, None] * width[:, None] * rel)[..., None, None]
-                Omega = 0.5 * delta * (M1 + M2) + (np.sqrt(3) / 12) * delta ** 2 * (
-                    M2 @ M1 - M1 @ M2)
-                E = expm_batch(Omega.reshape(-1, d, d)).reshape(k * D, S, d, d)
-                if len(counts) == 2:
-                    half = _tree_product(E[:, :counts[0]])
-                    E = _tree_product(E[:, counts[0]:])
-                    E += (E - half) / 15
-                else:
-                    E = _tree_product(E)
-                E = E.reshape(k, D, d, d)
+                M = M.reshape(k, D, nsub, 3, d, d)
+                delta = (self.lens[sel, None, None] * width[:, None] / nsub)[..., None, None]
+                Omega = _magnus6(M[:, :, :, 0], M[:, :, :, 1], M[:, :, :, 2], delta)
+                E = _expm_small(Omega.reshape(-1, d, d)).reshape(k * D, nsub, d, d)
+                E = _tree_product(E).reshape(k, D, d, d)
                 if ratio is not None:
                     E *= self.scale[:, None] / self.scale[None, :]
                 Phi[c0:c0 + k] = E[..., :n, :n]
@@ -228,3 +248,91 @@ class CellSamples:
                 Z[c0:c0 + k] = E[..., :n, n + m:] * (self.lens[sel, None] * width)[..., None,
                                                                                    None]
         return Phi, W, Z
+
+
+def lobatto(D):
+    """Chebyshev-Lobatto fractions of [0, 1] (symmetric) and their barycentric weights.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.celldata import lobatto
+    >>> x, w = lobatto(2)
+    >>> x, w
+    (array([0. , 0.5, 1. ]), array([ 0.5, -1. ,  0.5]))
+    """
+    k = np.arange(D + 1)
+    return 0.5 - 0.5 * np.cos(np.pi * k / D), (-1.0) ** k * np.where(k % D == 0, 0.5, 1.0)
+
+
+def interpolate(table, frac, cells, xi):
+    """Values at the fractions `xi` of cells `cells` of a table (cells, D+1, ...).
+
+    Barycentric interpolation at the Chebyshev-Lobatto fractions `frac`;
+    `table` is an array or a tuple of arrays with the same two leading axes.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.celldata import interpolate, lobatto
+    >>> frac, _ = lobatto(4)
+    >>> table = (frac ** 3)[None, :]                 # one cell, values of x³
+    >>> interpolate(table, frac, np.array([0, 0]), np.array([0.5, 0.1]))
+    array([0.125, 0.001])
+    """
+    single = not isinstance(table, tuple)
+    parts = (table,) if single else table
+    D = len(frac) - 1
+    _, weights = lobatto(D)
+    w = barycentric_matrix(np.clip(xi, 0.0, 1.0), frac, weights)          # (S, D+1)
+    sizes = [int(np.prod(v.shape[2:])) for v in parts]
+    flat = np.concatenate([v.reshape(v.shape[0], D + 1, -1) for v in parts], axis=2) \
+        if len(parts) > 1 else parts[0].reshape(parts[0].shape[0], D + 1, -1)
+    out = np.empty((len(xi), flat.shape[2]))
+    if len(xi) * (D + 1) * flat.shape[2] <= 2 ** 22:
+        # gather the cells' values: one product per sample
+        np.matmul(w[:, None, :], flat[cells], out=out[:, None, :])
+    else:
+        # one matrix product per cell on the sorted samples
+        order = np.argsort(cells, kind='stable')
+        cs, ws = cells[order], w[order]
+        bounds = np.flatnonzero(np.diff(cs)) + 1
+        starts, ends = np.concatenate([[0], bounds]), np.concatenate([bounds, [len(cs)]])
+        sorted_out = np.empty_like(out)
+        for a, b in zip(starts, ends):
+            if b > a:
+                np.matmul(ws[a:b], flat[cs[a]], out=sorted_out[a:b])
+        out[order] = sorted_out
+    res = tuple(q.reshape((len(xi),) + v.shape[2:])
+                for q, v in zip(np.split(out, np.cumsum(sizes)[:-1], axis=1), parts))
+    return res[0] if single else res
+
+
+class CellTable:
+    """Data of the cells of one period and of their first and last parts.
+
+    ``edges`` (N + 1,) and ``lens`` (N,) of the cells, ``frac`` the
+    Chebyshev-Lobatto fractions of the part lengths, ``fwd`` and ``bwd``
+    the tuples (Φ, W, Z) of ``[e_j, e_j + ℓ_i]`` and ``[e_{j+1} - ℓ_i,
+    e_{j+1}]``, ``ℓ_i = frac_i lens_j``, each of shape (N, D + 1, ...);
+    ``fwd[q][:, -1]`` are the whole cells.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.celldata import CellTable, lobatto
+    >>> frac, _ = lobatto(2)
+    >>> P = np.exp(-frac)[None, :, None, None]          # ẋ = -x on the cell [0, 1]
+    >>> W = Z = np.zeros((1, 3, 1, 1))
+    >>> table = CellTable(np.array([0.0, 1.0]), np.array([1.0]), frac, (P, W, Z), (P, W, Z))
+    >>> bool(table.first(np.array([0]), np.array([1.0]))[0][0, 0, 0] == np.exp(-1.0))
+    True
+    """
+
+    def __init__(self, edges, lens, frac, fwd, bwd):
+        self.edges, self.lens, self.frac, self.fwd, self.bwd = edges, lens, frac, fwd, bwd
+
+    def first(self, j, length, parts=(0, 1, 2)):
+        """(Φ, W, Z) (or the `parts` asked for) of ``[e_j, e_j + length]``."""
+        return interpolate(tuple(self.fwd[q] for q in parts), self.frac, j, length / self.lens[j])
+
+    def last(self, j, length, parts=(0, 1, 2)):
+        """(Φ, W, Z) (or the `parts` asked for) of ``[e_{j+1} - length, e_{j+1}]``."""
+        return interpolate(tuple(self.bwd[q] for q in parts), self.frac, j, length / self.lens[j])

@@ -15,8 +15,8 @@ there are samples.  Instead:
   head piece ``[t_k, e_{j+1}]``, c whole cells and a tail piece
   ``[e_J, t_k + h_k]``.  The data of every cell, and of its first and last
   parts at the D + 1 Chebyshev-Lobatto lengths ℓ, are integrated once
-  (``_core/celldata.py``: A and B sampled once per piece, fourth-order
-  Magnus sub-steps on the interpolated values, Richardson-extrapolated);
+  (``_core/celldata.py``: A and B sampled once per piece, sixth-order
+  Magnus steps on the interpolated values);
   a step's head and tail come from the first and last parts
   ``[e_j, e_j + ℓ]``, ``[e_{j+1} - ℓ, e_{j+1}]`` interpolated in ℓ.  The
   samples per piece, the degree D and the sub-steps are the cheapest that
@@ -46,7 +46,8 @@ from fractions import Fraction
 
 import numpy as np
 
-from .celldata import CellSamples, barycentric_matrix
+from .celldata import CellSamples, CellTable, interpolate, lobatto
+from .cellmarch import cell_march
 from .march import periodic_march
 from .transition import step_transitions
 
@@ -61,8 +62,8 @@ _MAX_REPEAT = 4096           # longest repeating phase pattern used as a period
 _TABLE_TOL = 1e-13           # accepted interpolation error (relative to a cell's data)
 _PIECE_CELLS = 8             # cells per piece on which A and B are interpolated
 _SAMPLES = (12, 20, 32)      # Chebyshev samples of A and B per piece, tried in turn
-# (degree D of the partial-cell interpolants, Magnus sub-steps per sub-interval), by cost
-_LADDER = ((5, 2), (6, 2), (8, 2), (8, 4), (10, 4), (12, 8))
+# (degree D of the partial-cell interpolants, Magnus steps per sub-interval), by cost
+_LADDER = ((4, 1), (5, 1), (6, 1), (8, 1), (8, 2), (10, 2), (12, 4))
 _PHASE_MAX = 1024            # most phases of the interpolated step data of a uniform grid
 
 
@@ -110,7 +111,12 @@ def grid_march(A, B, C, D, t, u, x0, hold, rtol, states=True):
             if repeat is None and np.allclose(h, h[0], rtol=1e-10, atol=0):
                 # a uniform grid: the step data are smooth periodic functions of the phase
                 table = _phase_table(A, B, float(h[0]), T, rtol)
-            if table is None:
+            if table is None and repeat is None:
+                # any other grid: march over the cells of a phase table
+                cells = _cell_table(A, B, h, T, rtol)
+                if cells is not None:
+                    return cell_march(cells, C, D, t, u, x0, hold, states)
+            elif table is None:
                 table = _table_steps(A, B, h, T, rtol)
     if repeat is not None:
         # the step data repeat every q steps: march with period q
@@ -289,10 +295,9 @@ class _PhaseInterpolant:
         return X[:, :, :n], X[:, :, n:n + m], X[:, :, n + m:]
 
 
-def _table_steps(A, B, h, T, rtol):
-    """Step data from a phase table (module notes), or None when not exact enough."""
-    hmin, hmax = float(h.min()), float(h.max())
-    n, m = A.shape[0], B.shape[1]
+def _cell_table(A, B, h, T, rtol):
+    """The phase table of the steps `h` (module notes), or None when not exact enough."""
+    hmin = float(h.min())
     tol = max(_TABLE_TOL, 0.1 * rtol)
     # pieces of about _PIECE_CELLS cells (split at the switching instants),
     # on which A and B are sampled; cells shorter than the shortest step (so
@@ -300,11 +305,13 @@ def _table_steps(A, B, h, T, rtol):
     # count of the ladder meets the tolerance
     N0 = max(16, math.floor(T / hmin) + 1)
     bps = np.mod(np.concatenate([A.breakpoints, B.breakpoints]), T)
-    Ns = -(-N0 // _PIECE_CELLS)
+    # a multiple of 5 pieces: the cells of a period have a divisor near the
+    # block length of the periodic march
+    Ns = -(-N0 // (5 * _PIECE_CELLS)) * 5
     pieces = np.union1d(np.linspace(0, T, Ns + 1), bps)
     pieces = pieces[np.concatenate([[True], np.diff(pieces) > 1e-12 * T])]
     pieces[-1] = T
-    k0 = -(-N0 // Ns)
+    k0 = _PIECE_CELLS
     if k0 * (len(pieces) - 1) > _MAX_CELLS:
         return None
     # A and B on every piece at the fewest Chebyshev points that resolve them
@@ -324,9 +331,20 @@ def _table_steps(A, B, h, T, rtol):
     else:
         return None
     frac, nsub = config
-    partial = _partial_table(cells, frac, nsub)
-    edges, lens = cells.edges, cells.lens
+    fwd, bwd = _partial_table(cells, frac, nsub)
+    return CellTable(cells.edges, cells.lens, frac, fwd, bwd)
+
+
+def _table_steps(A, B, h, T, rtol):
+    """Step data ``steps(tk, hk) -> (Φ, Γ0, Γ1)`` from a phase table, or None."""
+    table = _cell_table(A, B, h, T, rtol)
+    if table is None:
+        return None
+    hmax = float(h.max())
+    n, m = A.shape[0], B.shape[1]
+    edges, lens, frac = table.edges, table.lens, table.frac
     N = len(lens)
+    partial = table.fwd, table.bwd
     # the composition rule as a product of augmented matrices
     # [[Φ, W, Z], [0, I, ℓI], [0, 0, I]] (ℓ the interval's length)
     nodes = lens[:, None] * frac
@@ -355,7 +373,7 @@ def _table_steps(A, B, h, T, rtol):
         jb = np.clip(np.searchsorted(edges, phi - wraps * T, side='right') - 1, 0, N - 1)
         count = (jb + N * wraps.astype(int)) - j - 1
         # head [θ, e_{j+1}] and tail [e_J, t_k + h_k] from the partial cells
-        M = _interpolate(bwd, frac, j, (edges[j + 1] - theta) / lens[j])
+        M = interpolate(bwd, frac, j, (edges[j + 1] - theta) / lens[j])
         # the run of `count` cells after cell j, by the binary digits of count
         pos = (j + 1) % N
         if runs is not None:
@@ -366,22 +384,16 @@ def _table_steps(A, B, h, T, rtol):
                 if np.any(sel):
                     M[sel] = run[pos[sel]] @ M[sel]
                     pos = np.where(sel, (pos + 2 ** i) % N, pos)
-        tail = _interpolate(fwd, frac, jb, (phi - wraps * T - edges[jb]) / lens[jb])
+        tail = interpolate(fwd, frac, jb, (phi - wraps * T - edges[jb]) / lens[jb])
         M = tail @ M
         return M[:, :n, :n], M[:, :n, n:n + m], M[:, :n, n + m:] / hk[:, None, None]
     return steps
 
 
-def _lobatto(D):
-    """Chebyshev-Lobatto fractions of [0, 1] (symmetric) and their barycentric weights."""
-    k = np.arange(D + 1)
-    return 0.5 - 0.5 * np.cos(np.pi * k / D), (-1.0) ** k * np.where(k % D == 0, 0.5, 1.0)
-
-
 def _table_config(A, B, cells, rtol, tol):
     """``(fractions, sub-steps)`` of the cheapest accurate table, or None.
 
-    Degrees D and Magnus sub-steps are tried in order of cost on probe
+    Degrees D and Magnus steps are tried in order of cost on probe
     cells (spread over the period, the cell of the largest |A| and the
     least resolved one) until the interpolated head and tail pieces agree
     with the adaptive integrator at probe lengths to `tol`.
@@ -399,10 +411,10 @@ def _table_config(A, B, cells, rtol, tol):
                     np.concatenate([length, length]), rtol, A.shape[0])
     sub = np.repeat(np.arange(len(probe)), 3)
     for D, nsub in _LADDER:
-        nodes, _ = _lobatto(D)
+        nodes, _ = lobatto(D)
         err = 0.0
         for end, table in enumerate(_partial_table(cells, nodes, nsub, probe)):
-            approx = _interpolate(table, nodes, sub, xi)
+            approx = interpolate(table, nodes, sub, xi)
             ref = tuple(v[end * len(j):(end + 1) * len(j)] for v in exact)
             for i, (e, a, whole) in enumerate(zip(ref, approx, table)):
                 # Φ relative to max(1, |Φ|); W, Z relative to their size over a cell
@@ -451,36 +463,6 @@ def _partial_table(cells, frac, nsub, which=None):
         Pb[:, i + 1], Wb[:, i + 1], Zb[:, i + 1] = _compose(
             (Phi[:, k], W1[:, k], Z1[:, k]), (Pb[:, i], Wb[:, i], Zb[:, i]), dd[:, k])
     return (P, W, Z), (Pb, Wb, Zb)
-
-
-def _interpolate(table, frac, cells, xi):
-    """Values at the fractions `xi` of cells `cells` of a table (cells, D+1, ...).
-
-    Barycentric interpolation at the fractions `frac`; `table` is an array or
-    a tuple of arrays with the same two leading axes.
-    """
-    if isinstance(table, tuple):
-        return tuple(_interpolate(v, frac, cells, xi) for v in table)
-    D = len(frac) - 1
-    _, weights = _lobatto(D)
-    w = barycentric_matrix(np.clip(xi, 0.0, 1.0), frac, weights)                     # (S, D+1)
-    flat = table.reshape(table.shape[0], D + 1, -1)
-    out = np.empty((len(xi), flat.shape[2]))
-    if len(xi) * (D + 1) * flat.shape[2] <= 2 ** 22:
-        # gather the cells' values: one product per sample
-        np.einsum('si,sie->se', w, flat[cells], out=out)
-    else:
-        # one matrix product per cell on the sorted samples
-        order = np.argsort(cells, kind='stable')
-        cs, ws = cells[order], w[order]
-        bounds = np.flatnonzero(np.diff(cs)) + 1
-        starts, ends = np.concatenate([[0], bounds]), np.concatenate([bounds, [len(cs)]])
-        sorted_out = np.empty_like(out)
-        for a, b in zip(starts, ends):
-            if b > a:
-                np.matmul(ws[a:b], flat[cs[a]], out=sorted_out[a:b])
-        out[order] = sorted_out
-    return out.reshape((len(xi),) + table.shape[2:])
 
 
 def _pieces(A, B, a, length, rtol, n):

@@ -1,0 +1,202 @@
+"""Exact simulation on any grid by a march over the cells of a phase table.
+
+A phase table (``_core/gridmarch.py``) cuts one period into N cells
+``[e_j, e_{j+1}]`` shorter than the shortest step of the grid, so that a
+cell holds at most one sample, and tabulates for every cell the data
+(``Φ, W, Z``, module notes of ``gridmarch``) of the whole cell and of its
+first and last parts ``[e_j, e_j + ℓ]``, ``[e_{j+1} - ℓ, e_{j+1}]`` at
+D + 1 lengths (interpolated in ℓ).
+
+Instead of assembling the transition data of every step (products of
+augmented matrices per sample), the state is marched over the cells of
+the record, a uniform grid whose data repeat every N cells (the periodic
+march of ``_core/march.py``, BLAS-3 over the periods):
+
+    x(e_{c+1}) = Φ_c x(e_c) + f_c.
+
+The input is held (zero order) or linear (first order) between samples,
+``u(s) = u_k + σ_k (s - t_k)`` on ``[t_k, t_{k+1})`` (σ_k = 0 or the
+slope), so on a cell without a sample it is ``a_c + σ (s - e_c)`` with
+``a_c = u(e_c)``, and
+
+    f_c = W_c a_c + Z_c σ.
+
+A sample ``t_k`` inside the cell adds a jump J (zero-order hold) and a
+change of slope Δσ from ``t_k`` on: ``W_b J + Z_b Δσ`` with the data of
+the last part ``[t_k, e_{c+1}]``.  The state at the sample comes from the
+first part ``[e_c, t_k]``:
+
+    x(t_k) = Φ_f x(e_c) + W_f a_c + Z_f σ_{k-1}.
+
+Per sample, two interpolations in ℓ (n(n + 2m) and 2nm numbers) and a
+matrix-vector product; no step's transition matrix is formed.  Memory is
+linear in the record (the cell states) and bounded per chunk of samples.
+"""
+
+import numpy as np
+
+
+__all__ = []
+
+_CHUNK = 4096                  # samples interpolated at a time
+_BLOCK = 32                    # block length of the forced march (about)
+
+
+def cell_march(table, C, D, t, u, x0, hold, states=True):
+    """States and outputs on the grid `t` through the cells of `table`.
+
+    Parameters
+    ----------
+    table : CellTable
+        Phase table whose cells are shorter than the shortest step of `t`.
+    C, D : PeriodicMatrix
+    t : ndarray, shape (L,)
+    u : ndarray, shape (m, R, L)
+    x0 : ndarray, shape (n, R)
+    hold : {'foh', 'zoh'}
+    states : bool
+
+    Returns
+    -------
+    x : ndarray, shape (n, R, L), or None
+    y : ndarray, shape (p, R, L)
+
+    Examples
+    --------
+    A first-order lag on a non-uniform grid (constant input: ``1 - e^{-t}``):
+
+    >>> from ltpcontrol._core.cellmarch import cell_march
+    >>> from ltpcontrol._core.gridmarch import _cell_table
+    >>> sys = ltp.ltpss([[-1.0]], [[1.0]], [[1.0]], 0, period=1.0)
+    >>> t = np.cumsum(np.r_[0.0, np.random.default_rng(0).uniform(0.2, 0.3, 40)])
+    >>> table = _cell_table(sys.A, sys.B, np.diff(t), 1.0, 1e-12)
+    >>> x, y = cell_march(table, sys.C, sys.D, t, np.ones((1, 1, 41)), np.zeros((1, 1)),
+    ...                   'foh')
+    >>> bool(np.allclose(y[0, 0], 1 - np.exp(-t), rtol=0, atol=1e-13))
+    True
+    """
+    edges, T = table.edges, table.edges[-1]
+    N = len(table.lens)
+    n, R = x0.shape
+    m, L = u.shape[0], len(t)
+    p = C.shape[0]
+    # cell of every sample, counted from the start of the period of t[0]
+    base = np.floor(t[0] / T)
+    wraps = np.floor(t / T)
+    theta = t - wraps * T
+    j = np.clip(np.searchsorted(edges, theta, side='right') - 1, 0, N - 1)
+    g = (wraps - base).astype(np.int64) * N + j
+    ell = np.clip(theta - edges[j], 0.0, table.lens[j])           # first part
+    # slopes of the held input on [t_k, t_{k+1}) (zero after the last sample)
+    sigma = np.zeros((m, R, L))
+    if hold == 'foh':
+        sigma[:, :, :-1] = np.diff(u, axis=2) / np.diff(t)
+    # cell edges e(c) for c = g0 + 1 .. gL (the states marched), their times,
+    # the interval [t_k, t_{k+1}) holding each and the input there
+    g0, gL = int(g[0]), int(g[-1])
+    cells = np.arange(g0 + 1, gL + 1)
+    tau = (base + cells // N) * T + edges[cells % N]
+    k = np.clip(np.searchsorted(t, tau, side='right') - 1, 0, L - 1)
+    a = u[:, :, k] + sigma[:, :, k] * (tau - t[k])                 # (m, R, cells)
+    sig = sigma[:, :, k]
+    # forcing of the cells c = g0 + 1 .. gL - 1 (the last entry is not used)
+    ph = cells % N
+    W, Z = table.fwd[1][:, -1], table.fwd[2][:, -1]                # whole cells
+    f = (_apply(W[ph], a) + _apply(Z[ph], sig))
+    # samples inside the marched cells: the jump and the change of slope
+    inner = np.flatnonzero((g > g0) & (g < gL))
+    for s0 in range(0, len(inner), _CHUNK):
+        i = inner[s0:s0 + _CHUNK]
+        c = g[i] - g0 - 1
+        Wb, Zb = table.last(j[i], table.lens[j[i]] - ell[i], parts=(1, 2))
+        before = a[:, :, c] + sig[:, :, c] * (t[i] - tau[c])
+        jump = u[:, :, i] - before
+        f[:, :, c] += _apply(Wb, jump) + _apply(Zb, sigma[:, :, i] - sig[:, :, c])
+    # the first sample: its cell's last part carries x0 to e(g0 + 1)
+    Pb, Wb, Zb = table.last(j[:1], table.lens[j[:1]] - ell[:1])
+    x1 = Pb[0] @ x0 + Wb[0] @ u[:, :, 0] + Zb[0] @ sigma[:, :, 0]
+    # the march over the cells, phase (g0 + 1) mod N first
+    Phi = np.roll(table.fwd[0][:, -1], -((g0 + 1) % N), axis=0)
+    xe = forced_march(Phi, f, x1)
+    # states and outputs at the samples, from the first part of their cell
+    x = np.empty((n, R, L)) if states else None
+    y = np.empty((p, R, L))
+    for s0 in range(0, L, _CHUNK):
+        i = np.arange(s0, min(L, s0 + _CHUNK))
+        xs = np.empty((n, R, len(i)))
+        first = i[0] == 0
+        if first:
+            xs[:, :, 0] = x0
+        rest = i[1:] if first else i
+        if len(rest):
+            c = g[rest] - g0 - 1                         # e(g[rest]) is edge c of xe
+            Pf, Wf, Zf = table.first(j[rest], ell[rest])
+            prev = rest - 1
+            xs[:, :, len(i) - len(rest):] = (
+                _apply(Pf, xe[:, :, c]) + _apply(Wf, a[:, :, c]) + _apply(Zf, sigma[:, :, prev]))
+        tk = t[i]
+        y[:, :, i] = _apply(C(tk), xs) + _apply(D(tk), u[:, :, i])
+        if states:
+            x[:, :, i] = xs
+    return x, y
+
+
+def _apply(M, v):
+    """``M[s] @ v[:, :, s]`` for every s: M (S, a, b), v (b, R, S) -> (a, R, S)."""
+    return (M @ v.transpose(2, 0, 1)).transpose(1, 2, 0)
+
+
+def forced_march(Phi, f, x0):
+    """States of ``x[c+1] = Φ_{c mod N} x[c] + f[c]``, ``x[0] = x0``, for c < J.
+
+    Blocks of b cells (b a divisor of N near 32, else 1 block per cell
+    product): the transitions ``Φ(k, 0)`` of the N/b block phases are
+    formed once; inside every block the forced part from a zero start is
+    unrolled for all blocks at once (a loop over the b positions), and the
+    block starts are marched block by block.  Work O(J n² R + N n³).
+
+    Parameters
+    ----------
+    Phi : ndarray, shape (N, n, n)
+    f : ndarray, shape (n, R, J)
+    x0 : ndarray, shape (n, R)
+
+    Returns
+    -------
+    x : ndarray, shape (n, R, J)
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.cellmarch import forced_march
+    >>> Phi = np.array([[[0.5]], [[2.0]]])
+    >>> forced_march(Phi, np.ones((1, 1, 5)), np.ones((1, 1)))[0, 0]
+    array([1. , 1.5, 4. , 3. , 7. ])
+    """
+    N, n, _ = Phi.shape
+    R, J = f.shape[1], f.shape[2]
+    divisors = [b for b in range(1, min(N, 4 * _BLOCK) + 1) if N % b == 0]
+    b = min(divisors, key=lambda v: (abs(np.log(v / _BLOCK)), -v))
+    nph = N // b
+    nb = -(-J // b)
+    # phase of every block, and the inputs laid out by block: (nb, b, n, R)
+    bph = np.arange(nb) % nph
+    fb = np.zeros((nb * b, n, R))
+    fb[:J] = f.transpose(2, 0, 1)
+    fb = fb.reshape(nb, b, n, R)
+    Pb = Phi.reshape(nph, b, n, n)
+    # block-local transitions Φ(k, 0) per block phase and forced parts
+    O = np.empty((nph, b + 1, n, n))
+    O[:, 0] = np.eye(n)
+    sig = np.empty((nb, b + 1, n, R))
+    sig[:, 0] = 0.0
+    for k in range(b):
+        O[:, k + 1] = Pb[:, k] @ O[:, k]
+        sig[:, k + 1] = Pb[bph, k] @ sig[:, k] + fb[:, k]
+    # block starts
+    starts = np.empty((nb, n, R))
+    xs = x0
+    for i in range(nb):
+        starts[i] = xs
+        xs = O[bph[i], b] @ xs + sig[i, b]
+    x = O[bph, :b] @ starts[:, None] + sig[:, :b]                 # (nb, b, n, R)
+    return x.reshape(nb * b, n, R)[:J].transpose(1, 2, 0)
