@@ -33,8 +33,8 @@ def test_linspace_grid_equals_independent_integration(plant, hold):
     u = np.sin(2.1 * t) + 0.3 * np.cos(5.0 * t)
     resp = ltp.forced_response(sys, t, u, input_hold=hold)
     ref = ltp.forced_response(sys, t, u, input_hold=hold, method='solve_ivp', rtol=1e-12)
-    assert rel(resp.outputs, ref.outputs) < 1e-7          # the reference's accuracy
-    assert rel(resp.states, ref.states) < 1e-7
+    assert rel(resp.outputs, ref.outputs) < 1e-10
+    assert rel(resp.states, ref.states) < 1e-10
 
 
 def test_table_equals_per_step_integration(monkeypatch):
