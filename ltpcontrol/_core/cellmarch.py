@@ -39,7 +39,7 @@ import numpy as np
 __all__ = []
 
 _CHUNK = 4096                  # samples interpolated at a time
-_BLOCK = 32                    # block length of the forced march (about)
+_BLOCK = 64                    # longest block of the forced march (about)
 
 
 def cell_march(table, C, D, t, u, x0, hold, states=True):
@@ -84,7 +84,7 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     base = np.floor(t[0] / T)
     wraps = np.floor(t / T)
     theta = t - wraps * T
-    j = np.clip(np.searchsorted(edges, theta, side='right') - 1, 0, N - 1)
+    j = _cell_of(edges, theta)
     g = (wraps - base).astype(np.int64) * N + j
     ell = np.clip(theta - edges[j], 0.0, table.lens[j])           # first part
     # slopes of the held input on [t_k, t_{k+1}) (zero after the last sample)
@@ -100,18 +100,18 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     a = u[:, :, k] + sigma[:, :, k] * (tau - t[k])                 # (m, R, cells)
     sig = sigma[:, :, k]
     # forcing of the cells c = g0 + 1 .. gL - 1 (the last entry is not used)
-    ph = cells % N
-    W, Z = table.fwd[1][:, -1], table.fwd[2][:, -1]                # whole cells
-    f = (_apply(W[ph], a) + _apply(Z[ph], sig))
+    WZ = np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2)   # whole cells
+    f = _apply(WZ[cells % N], np.concatenate([a, sig]))
     # samples inside the marched cells: the jump and the change of slope
     inner = np.flatnonzero((g > g0) & (g < gL))
     for s0 in range(0, len(inner), _CHUNK):
         i = inner[s0:s0 + _CHUNK]
         c = g[i] - g0 - 1
         Wb, Zb = table.last(j[i], table.lens[j[i]] - ell[i], parts=(1, 2))
-        before = a[:, :, c] + sig[:, :, c] * (t[i] - tau[c])
-        jump = u[:, :, i] - before
-        f[:, :, c] += _apply(Wb, jump) + _apply(Zb, sigma[:, :, i] - sig[:, :, c])
+        sc = sig[:, :, c]
+        jump = u[:, :, i] - (a[:, :, c] + sc * (t[i] - tau[c]))
+        f[:, :, c] += _apply(np.concatenate([Wb, Zb], axis=2),
+                             np.concatenate([jump, sigma[:, :, i] - sc]))
     # the first sample: its cell's last part carries x0 to e(g0 + 1)
     Pb, Wb, Zb = table.last(j[:1], table.lens[j[:1]] - ell[:1])
     x1 = Pb[0] @ x0 + Wb[0] @ u[:, :, 0] + Zb[0] @ sigma[:, :, 0]
@@ -132,8 +132,9 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
             c = g[rest] - g0 - 1                         # e(g[rest]) is edge c of xe
             Pf, Wf, Zf = table.first(j[rest], ell[rest])
             prev = rest - 1
-            xs[:, :, len(i) - len(rest):] = (
-                _apply(Pf, xe[:, :, c]) + _apply(Wf, a[:, :, c]) + _apply(Zf, sigma[:, :, prev]))
+            xs[:, :, len(i) - len(rest):] = _apply(
+                np.concatenate([Pf, Wf, Zf], axis=2),
+                np.concatenate([xe[:, :, c], a[:, :, c], sigma[:, :, prev]]))
         tk = t[i]
         y[:, :, i] = _apply(C(tk), xs) + _apply(D(tk), u[:, :, i])
         if states:
@@ -149,9 +150,8 @@ def _apply(M, v):
 def forced_march(Phi, f, x0):
     """States of ``x[c+1] = Φ_{c mod N} x[c] + f[c]``, ``x[0] = x0``, for c < J.
 
-    Blocks of b cells (b a divisor of N near 32, else 1 block per cell
-    product): the transitions ``Φ(k, 0)`` of the N/b block phases are
-    formed once; inside every block the forced part from a zero start is
+    Blocks of b cells (b a divisor of N near √J, at most about 64): the
+    transitions ``Φ(k, 0)`` of the N/b block phases are formed once; inside every block the forced part from a zero start is
     unrolled for all blocks at once (a loop over the b positions), and the
     block starts are marched block by block.  Work O(J n² R + N n³).
 
@@ -174,8 +174,10 @@ def forced_march(Phi, f, x0):
     """
     N, n, _ = Phi.shape
     R, J = f.shape[1], f.shape[2]
-    divisors = [b for b in range(1, min(N, 4 * _BLOCK) + 1) if N % b == 0]
-    b = min(divisors, key=lambda v: (abs(np.log(v / _BLOCK)), -v))
+    # b near √J balances the two loops (over the b positions, over the blocks)
+    target = min(max(np.sqrt(J), 8.0), _BLOCK)
+    divisors = [b for b in range(1, min(N, 2 * _BLOCK) + 1) if N % b == 0]
+    b = min(divisors, key=lambda v: (abs(np.log(v / target)), -v))
     nph = N // b
     nb = -(-J // b)
     # phase of every block, and the inputs laid out by block: (nb, b, n, R)
@@ -200,3 +202,13 @@ def forced_march(Phi, f, x0):
         xs = O[bph[i], b] @ xs + sig[i, b]
     x = O[bph, :b] @ starts[:, None] + sig[:, :b]                 # (nb, b, n, R)
     return x.reshape(nb * b, n, R)[:J].transpose(1, 2, 0)
+
+
+def _cell_of(edges, theta):
+    """Index j of the cell ``[e_j, e_{j+1})`` holding each phase (uniform guess, corrected)."""
+    N = len(edges) - 1
+    j = np.clip((theta * (N / edges[-1])).astype(np.int64), 0, N - 1)
+    wrong = (theta < edges[j]) | (theta >= edges[j + 1])
+    if np.any(wrong):
+        j[wrong] = np.clip(np.searchsorted(edges, theta[wrong], side='right') - 1, 0, N - 1)
+    return j

@@ -22,6 +22,12 @@ there are samples.  Instead:
   samples per piece, the degree D and the sub-steps are the cheapest that
   agree with the adaptive integrator at probe lengths to 1e-13; cells are
   halved otherwise, or the steps are integrated one by one.
+* **Cell march.**  On a grid whose phases never repeat (non-uniform,
+  jittered, a few irregular steps, long records) no step's data are
+  formed: the state is marched over the cells of the record and read at
+  the samples from the cells' first parts (``_core/cellmarch.py``).  A
+  repeating pattern spanning several periods takes its q steps' data from
+  the table (head, runs of cells, tail, as below).
 
 The data of an interval ``I = [a, b]`` with a linear input
 ``u(τ) = u_k + (τ - t_k)/h_k Δu`` are
