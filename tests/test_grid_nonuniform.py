@@ -94,3 +94,13 @@ def test_grid_with_a_few_irregular_steps_and_many_traces():
         one = ltp.forced_response(sys, t, U[:, r], X0[:, r])
         np.testing.assert_allclose(one.outputs, resp.outputs[0, r], rtol=0,
                                    atol=1e-13 * np.abs(one.outputs).max())
+
+
+def test_system_without_inputs():
+    from systems import damped_mathieu
+    sys = damped_mathieu()
+    free = ltp.ltpss(sys.A, np.zeros((2, 0)), sys.C, np.zeros((1, 0)), period=sys.period)
+    t = np.cumsum(np.r_[0.1, np.random.default_rng(4).uniform(0.008, 0.012, 150)])
+    resp = ltp.forced_response(free, t, np.zeros((0, len(t))), [1.0, -0.5])
+    ref = ltp.forced_response(sys, t, 0.0, [1.0, -0.5], method='solve_ivp', rtol=1e-12)
+    assert rel(resp.outputs, ref.outputs) <= 1e-10

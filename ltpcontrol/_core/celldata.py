@@ -172,7 +172,7 @@ class CellSamples:
         vals = np.abs(self.values).reshape(-1, n, coef.shape[2])
         out = 0.0
         for part in (slice(0, n), slice(n, None)):
-            size = vals[:, :, part].max()
+            size = vals[:, :, part].max(initial=0.0)
             if size > 0:
                 out = max(out, float(coef[:, :, part].max() / size))
         return out
