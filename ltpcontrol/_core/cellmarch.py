@@ -38,7 +38,7 @@ import numpy as np
 
 __all__ = []
 
-_CHUNK = 4096                  # samples interpolated at a time
+_CHUNK_ENTRIES = 2 ** 21       # entries of the interpolated data of a chunk of samples
 _BLOCK = 64                    # longest block of the forced march (about)
 
 
@@ -104,8 +104,10 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     f = _apply(WZ[cells % N], np.concatenate([a, sig]))
     # samples inside the marched cells: the jump and the change of slope
     inner = np.flatnonzero((g > g0) & (g < gL))
-    for s0 in range(0, len(inner), _CHUNK):
-        i = inner[s0:s0 + _CHUNK]
+    # samples per chunk: the interpolated data of a chunk within a fixed budget
+    chunk = int(np.clip(_CHUNK_ENTRIES // (n * (n + 2 * m) * len(table.frac)), 256, 65536))
+    for s0 in range(0, len(inner), chunk):
+        i = inner[s0:s0 + chunk]
         c = g[i] - g0 - 1
         Wb, Zb = table.last(j[i], table.lens[j[i]] - ell[i], parts=(1, 2))
         sc = sig[:, :, c]
@@ -121,8 +123,8 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     # states and outputs at the samples, from the first part of their cell
     x = np.empty((n, R, L)) if states else None
     y = np.empty((p, R, L))
-    for s0 in range(0, L, _CHUNK):
-        i = np.arange(s0, min(L, s0 + _CHUNK))
+    for s0 in range(0, L, chunk):
+        i = np.arange(s0, min(L, s0 + chunk))
         xs = np.empty((n, R, len(i)))
         first = i[0] == 0
         if first:
@@ -153,7 +155,8 @@ def forced_march(Phi, f, x0):
     Blocks of b cells (b a divisor of N near √J, at most about 64): the
     transitions ``Φ(k, 0)`` of the N/b block phases are formed once; inside every block the forced part from a zero start is
     unrolled for all blocks at once (a loop over the b positions), and the
-    block starts are marched block by block.  Work O(J n² R + N n³).
+    block starts follow the same recurrence over the blocks (period N/b),
+    marched the same way when there are many.  Work O(J n² R + N n³).
 
     Parameters
     ----------
@@ -194,12 +197,16 @@ def forced_march(Phi, f, x0):
     for k in range(b):
         O[:, k + 1] = Pb[:, k] @ O[:, k]
         sig[:, k + 1] = Pb[bph, k] @ sig[:, k] + fb[:, k]
-    # block starts
-    starts = np.empty((nb, n, R))
-    xs = x0
-    for i in range(nb):
-        starts[i] = xs
-        xs = O[bph[i], b] @ xs + sig[i, b]
+    # block starts: the same recurrence over the blocks (period N/b), by the
+    # same method when there are many blocks
+    if nb > _BLOCK and nph > 1:
+        starts = forced_march(O[:, b], sig[:, b].transpose(1, 2, 0), x0).transpose(2, 0, 1)
+    else:
+        starts = np.empty((nb, n, R))
+        xs = x0
+        for i in range(nb):
+            starts[i] = xs
+            xs = O[bph[i], b] @ xs + sig[i, b]
     x = O[bph, :b] @ starts[:, None] + sig[:, :b]                 # (nb, b, n, R)
     return x.reshape(nb * b, n, R)[:J].transpose(1, 2, 0)
 

@@ -139,3 +139,18 @@ def test_substep_error_estimate_scales_as_the_fifth_power():
         step_transitions(sys.A, sys.B, t0, h, 1e-12, info=info)
         excess.append(info['excess'])
     assert 16 < excess[0] / excess[1] < 64            # 2^5 = 32
+
+
+@pytest.mark.parametrize("N, J", [(680, 20400), (12, 500), (7, 300)])
+def test_forced_march_equals_the_recurrence(N, J):
+    # blocks of a divisor of N, block starts by the same march (first case)
+    from ltpcontrol._core.cellmarch import forced_march
+    rng = np.random.default_rng(N)
+    Phi = 0.4 * rng.normal(size=(N, 2, 2))
+    f, x0 = rng.normal(size=(2, 3, J)), rng.normal(size=(2, 3))
+    x = forced_march(Phi, f, x0)
+    ref, xs = np.empty_like(x), x0
+    for c in range(J):
+        ref[:, :, c] = xs
+        xs = Phi[c % N] @ xs + f[:, :, c]
+    assert rel(x, ref) < 1e-13
