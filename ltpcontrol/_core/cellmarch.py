@@ -28,12 +28,17 @@ first part ``[e_c, t_k]``:
 
     x(t_k) = Φ_f x(e_c) + W_f a_c + Z_f σ_{k-1}.
 
-Per sample, two interpolations in ℓ (n(n + 2m) and 2nm numbers) and a
-matrix-vector product; no step's transition matrix is formed.  Memory is
-linear in the record (the cell states) and bounded per chunk of samples.
+Both are linear in the data at the table's D + 1 lengths, so the
+products are taken with those data for every cell of the record, laid out
+by phase (one batched product over the N phases, no gathered copies of
+the table), and only the results (n numbers per length) are interpolated
+in ℓ at the samples.  No step's transition matrix is formed; memory is
+linear in the record (the cell states) and bounded per chunk of periods.
 """
 
 import numpy as np
+
+from .celldata import barycentric_matrix, lobatto
 
 
 __all__ = []
@@ -99,49 +104,88 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     k = np.clip(np.searchsorted(t, tau, side='right') - 1, 0, L - 1)
     a = u[:, :, k] + sigma[:, :, k] * (tau - t[k])                 # (m, R, cells)
     sig = sigma[:, :, k]
-    # forcing of the cells c = g0 + 1 .. gL - 1 (the last entry is not used)
-    WZ = np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2)   # whole cells
-    f = _apply(WZ[cells % N], np.concatenate([a, sig]))
-    # samples inside the marched cells: the jump and the change of slope
+    # the cells of the record laid out by phase: cell c (0-based from g0 + 1)
+    # has phase (c + o) mod N, and every per-cell product is one batched
+    # product over the N phases (no gathered copies of the table)
+    o = (g0 + 1) % N
+    D1 = len(table.frac)
+    # forcing of the cells c = g0 + 1 .. gL - 1 (the last entry is not used):
+    # the whole cell's W a + Z σ, plus for a sample inside the cell the jump
+    # and the change of slope through the last part [t_k, e_{c+1}], whose data
+    # are Σ_i w_i(ℓ) (W_i, Z_i) at the table's lengths
+    q = np.zeros((2 * m * (D1 + 1), R, len(cells)))
+    q[:2 * m] = np.concatenate([a, sig])
     inner = np.flatnonzero((g > g0) & (g < gL))
-    # samples per chunk: the interpolated data of a chunk within a fixed budget
-    chunk = int(np.clip(_CHUNK_ENTRIES // (n * (n + 2 * m) * len(table.frac)), 256, 65536))
-    for s0 in range(0, len(inner), chunk):
-        i = inner[s0:s0 + chunk]
-        c = g[i] - g0 - 1
-        Wb, Zb = table.last(j[i], table.lens[j[i]] - ell[i], parts=(1, 2))
+    if len(inner):
+        c = g[inner] - g0 - 1
+        w = _weights(table, j[inner], table.lens[j[inner]] - ell[inner])     # (S, D1)
         sc = sig[:, :, c]
-        jump = u[:, :, i] - (a[:, :, c] + sc * (t[i] - tau[c]))
-        f[:, :, c] += _apply(np.concatenate([Wb, Zb], axis=2),
-                             np.concatenate([jump, sigma[:, :, i] - sc]))
+        jump = np.concatenate([u[:, :, inner] - (a[:, :, c] + sc * (t[inner] - tau[c])),
+                               sigma[:, :, inner] - sc])                         # (2m, R, S)
+        q[2 * m:, :, c] = (w.T[:, None, None, :] * jump[None]).reshape(-1, R, len(c))
+    WZb = np.concatenate([table.bwd[1], table.bwd[2]], axis=3)              # (N, D1, n, 2m)
+    Fq = np.concatenate([np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2),
+                         WZb.transpose(0, 2, 1, 3).reshape(N, n, D1 * 2 * m)], axis=2)
+    f = _by_phase(Fq, q, o)
     # the first sample: its cell's last part carries x0 to e(g0 + 1)
     Pb, Wb, Zb = table.last(j[:1], table.lens[j[:1]] - ell[:1])
     x1 = Pb[0] @ x0 + Wb[0] @ u[:, :, 0] + Zb[0] @ sigma[:, :, 0]
     # the march over the cells, phase (g0 + 1) mod N first
-    Phi = np.roll(table.fwd[0][:, -1], -((g0 + 1) % N), axis=0)
+    Phi = np.roll(table.fwd[0][:, -1], -o, axis=0)
     xe = forced_march(Phi, f, x1)
-    # states and outputs at the samples, from the first part of their cell
-    x = np.empty((n, R, L)) if states else None
+    # states at the samples from the first part [e_c, t_k] of their cell:
+    # the data at the table's lengths applied to (x(e_c), a_c, σ) for every
+    # cell, by phase, then interpolated in ℓ at the samples' cells
+    x = np.empty((n, R, L))
+    x[:, :, 0] = x0
+    if L > 1:
+        rest = np.arange(1, L)
+        c = g[rest] - g0 - 1
+        Ff = np.concatenate(table.fwd, axis=3).reshape(N, D1 * n, n + 2 * m)
+        V = _by_phase(Ff, np.concatenate([xe, a, sig]), o, pick=c)           # (D1 n, R, S)
+        w = _weights(table, j[rest], ell[rest])
+        x[:, :, 1:] = np.einsum('sd,dnrs->nrs', w, V.reshape(D1, n, R, len(c)))
     y = np.empty((p, R, L))
+    chunk = max(256, _CHUNK_ENTRIES // max(1, p * (n + m)))
     for s0 in range(0, L, chunk):
-        i = np.arange(s0, min(L, s0 + chunk))
-        xs = np.empty((n, R, len(i)))
-        first = i[0] == 0
-        if first:
-            xs[:, :, 0] = x0
-        rest = i[1:] if first else i
-        if len(rest):
-            c = g[rest] - g0 - 1                         # e(g[rest]) is edge c of xe
-            Pf, Wf, Zf = table.first(j[rest], ell[rest])
-            prev = rest - 1
-            xs[:, :, len(i) - len(rest):] = _apply(
-                np.concatenate([Pf, Wf, Zf], axis=2),
-                np.concatenate([xe[:, :, c], a[:, :, c], sigma[:, :, prev]]))
-        tk = t[i]
-        y[:, :, i] = _apply(C(tk), xs) + _apply(D(tk), u[:, :, i])
-        if states:
-            x[:, :, i] = xs
-    return x, y
+        i = slice(s0, s0 + chunk)
+        y[:, :, i] = _apply(C(t[i]), x[:, :, i]) + _apply(D(t[i]), u[:, :, i])
+    return (x if states else None), y
+
+
+def _weights(table, j, length):
+    """Barycentric weights (S, D + 1) of the lengths `length` of cells `j` at the table's nodes."""
+    _, wts = lobatto(len(table.frac) - 1)
+    return barycentric_matrix(np.clip(length / table.lens[j], 0.0, 1.0), table.frac, wts)
+
+
+def _by_phase(F, z, o, pick=None):
+    """``F[(c + o) % N] @ z[:, :, c]`` for every c, as (a, R, J) (or its columns `pick`).
+
+    F (N, a, b), z (b, R, J): the columns are laid out as periods of N
+    phases, so that the products are one batched product over the phases;
+    periods are taken in chunks within a fixed budget.
+    """
+    N, A_, b = F.shape
+    _, R, J = z.shape
+    P = -(-(J + o) // N)
+    per = max(1, _CHUNK_ENTRIES // max(1, N * (A_ + b) * R))
+    out = np.empty((A_, R, J if pick is None else len(pick)))
+    for p0 in range(0, P, per):
+        p1 = min(P, p0 + per)
+        lo, hi = max(0, p0 * N - o), min(J, p1 * N - o)
+        zp = np.zeros((b, R, (p1 - p0) * N))
+        zp[:, :, lo + o - p0 * N:hi + o - p0 * N] = z[:, :, lo:hi]
+        zt = np.ascontiguousarray(zp.reshape(b, R, p1 - p0, N).transpose(3, 0, 2, 1))
+        res = np.matmul(F, zt.reshape(N, b, (p1 - p0) * R)).reshape(N, A_, p1 - p0, R)
+        if pick is None:
+            res = res.transpose(1, 3, 2, 0).reshape(A_, R, (p1 - p0) * N)
+            out[:, :, lo:hi] = res[:, :, lo + o - p0 * N:hi + o - p0 * N]
+        else:
+            sel = np.flatnonzero((pick >= lo) & (pick < hi))
+            at = pick[sel] + o - p0 * N
+            out[:, :, sel] = res[at % N, :, at // N].transpose(1, 2, 0)
+    return out
 
 
 def _apply(M, v):

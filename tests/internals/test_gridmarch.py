@@ -154,3 +154,17 @@ def test_forced_march_equals_the_recurrence(N, J):
         ref[:, :, c] = xs
         xs = Phi[c % N] @ xs + f[:, :, c]
     assert rel(x, ref) < 1e-13
+
+
+@pytest.mark.parametrize("budget", [2 ** 21, 50])
+def test_products_by_phase_equal_the_loop(monkeypatch, budget):
+    # cells laid out by phase (offset o), in one chunk of periods or many
+    import ltpcontrol._core.cellmarch as cellmarch
+    monkeypatch.setattr(cellmarch, '_CHUNK_ENTRIES', budget)
+    rng = np.random.default_rng(3)
+    N, J, o = 7, 40, 5
+    F, z = rng.normal(size=(N, 3, 2)), rng.normal(size=(2, 2, J))
+    ref = np.stack([F[(c + o) % N] @ z[:, :, c] for c in range(J)], axis=2)
+    assert rel(cellmarch._by_phase(F, z, o), ref) < 1e-14
+    pick = np.array([0, 3, 17, 39, 21])
+    assert rel(cellmarch._by_phase(F, z, o, pick=pick), ref[:, :, pick]) < 1e-14
