@@ -64,32 +64,54 @@ def _magnus6(M1, M2, M3, h):
     With ``α1 = h M2``, ``α2 = √15/3 h (M3 - M1)``, ``α3 = 10/3 h (M3 - 2 M2 + M1)``:
     ``Ω = α1 + α3/12 + [-20 α1 - α3 + C1, α2 + C2]/240``, ``C1 = [α1, α2]``,
     ``C2 = -[α1, 2 α3 + C1]/60`` (Blanes, Casas and Ros).
+
+    The augmented M has zero rows below its first n (module notes), and so
+    have all the α, commutators and Ω: the arguments and the result are
+    those first n rows (shape (..., n, d)), and a product ``X Y`` of two
+    such matrices is ``X[:, :n] Y`` (n²d instead of d³ multiplications).
     """
+    n = M1.shape[-2]
+
+    def comm(X, Y):
+        return X[..., :n] @ Y - Y[..., :n] @ X
+
     a1 = h * M2
     a2 = (np.sqrt(15) / 3) * h * (M3 - M1)
     a3 = (10 / 3) * h * (M3 - 2 * M2 + M1)
-    C1 = a1 @ a2 - a2 @ a1
-    X = 2 * a3 + C1
-    C2 = -(a1 @ X - X @ a1) / 60
-    L, R = -20 * a1 - a3 + C1, a2 + C2
-    return a1 + a3 / 12 + (L @ R - R @ L) / 240
+    C1 = comm(a1, a2)
+    C2 = comm(a1, 2 * a3 + C1) / -60
+    return a1 + a3 / 12 + comm(C1 - 20 * a1 - a3, a2 + C2) / 240
 
 
 def _expm_small(X):
-    """e^X of a stack; Taylor series when every 1-norm is at most 0.25."""
+    """e^X of a stack of first rows (..., n, d) (zero rows below); the same first rows.
+
+    Taylor series when every 1-norm is at most 0.25 (Horner on the first
+    rows: ``X E = [X11 E11, X11 E12 + X12]`` since E's last rows are
+    ``[0, I]``), else scaling and squaring of the whole matrices.
+    """
+    S, n, d = X.shape
     norms = np.abs(X).sum(axis=-2).max(axis=-1)
     top = float(norms.max()) if len(norms) else 0.0
     if top > _TAYLOR_NORM:
-        return expm_batch(X)
+        full = np.zeros((S, d, d))
+        full[:, :n] = X
+        return expm_batch(full)[:, :n]
     # the truncation error top^(K+1)/(K+1)! below 2^-54
     K, term = 1, top
     while term > 2.0 ** -54 and K < 30:
         K += 1
         term *= top / K
-    eye = np.eye(X.shape[-1])
+    eye = np.eye(n, d)
+    X11 = X[:, :, :n]
+    tail = np.zeros_like(X)
+    tail[:, :, n:] = X[:, :, n:]
     E = eye + X / K
     for j in range(K - 1, 0, -1):
-        E = eye + (X @ E) / j
+        E = X11 @ E
+        E += tail
+        E /= j
+        E += eye
     return E
 
 
@@ -230,18 +252,23 @@ class CellSamples:
                 sel = cells[c0:c0 + chunk]
                 k = len(sel)
                 vals = (P[sel % self.k] @ self.values[sel // self.k]).reshape(k, Q, n, n + m)
-                M = np.zeros((k, Q, d, d))
-                M[..., :n, :n + m] = vals
-                M[..., :n, n + m:] = sigma[:, None, None] * vals[..., n:]
+                M = np.empty((k, Q, n, d))
+                M[..., :n + m] = vals
+                M[..., n + m:] = sigma[:, None, None] * vals[..., n:]
                 if ratio is not None:
-                    M *= ratio
-                M = M.reshape(k, D, nsub, 3, d, d)
+                    M *= ratio[:n]
+                M = M.reshape(k, D, nsub, 3, n, d)
                 delta = (self.lens[sel, None, None] * width[:, None] / nsub)[..., None, None]
                 Omega = _magnus6(M[:, :, :, 0], M[:, :, :, 1], M[:, :, :, 2], delta)
-                E = _expm_small(Omega.reshape(-1, d, d)).reshape(k * D, nsub, d, d)
-                E = _tree_product(E).reshape(k, D, d, d)
+                E = _expm_small(Omega.reshape(-1, n, d))
+                if nsub > 1:
+                    full = np.zeros((len(E), d, d))
+                    full[:, :n] = E
+                    full[:, n:, n:] = np.eye(d - n)
+                    E = _tree_product(full.reshape(k * D, nsub, d, d))[:, :n]
+                E = E.reshape(k, D, n, d)
                 if ratio is not None:
-                    E *= self.scale[:, None] / self.scale[None, :]
+                    E *= self.scale[:n, None] / self.scale[None, :]
                 Phi[c0:c0 + k] = E[..., :n, :n]
                 W[c0:c0 + k] = E[..., :n, n:n + m]
                 # Z = δ Γ1 (δ the sub-interval's length)
