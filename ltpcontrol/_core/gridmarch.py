@@ -10,15 +10,24 @@ there are samples.  Instead:
   grid commensurate with the period), the step data repeat every q steps:
   q steps are computed and the periodic march runs with period q.
 * **Phase table.**  Otherwise one period is cut into N cells
-  ``[e_j, e_{j+1}]`` shorter than the shortest step (uniform, split at the
-  switching instants), and a step is split into a head piece
-  ``[t_k, e_{j+1}]``, c whole cells and a tail piece ``[e_J, t_k + h_k]``.
-  The data of every cell, and of its first and last parts at D + 1
-  equispaced lengths ℓ, are integrated once; a step's head and tail
-  come from the first and last parts ``[e_j, e_j + ℓ]``,
-  ``[e_{j+1} - ℓ, e_{j+1}]`` interpolated in ℓ (degree D, checked against
-  the integrator at probe lengths: cells are halved until the error is
-  below 1e-13, or the steps are integrated one by one).
+  ``[e_j, e_{j+1}]`` shorter than the shortest step (pieces of a few
+  cells, split at the switching instants), and a step is split into a
+  head piece ``[t_k, e_{j+1}]``, c whole cells and a tail piece
+  ``[e_J, t_k + h_k]``.  The data of every cell, and of its first and last
+  parts at the D + 1 Chebyshev-Lobatto lengths ℓ, are integrated once
+  (``_core/celldata.py``: A and B sampled once per piece, sixth-order
+  Magnus steps on the interpolated values);
+  a step's head and tail come from the first and last parts
+  ``[e_j, e_j + ℓ]``, ``[e_{j+1} - ℓ, e_{j+1}]`` interpolated in ℓ.  The
+  samples per piece, the degree D and the sub-steps are the cheapest that
+  agree with the adaptive integrator at probe lengths to 1e-13; cells are
+  halved otherwise, or the steps are integrated one by one.
+* **Cell march.**  On a grid whose phases never repeat (non-uniform,
+  jittered, a few irregular steps, long records) no step's data are
+  formed: the state is marched over the cells of the record and read at
+  the samples from the cells' first parts (``_core/cellmarch.py``).  A
+  repeating pattern spanning several periods takes its q steps' data from
+  the table (head, runs of cells, tail, as below).
 
 The data of an interval ``I = [a, b]`` with a linear input
 ``u(τ) = u_k + (τ - t_k)/h_k Δu`` are
@@ -39,11 +48,12 @@ block kernel of ``_march``, a chunk being one "period" of step data.
 """
 
 import math
-import warnings
 from fractions import Fraction
 
 import numpy as np
 
+from .celldata import CellSamples, CellTable, interpolate, lobatto
+from .cellmarch import cell_march
 from .march import periodic_march
 from .transition import step_transitions
 
@@ -55,10 +65,11 @@ _SEQ_BLOCK = 32              # block length of that march
 _MAX_CELLS = 2 ** 15         # cells of the phase table
 _FEW_CELLS = 16              # runs of fewer cells than this are tabulated
 _MAX_REPEAT = 4096           # longest repeating phase pattern used as a period
-_DEG = 10                    # degree of the partial-cell interpolants (equispaced nodes)
 _TABLE_TOL = 1e-13           # accepted interpolation error (relative to a cell's data)
-_PROBES = 32                 # probe intervals of the sub-step error estimate
-_MARGIN = 3.0                # its safety factor (the error between the probes)
+_PIECE_CELLS = 8             # cells per piece on which A and B are interpolated
+_SAMPLES = (12, 20, 32)      # Chebyshev samples of A and B per piece, tried in turn
+# (degree D of the partial-cell interpolants, Magnus steps per sub-interval), by cost
+_LADDER = ((4, 1), (5, 1), (6, 1), (8, 1), (8, 2), (10, 2), (12, 4))
 _PHASE_MAX = 1024            # most phases of the interpolated step data of a uniform grid
 
 
@@ -106,7 +117,12 @@ def grid_march(A, B, C, D, t, u, x0, hold, rtol, states=True):
             if repeat is None and np.allclose(h, h[0], rtol=1e-10, atol=0):
                 # a uniform grid: the step data are smooth periodic functions of the phase
                 table = _phase_table(A, B, float(h[0]), T, rtol)
-            if table is None:
+            if table is None and repeat is None:
+                # any other grid: march over the cells of a phase table
+                cells = _cell_table(A, B, h, T, rtol)
+                if cells is not None:
+                    return cell_march(cells, C, D, t, u, x0, hold, states)
+            elif table is None:
                 table = _table_steps(A, B, h, T, rtol)
     if repeat is not None:
         # the step data repeat every q steps: march with period q
@@ -285,44 +301,61 @@ class _PhaseInterpolant:
         return X[:, :, :n], X[:, :, n:n + m], X[:, :, n + m:]
 
 
-def _table_steps(A, B, h, T, rtol):
-    """Step data from a phase table (module notes), or None when not exact enough."""
-    hmin, hmax = float(h.min()), float(h.max())
-    n, m = A.shape[0], B.shape[1]
-    # cells shorter than the shortest step (so that a step spans a cell
-    # boundary), made shorter when their node intervals would need more than
-    # four Magnus sub-steps (cheaper in total): the error estimate with two
-    # sub-steps, ∝ δ⁵, is measured at probe intervals and the cells shortened
-    # until it meets the tolerance with a margin, so that every node interval
-    # is accepted at the first comparison (two against four sub-steps)
+def _cell_table(A, B, h, T, rtol):
+    """The phase table of the steps `h` (module notes), or None when not exact enough."""
+    hmin = float(h.min())
+    tol = max(_TABLE_TOL, 0.1 * rtol)
+    # pieces of about _PIECE_CELLS cells (split at the switching instants),
+    # on which A and B are sampled; cells shorter than the shortest step (so
+    # that a step spans a cell boundary), halved when no degree and sub-step
+    # count of the ladder meets the tolerance
     N0 = max(16, math.floor(T / hmin) + 1)
-    info = {}
-    with warnings.catch_warnings():
-        warnings.simplefilter('ignore')          # only the first comparison is needed
-        step_transitions(A, B, np.linspace(0, T, _PROBES, endpoint=False),
-                         np.full(_PROBES, T / N0 / _DEG), rtol, max_substeps=4, info=info)
-    N0 = math.ceil(N0 * max(1.0, _MARGIN * info['excess']) ** 0.2)
-    for refine in (1, 2, 4):
-        # split at the switching instants
-        N = refine * N0
-        if N > _MAX_CELLS:
-            return None
-        bps = np.mod(np.concatenate([A.breakpoints, B.breakpoints]), T)
-        edges = np.union1d(np.linspace(0, T, N + 1), bps)
-        edges = edges[np.concatenate([[True], np.diff(edges) > 1e-12 * T])]
-        edges[-1] = T
-        partial = _partial_table(A, B, edges, rtol)
-        if _partial_error(A, B, edges, partial, rtol) <= max(_TABLE_TOL, 0.1 * rtol):
+    bps = np.mod(np.concatenate([A.breakpoints, B.breakpoints]), T)
+    # a multiple of 5 pieces: the cells of a period have a divisor near the
+    # block length of the periodic march
+    Ns = -(-N0 // (5 * _PIECE_CELLS)) * 5
+    pieces = np.union1d(np.linspace(0, T, Ns + 1), bps)
+    pieces = pieces[np.concatenate([[True], np.diff(pieces) > 1e-12 * T])]
+    pieces[-1] = T
+    k0 = _PIECE_CELLS
+    if k0 * (len(pieces) - 1) > _MAX_CELLS:
+        return None
+    # A and B on every piece at the fewest Chebyshev points that resolve them
+    for G in _SAMPLES:
+        cells = CellSamples(A, B, pieces, k0, G)
+        if cells.tail() <= tol:
             break
     else:
         return None
-    lens = np.diff(edges)
-    N = len(lens)
+    for refine in (1, 2, 4):
+        if refine * k0 * (len(pieces) - 1) > _MAX_CELLS:
+            return None
+        cells.refine(refine * k0)
+        config = _table_config(A, B, cells, rtol, tol)
+        if config is not None:
+            break
+    else:
+        return None
+    frac, nsub = config
+    fwd, bwd = _partial_table(cells, frac, nsub)
+    return CellTable(cells.edges, cells.lens, frac, fwd, bwd)
+
+
+def _table_steps(A, B, h, T, rtol):
+    """Step data ``steps(tk, hk) -> (Φ, Γ0, Γ1)`` from a phase table, or None."""
+    table = _cell_table(A, B, h, T, rtol)
+    if table is None:
+        return None
+    hmax = float(h.max())
     n, m = A.shape[0], B.shape[1]
+    edges, lens, frac = table.edges, table.lens, table.frac
+    N = len(lens)
+    partial = table.fwd, table.bwd
     # the composition rule as a product of augmented matrices
     # [[Φ, W, Z], [0, I, ℓI], [0, 0, I]] (ℓ the interval's length)
-    nodes = lens[:, None] * np.linspace(0.0, 1.0, _DEG + 1)
+    nodes = lens[:, None] * frac
     fwd, bwd = (_augment(*v, nodes) for v in partial)
+    del partial
     cells = fwd[:, -1]
     # runs of 2^i cells from every cell
     levels = max(1, int(math.ceil(hmax / lens.min()) + 1).bit_length())
@@ -346,7 +379,7 @@ def _table_steps(A, B, h, T, rtol):
         jb = np.clip(np.searchsorted(edges, phi - wraps * T, side='right') - 1, 0, N - 1)
         count = (jb + N * wraps.astype(int)) - j - 1
         # head [θ, e_{j+1}] and tail [e_J, t_k + h_k] from the partial cells
-        (M,) = _interpolate((bwd,), edges, j, edges[j + 1] - theta)
+        M = interpolate(bwd, frac, j, (edges[j + 1] - theta) / lens[j])
         # the run of `count` cells after cell j, by the binary digits of count
         pos = (j + 1) % N
         if runs is not None:
@@ -357,10 +390,48 @@ def _table_steps(A, B, h, T, rtol):
                 if np.any(sel):
                     M[sel] = run[pos[sel]] @ M[sel]
                     pos = np.where(sel, (pos + 2 ** i) % N, pos)
-        (tail,) = _interpolate((fwd,), edges, jb, phi - wraps * T - edges[jb])
+        tail = interpolate(fwd, frac, jb, (phi - wraps * T - edges[jb]) / lens[jb])
         M = tail @ M
         return M[:, :n, :n], M[:, :n, n:n + m], M[:, :n, n + m:] / hk[:, None, None]
     return steps
+
+
+def _table_config(A, B, cells, rtol, tol):
+    """``(fractions, sub-steps)`` of the cheapest accurate table, or None.
+
+    Degrees D and Magnus steps are tried in order of cost on probe
+    cells (spread over the period, the cell of the largest |A| and the
+    least resolved one) until the interpolated head and tail pieces agree
+    with the adaptive integrator at probe lengths to `tol`.
+    """
+    edges = cells.edges
+    N = len(edges) - 1
+    probe = np.unique(np.concatenate([np.linspace(0, N - 1, min(N, 6)).astype(int),
+                                      [np.argmax(cells.cell_norms()),
+                                       np.argmax(cells.cell_tails())]]))
+    # reference pieces at both ends of the probe cells
+    xi = np.tile([0.0731, 0.2917, 0.6180], len(probe))
+    j = np.repeat(probe, 3)
+    length = xi * (edges[j + 1] - edges[j])
+    exact = _pieces(A, B, np.concatenate([edges[j], edges[j + 1] - length]),
+                    np.concatenate([length, length]), rtol, A.shape[0])
+    sub = np.repeat(np.arange(len(probe)), 3)
+    for D, nsub in _LADDER:
+        nodes, _ = lobatto(D)
+        err = 0.0
+        for end, table in enumerate(_partial_table(cells, nodes, nsub, probe)):
+            approx = interpolate(table, nodes, sub, xi)
+            ref = tuple(v[end * len(j):(end + 1) * len(j)] for v in exact)
+            for i, (e, a, whole) in enumerate(zip(ref, approx, table)):
+                if not e.size:                       # no inputs
+                    continue
+                # Φ relative to max(1, |Φ|); W, Z relative to their size over a cell
+                scale = np.abs(whole[:, -1]).max()
+                scale = max(1.0, scale) if i == 0 else max(scale, 1e-300)
+                err = max(err, float(np.abs(e - a).max() / scale))
+        if err <= tol:
+            return nodes, nsub
+    return None
 
 
 def _augment(P, W, Z, lengths):
@@ -373,86 +444,33 @@ def _augment(P, W, Z, lengths):
     return M
 
 
-def _partial_table(A, B, edges, rtol):
-    """(Φ, W, Z) of ``[e_j, e_j + ℓ_i]`` and ``[e_{j+1} - ℓ_i, e_{j+1}]``, ``ℓ_i = i h_j/D``."""
-    n, m = A.shape[0], B.shape[1]
-    lens = np.diff(edges)
-    nodes = edges[:-1, None] + lens[:, None] * np.linspace(0.0, 1.0, _DEG + 1)       # (N, D+1)
-    a, d = nodes[:, :-1].ravel(), np.diff(nodes, axis=1).ravel()
-    Phi, G0, G1 = step_transitions(A, B, a, d, rtol)
-    shape = (len(lens), _DEG)
-    Phi, W1, Z1 = (v.reshape(shape + v.shape[1:]) for v in (Phi, G0, G1 * d[:, None, None]))
-    P = np.empty((len(lens), _DEG + 1, n, n))
-    W = np.zeros((len(lens), _DEG + 1, n, m))
-    Z = np.zeros((len(lens), _DEG + 1, n, m))
+def _partial_table(cells, frac, nsub, which=None):
+    """(Φ, W, Z) of ``[e_j, e_j + ℓ_i]`` and ``[e_{j+1} - ℓ_i, e_{j+1}]``, ``ℓ_i = x_i h_j``.
+
+    `frac` holds the fractions ``x_i`` (symmetric about 1/2, so that the
+    backward pieces have the same lengths); `which` selects cells.
+    """
+    n, m = cells.n, cells.m
+    D = len(frac) - 1
+    Phi, W1, Z1 = cells.interval_data(frac, nsub, which)
+    lens = cells.lens if which is None else cells.lens[which]
+    Nc = len(lens)
+    start = lens[:, None] * frac                               # (Nc, D+1)
+    dd = np.diff(start, axis=1)
+    P = np.empty((Nc, D + 1, n, n))
+    W = np.zeros((Nc, D + 1, n, m))
+    Z = np.zeros((Nc, D + 1, n, m))
     P[:, 0] = np.eye(n)
     Pb, Wb, Zb = P.copy(), W.copy(), Z.copy()
-    dd = d.reshape(shape)
-    for i in range(_DEG):
-        # forward: [e_j, e_j + ℓ_i] then node interval i
+    for i in range(D):
+        # forward: [e_j, e_j + ℓ_i] then sub-interval i
         P[:, i + 1], W[:, i + 1], Z[:, i + 1] = _compose(
-            (P[:, i], W[:, i], Z[:, i]), (Phi[:, i], W1[:, i], Z1[:, i]),
-            nodes[:, i] - nodes[:, 0])
-        # backward: node interval D-1-i then [e_{j+1} - ℓ_i, e_{j+1}]
-        k = _DEG - 1 - i
+            (P[:, i], W[:, i], Z[:, i]), (Phi[:, i], W1[:, i], Z1[:, i]), start[:, i])
+        # backward: sub-interval D-1-i then [e_{j+1} - ℓ_i, e_{j+1}]
+        k = D - 1 - i
         Pb[:, i + 1], Wb[:, i + 1], Zb[:, i + 1] = _compose(
             (Phi[:, k], W1[:, k], Z1[:, k]), (Pb[:, i], Wb[:, i], Zb[:, i]), dd[:, k])
     return (P, W, Z), (Pb, Wb, Zb)
-
-
-def _interpolate(partial, edges, j, length):
-    """(Φ, W, Z) at `length` in cells `j`, by barycentric interpolation in each cell."""
-    xi = np.clip(length / (edges[j + 1] - edges[j]), 0.0, 1.0)
-    cheb = np.linspace(0.0, 1.0, _DEG + 1)
-    # barycentric weights of equispaced nodes: (-1)^j binom(D, j)
-    bary = np.array([(-1.0) ** k * math.comb(_DEG, k) for k in range(_DEG + 1)])
-    diff = xi[:, None] - cheb[None, :]
-    hit = diff == 0
-    with np.errstate(divide='ignore'):
-        w = np.where(hit.any(axis=1, keepdims=True), hit.astype(float), bary / diff)
-    w /= w.sum(axis=1, keepdims=True)
-    # one matrix product per cell: weights (samples, D+1) times values (D+1, all entries)
-    sizes = [int(np.prod(v.shape[2:])) for v in partial]
-    flat = [v.reshape(v.shape[0], v.shape[1], -1) for v in partial]
-    table = flat[0] if len(flat) == 1 else np.concatenate(flat, axis=2)
-    order = np.argsort(j, kind='stable')
-    js, ws = j[order], w[order]
-    bounds = np.flatnonzero(np.diff(js)) + 1
-    starts, ends = np.concatenate([[0], bounds]), np.concatenate([bounds, [len(j)]])
-    if len(j) == 0:
-        starts = ends = []
-    sorted_out = np.empty((len(j), table.shape[2]))
-    for a, b in zip(starts, ends):
-        np.matmul(ws[a:b], table[js[a]], out=sorted_out[a:b])
-    out = np.empty_like(sorted_out)
-    out[order] = sorted_out
-    parts = np.split(out, np.cumsum(sizes)[:-1], axis=1)
-    return tuple(q.reshape((len(j),) + v.shape[2:]) for q, v in zip(parts, partial))
-
-
-def _partial_error(A, B, edges, partial, rtol):
-    """Largest interpolation error at probe lengths of a few cells, against the integrator."""
-    N = len(edges) - 1
-    # short probe lengths keep the reference integration cheap
-    j = np.unique(np.linspace(0, N - 1, min(N, 5)).astype(int))
-    j = np.concatenate([j, j])
-    frac = np.concatenate([np.full(len(j) // 2, 0.0731), np.full(len(j) // 2, 0.2917)])
-    length = frac * (edges[j + 1] - edges[j])
-    fwd, bwd = partial
-    err = 0.0
-    # the pieces at both ends of the cells, integrated at once
-    both = _pieces(A, B, np.concatenate([edges[j], edges[j + 1] - length]),
-                   np.concatenate([length, length]), rtol, A.shape[0])
-    for end, table in enumerate((fwd, bwd)):
-        exact = tuple(v[end * len(j):(end + 1) * len(j)] for v in both)
-        approx = _interpolate(table, edges, j, length)
-        for i, (e, a, whole) in enumerate(zip(exact, approx, table)):
-            if e.size:
-                # Φ relative to max(1, |Φ|); W, Z relative to their size over a cell
-                scale = np.abs(whole[:, -1]).max()
-                scale = max(1.0, scale) if i == 0 else max(scale, 1e-300)
-                err = max(err, float(np.abs(e - a).max() / scale))
-    return err
 
 
 def _pieces(A, B, a, length, rtol, n):

@@ -9,7 +9,8 @@ of all samples and traces then come from blocks of steps as matrix products
 (``_march``).
 
 A reference path (``method='solve_ivp'``) integrates with
-`scipy.integrate.solve_ivp` between switching instants.
+`scipy.integrate.solve_ivp` between samples and switching instants (the
+held input and A, B are smooth there).
 """
 
 import functools
@@ -328,28 +329,27 @@ def _solve_ivp(sys, t, u, x0, hold, rtol):
         shifts = np.arange(np.floor(t[0] / sys.period), np.floor(t[-1] / sys.period) + 1)
         cuts = (bps[None, :] + sys.period * shifts[:, None]).ravel()
         cuts = cuts[(cuts > t[0]) & (cuts < t[-1])]
-    edges = np.unique(np.concatenate([[t[0]], cuts, [t[-1]]]))
+    # the held input is smooth between samples, A and B between switching
+    # instants: the integration restarts at both (no step across a jump or kink)
+    edges = np.unique(np.concatenate([t, cuts]))
+    at = np.searchsorted(edges, t)                   # t[k] == edges[at[k]]
     x = np.empty((n, R, len(t)))
-
-    def uval(tau, r):
-        if hold == 'zoh':
-            idx = np.clip(np.searchsorted(t, tau, side='right') - 1, 0, len(t) - 1)
-            return u[:, r, idx]
-        return np.array([np.interp(tau, t, u[i, r]) for i in range(u.shape[0])])
-
     for r in range(R):
         xr = x0[:, r]
         x[:, r, 0] = xr
-        for a, b in zip(edges[:-1], edges[1:]):
-            sel = (t > a) & (t < b)
-            sol = solve_ivp(lambda tau, xx: sys.A(tau) @ xx + sys.B(tau) @ uval(tau, r),
-                            (a, b), xr, method='DOP853', rtol=rtol, atol=rtol * 1e-3,
-                            t_eval=np.append(t[sel], b))
+        for i, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
+            k = min(np.searchsorted(t, a, side='right') - 1, len(t) - 2)
+            u0, u1 = u[:, r, k], u[:, r, k + 1]
+            tk, hk = t[k], t[k + 1] - t[k]
+
+            def rhs(tau, xx):
+                uu = u0 if hold == 'zoh' else u0 + (tau - tk) / hk * (u1 - u0)
+                return sys.A(tau) @ xx + sys.B(tau) @ uu
+            sol = solve_ivp(rhs, (a, b), xr, method='DOP853', rtol=rtol, atol=rtol * 1e-3)
             if not sol.success:
                 raise RuntimeError(f"solve_ivp failed: {sol.message}")
-            x[:, r, sel] = sol.y[:, :-1]
             xr = sol.y[:, -1]
-            x[:, r, t == b] = xr[:, None]
+            x[:, r, at == i + 1] = xr[:, None]
     return x
 
 

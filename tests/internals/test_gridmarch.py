@@ -20,6 +20,7 @@ def direct(monkeypatch, sys, t, u, **kw):
     """The same exact discretization with every step integrated on its own."""
     with monkeypatch.context() as mp:
         mp.setattr(gridmarch, '_table_steps', lambda *a: None)
+        mp.setattr(gridmarch, '_cell_table', lambda *a: None)
         mp.setattr(gridmarch, '_repeat_length', lambda *a: None)
         return ltp.forced_response(sys, t, u, **kw)
 
@@ -32,8 +33,8 @@ def test_linspace_grid_equals_independent_integration(plant, hold):
     u = np.sin(2.1 * t) + 0.3 * np.cos(5.0 * t)
     resp = ltp.forced_response(sys, t, u, input_hold=hold)
     ref = ltp.forced_response(sys, t, u, input_hold=hold, method='solve_ivp', rtol=1e-12)
-    assert rel(resp.outputs, ref.outputs) < 1e-7          # the reference's accuracy
-    assert rel(resp.states, ref.states) < 1e-7
+    assert rel(resp.outputs, ref.outputs) < 1e-10
+    assert rel(resp.states, ref.states) < 1e-10
 
 
 def test_table_equals_per_step_integration(monkeypatch):
@@ -138,3 +139,32 @@ def test_substep_error_estimate_scales_as_the_fifth_power():
         step_transitions(sys.A, sys.B, t0, h, 1e-12, info=info)
         excess.append(info['excess'])
     assert 16 < excess[0] / excess[1] < 64            # 2^5 = 32
+
+
+@pytest.mark.parametrize("N, J", [(680, 20400), (12, 500), (7, 300)])
+def test_forced_march_equals_the_recurrence(N, J):
+    # blocks of a divisor of N, block starts by the same march (first case)
+    from ltpcontrol._core.cellmarch import forced_march
+    rng = np.random.default_rng(N)
+    Phi = 0.4 * rng.normal(size=(N, 2, 2))
+    f, x0 = rng.normal(size=(2, 3, J)), rng.normal(size=(2, 3))
+    x = forced_march(Phi, f, x0)
+    ref, xs = np.empty_like(x), x0
+    for c in range(J):
+        ref[:, :, c] = xs
+        xs = Phi[c % N] @ xs + f[:, :, c]
+    assert rel(x, ref) < 1e-13
+
+
+@pytest.mark.parametrize("budget", [2 ** 21, 50])
+def test_products_by_phase_equal_the_loop(monkeypatch, budget):
+    # cells laid out by phase (offset o), in one chunk of periods or many
+    import ltpcontrol._core.cellmarch as cellmarch
+    monkeypatch.setattr(cellmarch, '_CHUNK_ENTRIES', budget)
+    rng = np.random.default_rng(3)
+    N, J, o = 7, 40, 5
+    F, z = rng.normal(size=(N, 3, 2)), rng.normal(size=(2, 2, J))
+    ref = np.stack([F[(c + o) % N] @ z[:, :, c] for c in range(J)], axis=2)
+    assert rel(cellmarch._by_phase(F, z, o), ref) < 1e-14
+    pick = np.array([0, 3, 17, 39, 21])
+    assert rel(cellmarch._by_phase(F, z, o, pick=pick), ref[:, :, pick]) < 1e-14
