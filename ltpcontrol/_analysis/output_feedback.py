@@ -61,13 +61,14 @@ from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .._core.steps import step_grid, step_integrals
 from .._core.validation import real_array
 from .lyapunov import cyclic_lyap
+from .output_feedback_lq import DiscreteLQ, minimize_lq
 
 __all__ = ['ofstab', 'oflqr', 'OutputFeedbackResult']
 
 # Gauss–Legendre nodes per step of the continuous-time gradient quadrature
 _GAUSS = 6
 # log|μ_max| a stabilizing start for the LQ phase must reach
-_STAB_TARGET = -0.05
+_STAB_TARGET = -1e-3
 # degree of the Chebyshev surrogates of the continuous-time plant data per step
 _CHEB = 16
 
@@ -239,12 +240,23 @@ def oflqr(sys, Q, R, *, X0=None, times=None, order=None, K0=None, maxiter=500, g
     prob = _problem(sys, times, order, Q, R, X0, nsteps)
     theta = prob.initial(K0)
     nit, message = 0, ''
+    if K0 is None and prob.basis.size > 1:
+        # warm start: the best constant gain, when it stabilizes
+        _, const = oflqr(sys, Q, R, X0=X0, K0=None, maxiter=maxiter, gtol=gtol, nsteps=nsteps)
+        nit = const.nit
+        if np.isfinite(const.cost):
+            theta = prob.basis.lift(const.params[0]).ravel()
     if not prob.log_radius(theta) < _STAB_TARGET:
-        theta, nit, message = _stabilize(prob, theta, maxiter, gtol, _STAB_TARGET)
+        theta, k, message = _stabilize(prob, theta, maxiter, gtol, _STAB_TARGET)
+        nit += k
         if not prob.log_radius(theta) < 0:
             return prob.result(theta, nit, "no stabilizing gain found in the family: "
                                + message, objective='lq')
-    theta, nit2, message = _minimize(prob.lq_objective, theta, maxiter, gtol)
+    if prob.discrete:
+        theta, nit2, converged, message = minimize_lq(prob.lq, theta, maxiter, gtol)
+        message = message if converged else message + ' (not converged)'
+    else:
+        theta, nit2, message = _minimize(prob.lq_objective, theta, maxiter, gtol)
     return prob.result(theta, nit + nit2, message, objective='lq')
 
 
@@ -372,6 +384,15 @@ class _Basis:
         out[:, 0] = 1.0
         out[:, 1::2] = np.cos(t[:, None] * w)
         out[:, 2::2] = np.sin(t[:, None] * w)
+        return out
+
+    def lift(self, F):
+        """Parameters of the constant gain F in this family."""
+        out = np.zeros((self.size,) + np.shape(F))
+        if self.kind == 'switching':
+            out[:] = F
+        else:
+            out[0] = F
         return out
 
     def matrix(self, theta):
@@ -629,6 +650,7 @@ class _DiscreteProblem(_Problem):
             self.Q = _per_step(Q, sys, 'Q', (n, n))
             self.R = _per_step(R, sys, 'R', (m, m))
             _check_weights(self.Q, self.R)
+            self.lq = DiscreteLQ(self.A, self.B, self.C, self.Q, self.R, self.X0, self.phi)
 
     def gain(self, params):
         F = np.einsum('ki,iab->kab', self.phi, params)
@@ -672,26 +694,14 @@ class _DiscreteProblem(_Problem):
         return f, np.einsum('ki,kab->iab', self.phi, G).ravel()
 
     def lq_objective(self, theta):
-        params = self.unpack(theta)
-        F, Ac = self._closed(params)
-        c = 1.0 if self.shift is None else np.exp(-self.shift / self.N)
-        Ac = c * Ac
-        logmod, _ = _log_multipliers(None, None, grid=None, factors=Ac)
-        if not logmod.max() < 0:
-            return np.inf, np.zeros_like(theta)
-        FC = F @ self.C
         if self.shift is None:
-            Qc, RFC = self.Q + np.swapaxes(FC, 1, 2) @ self.R @ FC, self.R @ F @ self.C
-        else:                                        # stabilization: Q = I, R = 0
-            Qc, RFC = np.broadcast_to(np.eye(self.n), Ac.shape), 0.0
-        P = cyclic_lyap(Ac, Qc, adjoint=True, check=False)
-        W = np.zeros_like(Ac)
-        W[-1] = self.X0
-        Y = cyclic_lyap(Ac, W, check=False)
-        Pn = np.roll(P, -1, axis=0)                  # P_{k+1}
-        cost = float(np.trace(P[0] @ self.X0))
-        G = 2 * (RFC - c * np.swapaxes(self.B, 1, 2) @ Pn @ Ac) @ Y @ np.swapaxes(self.C, 1, 2)
-        return cost, np.einsum('ki,kab->iab', self.phi, G).ravel()
+            return self.lq(theta)
+        # stabilization: Q = I, R = 0 on the loop scaled by e^{-α/N} per step
+        c = np.exp(-self.shift / self.N)
+        n, N = self.n, self.N
+        lq = DiscreteLQ(c * self.A, c * self.B, self.C, np.broadcast_to(np.eye(n), (N, n, n)),
+                        np.zeros((N, self.m, self.m)), self.X0, self.phi)
+        return lq(theta)
 
 
 #
