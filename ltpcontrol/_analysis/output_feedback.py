@@ -61,7 +61,8 @@ from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .._core.steps import step_grid, step_integrals
 from .._core.validation import real_array
 from .lyapunov import cyclic_lyap
-from .output_feedback_lq import DiscreteLQ, minimize_lq
+from .output_feedback_basis import Basis as _Basis
+from .output_feedback_lq import DiscreteLQ, minimize_lq, stabilize_lq
 
 __all__ = ['ofstab', 'oflqr', 'OutputFeedbackResult']
 
@@ -203,7 +204,11 @@ def oflqr(sys, Q, R, *, X0=None, times=None, order=None, K0=None, maxiter=500, g
     k) from an initial state of covariance X0 at t = 0, over a switching or
     harmonic gain, with exact gradients from periodic Lyapunov adjoints
     (module notes).  A non-stabilizing start is first stabilized by
-    `ofstab`'s objective.
+    `ofstab`'s objective; without `K0`, a switching or harmonic family
+    starts from the best constant gain when that one stabilizes.  Discrete
+    time, BFGS works in variables whitened by the Levine–Athans curvature
+    and a trust-region Newton step with the exact Hessian finishes
+    (`ltpcontrol._analysis.output_feedback_lq`).
 
     Parameters
     ----------
@@ -214,8 +219,15 @@ def oflqr(sys, Q, R, *, X0=None, times=None, order=None, K0=None, maxiter=500, g
         time also one matrix per step, shape (N, ., .)).
     X0 : array_like, optional
         Covariance of the initial state (n, n); identity by default.
-    times, order, K0, maxiter, gtol, nsteps
+    times, order, K0, nsteps
         As in `ofstab`.
+    maxiter : int, optional
+        Iterations of each phase (stabilization, BFGS; discrete time also
+        at most ``min(100, maxiter)`` Newton steps after each BFGS stage).
+    gtol : float, optional
+        Discrete time: relative tolerance of the Newton decrement
+        ``gᵀH⁻¹g <= gtol·J`` (exact Hessian H, positive definite: a
+        certified local minimum); continuous time: BFGS gradient tolerance.
 
     Returns
     -------
@@ -272,7 +284,18 @@ def _stabilize(prob, theta, maxiter, gtol, target, rounds=8):
     """Lower the dominant multiplier by a homotopy on the shift α (module notes):
     minimize the smooth shifted cost with α just above ``log|μ_max|``, then
     lower α; finish with BFGS on ``log|μ_max|`` itself.  Stops early once
-    ``log|μ_max| < target`` (when given)."""
+    ``log|μ_max| < target`` (when given).  Discrete plants use whitened
+    variables and the LQ weights (`output_feedback_lq.stabilize_lq`)."""
+    if prob.discrete:
+        theta, f, nit = stabilize_lq(prob.shifted_lq, theta, prob.log_radius,
+                                     -np.inf if target is None else target, maxiter)
+        if target is not None and f < target:
+            return theta, nit, 'stabilized'
+        theta_new, k, message = _minimize(prob.stab_objective, theta, maxiter, gtol,
+                                          stop_below=target)
+        if prob.log_radius(theta_new) <= f:
+            theta = theta_new
+        return theta, nit + k, message
     f = prob.log_radius(theta)
     nit, message = 0, ''
     for _ in range(rounds):
@@ -339,73 +362,6 @@ def _problem(sys, times, order, Q, R, X0, nsteps):
     basis = _Basis(sys, times, order)
     cls = _DiscreteProblem if sys.isdtime(strict=True) else _ContinuousProblem
     return cls(sys, basis, Q, R, X0, nsteps)
-
-
-class _Basis:
-    """Switching indicators or harmonics ``φ_i`` of the gain family."""
-
-    def __init__(self, sys, times, order):
-        T = sys.period
-        self.period, self.discrete = T, sys.isdtime(strict=True)
-        if times is not None and order is not None:
-            raise ControlArgument("give times (switching gain) or order (harmonic gain), "
-                                  "not both")
-        if order is not None:
-            if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 0:
-                raise ValueError(f"order must be a non-negative integer, got {order!r}")
-            if self.discrete and 2 * order + 1 > sys.nsteps:
-                raise ValueError(f"order {order} needs {2 * order + 1} samples per period, "
-                                 f"the plant has {sys.nsteps}")
-            self.kind, self.order, self.size = 'harmonic', int(order), 2 * int(order) + 1
-            return
-        times = np.zeros(1) if times is None else real_array(times, 'times', ndim=1)
-        if len(times) == 0 or abs(times[0]) > 1e-12 * T:
-            raise ValueError("times must start at 0 (the partition must cover the period "
-                             f"from its start), got {times[:1]}")
-        if np.any(np.diff(times) <= 0) or times[-1] >= T or times[0] < 0:
-            raise ValueError(f"times must increase strictly within [0, {T}) (one period), "
-                             f"got {times}")
-        if self.discrete:
-            k = times / sys.dt
-            if np.any(np.abs(k - np.round(k)) > 1e-9 * max(1.0, k.max())):
-                raise ValueError(f"times must be multiples of dt={sys.dt} for a discrete "
-                                 f"plant, got {times}")
-            self.steps = np.round(k).astype(int)
-        self.kind, self.times, self.size = 'switching', times.copy(), len(times)
-
-    def values(self, t):
-        """``φ_i(t)``, shape (len(t), s)."""
-        t = np.mod(np.asarray(t, float), self.period)
-        if self.kind == 'switching':
-            idx = np.searchsorted(self.times, t + 1e-12 * self.period, side='right') - 1
-            return (idx[:, None] == np.arange(self.size)).astype(float)
-        w = 2 * np.pi / self.period * np.arange(1, self.order + 1)
-        out = np.empty((len(t), self.size))
-        out[:, 0] = 1.0
-        out[:, 1::2] = np.cos(t[:, None] * w)
-        out[:, 2::2] = np.sin(t[:, None] * w)
-        return out
-
-    def lift(self, F):
-        """Parameters of the constant gain F in this family."""
-        out = np.zeros((self.size,) + np.shape(F))
-        if self.kind == 'switching':
-            out[:] = F
-        else:
-            out[0] = F
-        return out
-
-    def matrix(self, theta):
-        """The continuous-time gain F as a `PeriodicMatrix`."""
-        if self.kind == 'switching':
-            return PeriodicMatrix.switching(list(theta), self.times, self.period)
-        q = self.order
-        coeffs = np.zeros((2 * q + 1,) + theta.shape[1:], complex)
-        coeffs[q] = theta[0]
-        for j in range(1, q + 1):
-            c = 0.5 * (theta[2 * j - 1] - 1j * theta[2 * j])
-            coeffs[q + j], coeffs[q - j] = c, np.conj(c)
-        return PeriodicMatrix(coeffs, self.period)
 
 
 class _Problem:
@@ -694,14 +650,19 @@ class _DiscreteProblem(_Problem):
         return f, np.einsum('ki,kab->iab', self.phi, G).ravel()
 
     def lq_objective(self, theta):
-        if self.shift is None:
-            return self.lq(theta)
-        # stabilization: Q = I, R = 0 on the loop scaled by e^{-α/N} per step
-        c = np.exp(-self.shift / self.N)
+        return self.lq(theta) if self.shift is None else self.shifted_lq(self.shift)(theta)
+
+    def shifted_lq(self, alpha):
+        """LQ cost of the loop scaled by ``e^{-α}`` per period (A and B scaled by
+        ``e^{-α/N}``), with the design weights, or Q = I, R = 0 (`ofstab`)."""
+        c = np.exp(-alpha / self.N)
         n, N = self.n, self.N
-        lq = DiscreteLQ(c * self.A, c * self.B, self.C, np.broadcast_to(np.eye(n), (N, n, n)),
-                        np.zeros((N, self.m, self.m)), self.X0, self.phi)
-        return lq(theta)
+        Q = getattr(self, 'Q', None)
+        if Q is None:
+            Q, R = np.broadcast_to(np.eye(n), (N, n, n)), np.zeros((N, self.m, self.m))
+        else:
+            R = self.R
+        return DiscreteLQ(c * self.A, c * self.B, self.C, Q, R, self.X0, self.phi)
 
 
 #

@@ -190,9 +190,12 @@ def trust_newton(fun, theta, maxiter, rtol):
     `fun(θ, hessian)` returns ``(J, grad[, hess])`` with ``J = inf`` outside
     the domain.  Stops when the Hessian is positive definite and the Newton
     decrement ``gᵀH⁻¹g`` (twice the decrease a Newton step predicts) is at
-    most ``rtol·J``.  Returns ``(θ, nit, converged, decrement)``.
+    most ``rtol·J``; gives up when ten steps lower J by less than 1e-7
+    relative (a saddle or a flat valley).  Returns ``(θ, nit, converged,
+    decrement)``.
     """
     J, g, H = fun(theta, True)
+    history = [J]
     d = np.sqrt(np.maximum(np.abs(np.diag(H)), 1e-300))
     d = np.maximum(d, 1e-8 * d.max())
     radius, nit, dec = 1.0, 0, np.inf
@@ -224,6 +227,9 @@ def trust_newton(fun, theta, maxiter, rtol):
                 return theta, nit, False, dec
         theta = trial
         J, g, H = fun(theta, True)
+        history.append(J)
+        if len(history) > 10 and history[-11] - J <= 1e-7 * abs(J):
+            return theta, nit + 1, False, dec
     return theta, maxiter, False, dec
 
 
@@ -251,21 +257,55 @@ def _tr_step(w, V, c, radius):
     return V @ step(hi)
 
 
-def minimize_lq(lq, theta, maxiter, rtol, bfgs_round=200, newton_size=2e7):
+def minimize_lq(lq, theta, maxiter, rtol, newton=True, bfgs_round=200, newton_size=2e7):
     """Minimize the discrete LQ cost from a stabilizing θ.
 
     Rounds of BFGS in variables whitened by `DiscreteLQ.curvature` at the
     round's start (gains of 1e4..1e7 and costs of order 1 make the raw
-    variables useless to BFGS) until a round ends on its own or lowers J by
-    less than ``1e-3 rtol`` relative; then `trust_newton` with the exact
+    variables useless to BFGS) until a round ends on its own, lowers J by
+    less than 1e-8 relative or reaches the first-order test below, at most
+    `maxiter` iterations in all; then (`newton`)
+    at most ``min(100, maxiter)`` steps of `trust_newton` with the exact
     Hessian, which certifies a local minimum (positive definite Hessian,
-    Newton decrement ``<= rtol J``).  Problems whose Hessian would need more
-    than `newton_size` numbers (directions x steps x n²) stop after BFGS,
-    judged by the whitened gradient.  Returns ``(θ, nit, converged,
+    Newton decrement ``<= rtol J``).  Otherwise (or when the Hessian would
+    need more than `newton_size` numbers, directions x steps x n²) the
+    point is judged stationary by the whitened gradient, ``gᵀĤ⁻¹g <= rtol
+    J`` with Ĥ the curvature above; failing both, BFGS and Newton are
+    repeated within `maxiter`.  Returns ``(θ, nit, converged,
     message)``.
     """
-    nit, J = 0, lq(theta)[0]
-    d = theta.size
+    nit, d, dec = 0, theta.size, np.inf
+    while True:
+        theta, k = _whitened_bfgs(lq, theta, maxiter - nit, rtol, bfgs_round)
+        nit += k
+        if not newton:
+            return theta, nit, True, 'BFGS'
+        if d * lq.N * lq.n ** 2 <= newton_size:
+            theta, k, ok, dec = trust_newton(lambda t, h: lq(t, hessian=h), theta,
+                                             min(100, maxiter), rtol)
+            nit += k
+            if ok:
+                return theta, nit, True, (f"local minimum: positive definite Hessian, Newton "
+                                          f"decrement {dec / abs(lq(theta)[0]):.2e} J <= gtol J")
+        dec = _whitened_decrement(lq, theta)
+        if dec <= rtol:
+            return theta, nit, True, (
+                f"stationary point: whitened gradient gᵀĤ⁻¹g = {dec:.2e} J <= gtol J, but no "
+                "local minimum certified (the exact Hessian is not positive definite or too "
+                "large: a saddle or a flat valley)")
+        if nit >= maxiter:
+            break
+    return theta, nit, False, f"not stationary: whitened gradient gᵀĤ⁻¹g = {dec:.2e} J > gtol J"
+
+
+def _whitened_decrement(lq, theta):
+    J, g = lq(theta)
+    return float(g @ np.linalg.solve(lq.curvature(theta), g)) / abs(J)
+
+
+def _whitened_bfgs(lq, theta, maxiter, rtol, bfgs_round):
+    """BFGS rounds in whitened variables (`minimize_lq`); ``(θ, nit)``."""
+    nit, J, d = 0, lq(theta)[0], theta.size
     while nit < maxiter:
         H = lq.curvature(theta)
         lam, U = np.linalg.eigh(H)
@@ -283,24 +323,30 @@ def minimize_lq(lq, theta, maxiter, rtol, bfgs_round=200, newton_size=2e7):
             res = minimize(fun, np.zeros(d), jac=True, method='BFGS',
                            options={'maxiter': min(bfgs_round, maxiter - nit), 'gtol': 0.0})
         nit += max(int(res.nit), 1)
+        drop = 0.0
         if res.fun < J:
             theta = f0 + S @ res.x
             drop, J = (J - res.fun) / abs(res.fun), res.fun
-        else:
-            drop = 0.0
-        if res.nit < bfgs_round or drop < 1e-3 * rtol:
+        if res.nit < bfgs_round or drop < 1e-8 or _whitened_decrement(lq, theta) <= rtol:
             break
-    if d * lq.N * lq.n ** 2 > newton_size:
-        g = lq(theta)[1]
-        dec = float(g @ np.linalg.solve(lq.curvature(theta), g))
-        ok = dec <= rtol * abs(J)
-        return theta, nit, ok, (f"BFGS: scaled gradient {dec:.2e} J" if ok else
-                                f"BFGS stopped with scaled gradient {dec:.2e} > rtol J")
-    theta, k, ok, dec = trust_newton(lambda t, h: lq(t, hessian=h), theta, max(maxiter - nit, 0),
-                                     rtol)
-    nit += k
-    if ok:
-        return theta, nit, True, (f"local minimum: positive definite Hessian, Newton decrement "
-                                  f"{dec:.2e} <= gtol J")
-    return theta, nit, False, ("no local minimum certified within maxiter (Hessian indefinite "
-                               "or Newton decrement above gtol J)")
+    return theta, nit
+
+
+def stabilize_lq(make_lq, theta, log_radius, target, maxiter, rounds=10):
+    """Lower ``f = log|μ_max|`` (per period) below `target` by minimizing the
+    LQ cost of loops scaled by ``e^{-α}`` per period, ``α = max(f, 0) +
+    log 1.01`` (finite at the start; the reference toolbox's homotopy),
+    at most 50 whitened BFGS iterations per round and `maxiter` in all.
+    `make_lq(α)` builds the scaled `DiscreteLQ`.  Returns ``(θ, f, nit)``."""
+    f, nit = log_radius(theta), 0
+    for _ in range(rounds):
+        if f < target or nit >= maxiter:
+            break
+        lq = make_lq(max(f, 0.0) + np.log(1.01))
+        theta_new, k, _, _ = minimize_lq(lq, theta, min(50, maxiter - nit), 0.0, newton=False)
+        nit += k
+        f_new = log_radius(theta_new)
+        if not f_new < f:
+            break
+        theta, f = theta_new, f_new
+    return theta, f, nit
