@@ -271,11 +271,13 @@ def minimize_lq(lq, theta, maxiter, rtol, newton=True, bfgs_round=200, newton_si
     need more than `newton_size` numbers, directions x steps x n²) the
     point is judged stationary by the whitened gradient, ``gᵀĤ⁻¹g <= rtol
     J`` with Ĥ the curvature above; failing both, BFGS and Newton are
-    repeated within `maxiter`.  Returns ``(θ, nit, converged,
+    repeated within `maxiter` while a cycle lowers J by more than 1e-10
+    relative.  Returns ``(θ, nit, converged,
     message)``.
     """
     nit, d, dec = 0, theta.size, np.inf
     while True:
+        J0 = lq(theta)[0]
         theta, k = _whitened_bfgs(lq, theta, maxiter - nit, rtol, bfgs_round)
         nit += k
         if not newton:
@@ -293,8 +295,8 @@ def minimize_lq(lq, theta, maxiter, rtol, newton=True, bfgs_round=200, newton_si
                 f"stationary point: whitened gradient gᵀĤ⁻¹g = {dec:.2e} J <= gtol J, but no "
                 "local minimum certified (the exact Hessian is not positive definite or too "
                 "large: a saddle or a flat valley)")
-        if nit >= maxiter:
-            break
+        if nit >= maxiter or J0 - lq(theta)[0] <= 1e-10 * abs(J0):
+            break                                # budget spent, or a cycle that stalls
     return theta, nit, False, f"not stationary: whitened gradient gᵀĤ⁻¹g = {dec:.2e} J > gtol J"
 
 
