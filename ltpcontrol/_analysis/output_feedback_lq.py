@@ -182,26 +182,37 @@ class DiscreteLQ:
         return cost, grad, 0.5 * (H + H.T)
 
 
-def trust_newton(fun, theta, maxiter, rtol):
+def trust_newton(fun, theta, maxiter, rtol, metric=None, stall=1e-7, floor=1e-8):
     """Trust-region Newton with the exact Hessian (Moré–Sorensen step from
-    the eigendecomposition), in variables scaled by the Hessian diagonal at
-    the start.
+    the eigendecomposition).
 
+    The trust region is a ball in variables scaled by the Hessian diagonal
+    (Moré's adaptive scaling) or, with a positive definite `metric` M, in
+    variables whitened by M (``θ = θ₀ + M^{-1/2} x``; the Levine–Athans
+    curvature makes the steps of very different gains comparable).
     `fun(θ, hessian)` returns ``(J, grad[, hess])`` with ``J = inf`` outside
     the domain.  Stops when the Hessian is positive definite and the Newton
     decrement ``gᵀH⁻¹g`` (twice the decrease a Newton step predicts) is at
-    most ``rtol·J``; gives up when ten steps lower J by less than 1e-7
+    most ``rtol·J``; gives up when ten steps lower J by less than `stall`
     relative (a saddle or a flat valley).  Returns ``(θ, nit, converged,
     decrement)``.
     """
     J, g, H = fun(theta, True)
     history = [J]
-    d = np.sqrt(np.maximum(np.abs(np.diag(H)), 1e-300))
-    d = np.maximum(d, 1e-8 * d.max())
+    if metric is None:
+        d = np.sqrt(np.maximum(np.abs(np.diag(H)), 1e-300))
+        d = np.maximum(d, floor * d.max())
+    else:
+        lam, U = np.linalg.eigh(metric)
+        lam = np.maximum(lam, 1e-12 * lam.max())
+        S = U / np.sqrt(lam)
     radius, nit, dec = 1.0, 0, np.inf
     for nit in range(maxiter + 1):
-        d = np.maximum(d, np.sqrt(np.abs(np.diag(H))))      # Moré's adaptive scaling
-        gs, Hs = g / d, H / d[:, None] / d[None, :]
+        if metric is None:
+            d = np.maximum(d, np.sqrt(np.abs(np.diag(H))))      # Moré's adaptive scaling
+            gs, Hs = g / d, H / d[:, None] / d[None, :]
+        else:
+            gs, Hs = S.T @ g, S.T @ H @ S
         w, V = np.linalg.eigh(Hs)
         c = V.T @ gs
         if w[0] > 0:
@@ -213,7 +224,7 @@ def trust_newton(fun, theta, maxiter, rtol):
         while True:
             step = _tr_step(w, V, c, radius)
             pred = -(gs @ step + 0.5 * step @ Hs @ step)
-            trial = theta + step / d
+            trial = theta + (step / d if metric is None else S @ step)
             J_new, g_new = fun(trial, False)[:2]
             rho = (J - J_new) / pred if pred > 0 else -np.inf
             norm = np.linalg.norm(step)
@@ -228,7 +239,7 @@ def trust_newton(fun, theta, maxiter, rtol):
         theta = trial
         J, g, H = fun(theta, True)
         history.append(J)
-        if len(history) > 10 and history[-11] - J <= 1e-7 * abs(J):
+        if len(history) > 10 and history[-11] - J <= stall * abs(J):
             return theta, nit + 1, False, dec
     return theta, maxiter, False, dec
 
@@ -272,8 +283,9 @@ def minimize_lq(lq, theta, maxiter, rtol, newton=True, bfgs_round=200, newton_si
     point is judged stationary by the whitened gradient, ``gᵀĤ⁻¹g <= rtol
     J`` with Ĥ the curvature above; failing both, BFGS and Newton are
     repeated within `maxiter` while a cycle lowers J by more than 1e-10
-    relative.  Returns ``(θ, nit, converged,
-    message)``.
+    relative; when they stall, `_polish` takes trust-region Newton steps
+    along the negative curvature and the whitened-gradient test is applied
+    again.  Returns ``(θ, nit, converged, message)``.
     """
     nit, d, dec = 0, theta.size, np.inf
     while True:
@@ -297,7 +309,43 @@ def minimize_lq(lq, theta, maxiter, rtol, newton=True, bfgs_round=200, newton_si
                 "large: a saddle or a flat valley)")
         if nit >= maxiter or J0 - lq(theta)[0] <= 1e-10 * abs(J0):
             break                                # budget spent, or a cycle that stalls
+    if d * lq.N * lq.n ** 2 <= newton_size:
+        theta, k, ok, dec = _polish(lq, theta, maxiter - nit, rtol)
+        nit += k
+        if ok:
+            return theta, nit, True, (
+                f"stationary point: whitened gradient gᵀĤ⁻¹g = {dec:.2e} J <= gtol J, but no "
+                "local minimum certified (the exact Hessian is indefinite: a saddle or a flat "
+                "valley)")
     return theta, nit, False, f"not stationary: whitened gradient gᵀĤ⁻¹g = {dec:.2e} J > gtol J"
+
+
+def _polish(lq, theta, maxiter, rtol):
+    """Last stage of `minimize_lq` on an indefinite, badly scaled Hessian
+    where BFGS and Newton stall: trust-region Newton steps along the
+    negative curvature, the trust region alternately a ball in variables
+    whitened by the curvature and in variables scaled by the Hessian
+    diagonal down to 1e-12 of its largest entry, stopping on ten steps that
+    lower J by less than 1e-9 relative, repeated while a round lowers J.
+    Returns ``(θ, nit, stationary, whitened decrement / J)``."""
+    nit, dec = 0, _whitened_decrement(lq, theta)
+    for rnd in range(20):
+        if dec <= rtol or nit >= maxiter:
+            break
+        J0 = lq(theta)[0]
+        metric = lq.curvature(theta) if rnd % 2 else None
+        theta_new, k, ok, _ = trust_newton(lambda t, h: lq(t, hessian=h), theta,
+                                           min(100, maxiter - nit), rtol, metric=metric,
+                                           stall=1e-9, floor=1e-12)
+        nit += max(k, 1)
+        if lq(theta_new)[0] < J0:
+            theta = theta_new
+        dec = _whitened_decrement(lq, theta)
+        if ok:
+            return theta, nit, True, dec
+        if rnd % 2 and not J0 - lq(theta)[0] > 1e-12 * abs(J0) and rnd > 1:
+            break
+    return theta, nit, dec <= rtol, dec
 
 
 def _whitened_decrement(lq, theta):

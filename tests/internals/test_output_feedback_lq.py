@@ -59,3 +59,15 @@ def test_trust_newton_certifies_a_local_minimum():
     # no random nearby point is lower
     for _ in range(20):
         assert lq(theta + 1e-3 * rng.normal(size=8))[0] >= J
+
+
+@pytest.mark.parametrize("metric", [False, True])
+def test_trust_newton_whitened_by_the_curvature_certifies_the_same_minimum(metric):
+    lq, rng = _lq(4)
+    ref, _, ok_ref, _ = trust_newton(lambda t, h: lq(t, hessian=h), np.zeros(8), 50, 1e-12)
+    M = lq.curvature(np.zeros(8)) if metric else None
+    theta, nit, ok, dec = trust_newton(lambda t, h: lq(t, hessian=h), np.zeros(8), 50, 1e-12,
+                                       metric=M, stall=1e-9, floor=1e-12)
+    assert ok and ok_ref and dec <= 1e-12 * lq(theta)[0]
+    np.testing.assert_allclose(theta, ref, rtol=1e-6, atol=1e-9)
+    assert np.linalg.eigvalsh(lq(theta, hessian=True)[2]).min() > 0
