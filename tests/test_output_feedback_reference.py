@@ -80,6 +80,21 @@ def test_pitelkau_constant_gain_at_120_steps_per_orbit(satellite):
         assert _lq_cost(satellite, Kp, Q_SAT, R_SAT)[0] > info.cost
 
 
+def test_pitelkau_constant_gain_at_10_steps_per_orbit():
+    # the homotopy from zero does not stabilize this plant; the projected
+    # state-feedback start does (a grid search finds max|mu| = 0.917)
+    sat = ltp.sample_system(_pitelkau(), TP / 10)
+    K, info = ltp.ofstab(sat)
+    mu = np.linalg.eigvals(np.linalg.multi_dot(_steps(sat, K)[0][::-1]))
+    assert info.success and np.abs(mu).max() < 1
+    K, info = ltp.oflqr(sat, Q_SAT, R_SAT)
+    cost, mono = _lq_cost(sat, K, Q_SAT, R_SAT)
+    assert info.success and np.abs(np.linalg.eigvals(mono)).max() < 1
+    assert info.cost == pytest.approx(cost, rel=1e-9)
+    _, X, _ = ltp.dlqr(sat, Q_SAT, R_SAT)
+    assert info.cost >= np.trace(X(0.0))
+
+
 d = 0.9
 
 

@@ -60,6 +60,7 @@ from .._core.ltpsys import feedback
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .._core.steps import step_grid, step_integrals
 from .._core.validation import real_array
+from .design import dlqr
 from .lyapunov import cyclic_lyap
 from .output_feedback_basis import Basis as _Basis
 from .output_feedback_lq import DiscreteLQ, minimize_lq, stabilize_lq
@@ -142,7 +143,9 @@ def ofstab(sys, *, times=None, order=None, K0=None, target=None, maxiter=100, gt
         matrices).  Give `times` or `order`, not both.
     K0 : array_like, optional
         Initial parameters ``F_i``, shape (s, m, p) or (m, p) (the same for
-        all); zero by default.
+        all); zero by default (for a discrete plant that the homotopy
+        from zero does not stabilize, then the projected periodic LQR gain
+        ``K_k C_k⁺`` of smallest multiplier over a log-spaced scale).
     target : float, optional
         Stop as soon as the stability degree (`OutputFeedbackResult.sdeg`)
         is below this value; by default it is minimized as far as the
@@ -219,15 +222,24 @@ def oflqr(sys, Q, R, *, X0=None, times=None, order=None, K0=None, maxiter=500, g
         time also one matrix per step, shape (N, ., .)).
     X0 : array_like, optional
         Covariance of the initial state (n, n); identity by default.
-    times, order, K0, nsteps
-        As in `ofstab`.
+    times, order, K0
+        As in `ofstab`.  A discrete plant that the homotopy from zero does
+        not stabilize is restarted from the projected periodic LQR gain
+        ``K_k C_k⁺`` of smallest closed-loop multiplier over a log-spaced
+        scale.
     maxiter : int, optional
         Iterations of each phase (stabilization, BFGS; discrete time also
-        at most ``min(100, maxiter)`` Newton steps after each BFGS stage).
+        at most ``min(100, maxiter)`` Newton steps after each BFGS stage,
+        then trust-region Newton rounds along negative curvature when both
+        stall).
     gtol : float, optional
         Discrete time: relative tolerance of the Newton decrement
         ``gᵀH⁻¹g <= gtol·J`` (exact Hessian H, positive definite: a
-        certified local minimum); continuous time: BFGS gradient tolerance.
+        certified local minimum), or of the gradient whitened by the
+        Levine–Athans curvature Ĥ, ``gᵀĤ⁻¹g <= gtol·J`` (a stationary
+        point, reported as such); continuous time: BFGS gradient tolerance.
+    nsteps
+        As in `ofstab`.
 
     Returns
     -------
@@ -249,17 +261,22 @@ def oflqr(sys, Q, R, *, X0=None, times=None, order=None, K0=None, maxiter=500, g
     >>> bool(abs(info.cost - np.trace(X(0.0))) < 1e-6 * info.cost)
     True
     """
+    return _oflqr(sys, Q, R, X0, times, order, K0, maxiter, gtol, nsteps, seed=True)
+
+
+def _oflqr(sys, Q, R, X0, times, order, K0, maxiter, gtol, nsteps, seed):
     prob = _problem(sys, times, order, Q, R, X0, nsteps)
     theta = prob.initial(K0)
     nit, message = 0, ''
     if K0 is None and prob.basis.size > 1:
-        # warm start: the best constant gain, when it stabilizes
-        _, const = oflqr(sys, Q, R, X0=X0, K0=None, maxiter=maxiter, gtol=gtol, nsteps=nsteps)
+        # warm start: the best constant gain, when the homotopy from zero
+        # finds one (the family's own homotopy is tried before any seed)
+        _, const = _oflqr(sys, Q, R, X0, None, None, None, maxiter, gtol, nsteps, seed=False)
         nit = const.nit
         if np.isfinite(const.cost):
             theta = prob.basis.lift(const.params[0]).ravel()
     if not prob.log_radius(theta) < _STAB_TARGET:
-        theta, k, message = _stabilize(prob, theta, maxiter, gtol, _STAB_TARGET)
+        theta, k, message = _stabilize(prob, theta, maxiter, gtol, _STAB_TARGET, seed=seed)
         nit += k
         if not prob.log_radius(theta) < 0:
             return prob.result(theta, nit, "no stabilizing gain found in the family: "
@@ -280,22 +297,24 @@ class _Stop(Exception):
     pass
 
 
-def _stabilize(prob, theta, maxiter, gtol, target, rounds=8):
+def _stabilize(prob, theta, maxiter, gtol, target, rounds=8, seed=True):
     """Lower the dominant multiplier by a homotopy on the shift α (module notes):
     minimize the smooth shifted cost with α just above ``log|μ_max|``, then
     lower α; finish with BFGS on ``log|μ_max|`` itself.  Stops early once
     ``log|μ_max| < target`` (when given).  Discrete plants use whitened
     variables and the LQ weights (`output_feedback_lq.stabilize_lq`)."""
     if prob.discrete:
-        theta, f, nit = stabilize_lq(prob.shifted_lq, theta, prob.log_radius,
-                                     -np.inf if target is None else target, maxiter)
-        if target is not None and f < target:
-            return theta, nit, 'stabilized'
-        theta_new, k, message = _minimize(prob.stab_objective, theta, maxiter, gtol,
-                                          stop_below=target)
-        if prob.log_radius(theta_new) <= f:
-            theta = theta_new
-        return theta, nit + k, message
+        theta, nit, message = _stabilize_discrete(prob, theta, maxiter, gtol, target)
+        if seed and not prob.log_radius(theta) < 0 and not np.any(theta):
+            # the homotopy from zero failed: restart from the best projected
+            # state-feedback gain
+            seed = _state_feedback_seed(prob)
+            if seed is not None:
+                seeded, k, message = _stabilize_discrete(prob, seed, maxiter, gtol, target)
+                nit += k
+                if prob.log_radius(seeded) < prob.log_radius(theta):
+                    theta = seeded
+        return theta, nit, message
     f = prob.log_radius(theta)
     nit, message = 0, ''
     for _ in range(rounds):
@@ -353,6 +372,49 @@ def _minimize(fun, theta0, maxiter, gtol, stop_below=None):
 #
 # Problems
 #
+
+def _stabilize_discrete(prob, theta, maxiter, gtol, target):
+    theta, f, nit = stabilize_lq(prob.shifted_lq, theta, prob.log_radius,
+                                 -np.inf if target is None else target, maxiter)
+    if target is not None and f < target:
+        return theta, nit, 'stabilized'
+    theta_new, k, message = _minimize(prob.stab_objective, theta, maxiter, gtol,
+                                      stop_below=target)
+    if prob.log_radius(theta_new) <= f:
+        theta = theta_new
+    return theta, nit + k, message
+
+
+def _state_feedback_seed(prob):
+    """A start for discrete stabilization: the periodic LQR gains ``K_k`` (the
+    problem's weights, else identities) at up to ten steps, projected on the
+    outputs (``K_k C_k⁺``) and used as constant gains scaled by 10^-3..10^3;
+    the one of smallest ``|μ_max|`` (parameters θ), None when dlqr fails."""
+    n, m = prob.n, prob.m
+    Q = prob.Q.mean(0) if hasattr(prob, 'Q') else np.eye(n)
+    R = prob.R.mean(0) if hasattr(prob, 'R') else np.eye(m)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore')
+            Kd = dlqr(prob.sys, Q, R)[0]
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError, ControlArgument):
+        return None
+    N = prob.N
+    steps = np.unique(np.linspace(0, N - 1, min(N, 10)).astype(int))
+    Ks = np.asarray(Kd.sample(N), float).reshape(N, m, n)
+    F0 = Ks[steps] @ np.linalg.pinv(prob.C[steps])                  # (k, m, p)
+    F = (np.logspace(-3, 3, 25)[:, None, None, None] * F0).reshape(-1, m, prob.p)
+    if not np.all(np.isfinite(F)):
+        return None
+    M = np.broadcast_to(np.eye(n), (F.shape[0], n, n))
+    with np.errstate(all='ignore'):
+        for k in range(N):
+            M = (prob.A[k] - prob.B[k] @ F @ prob.C[k]) @ M
+        r = np.abs(np.linalg.eigvals(np.nan_to_num(M, nan=1e300, posinf=1e300,
+                                                   neginf=-1e300))).max(-1)
+    best = F[int(np.argmin(r))]
+    return prob.basis.lift(best).ravel()
+
 
 def _problem(sys, times, order, Q, R, X0, nsteps):
     sys = as_ltp(sys)
