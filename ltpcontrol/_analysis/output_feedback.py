@@ -60,14 +60,17 @@ from .._core.ltpsys import feedback
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .._core.steps import step_grid, step_integrals
 from .._core.validation import real_array
+from .design import dlqr
 from .lyapunov import cyclic_lyap
+from .output_feedback_basis import Basis as _Basis
+from .output_feedback_lq import DiscreteLQ, minimize_lq, stabilize_lq
 
 __all__ = ['ofstab', 'oflqr', 'OutputFeedbackResult']
 
 # Gauss–Legendre nodes per step of the continuous-time gradient quadrature
 _GAUSS = 6
 # log|μ_max| a stabilizing start for the LQ phase must reach
-_STAB_TARGET = -0.05
+_STAB_TARGET = -1e-3
 # degree of the Chebyshev surrogates of the continuous-time plant data per step
 _CHEB = 16
 
@@ -140,7 +143,9 @@ def ofstab(sys, *, times=None, order=None, K0=None, target=None, maxiter=100, gt
         matrices).  Give `times` or `order`, not both.
     K0 : array_like, optional
         Initial parameters ``F_i``, shape (s, m, p) or (m, p) (the same for
-        all); zero by default.
+        all); zero by default (for a discrete plant that the homotopy
+        from zero does not stabilize, then the projected periodic LQR gain
+        ``K_k C_k⁺`` of smallest multiplier over a log-spaced scale).
     target : float, optional
         Stop as soon as the stability degree (`OutputFeedbackResult.sdeg`)
         is below this value; by default it is minimized as far as the
@@ -202,7 +207,11 @@ def oflqr(sys, Q, R, *, X0=None, times=None, order=None, K0=None, maxiter=500, g
     k) from an initial state of covariance X0 at t = 0, over a switching or
     harmonic gain, with exact gradients from periodic Lyapunov adjoints
     (module notes).  A non-stabilizing start is first stabilized by
-    `ofstab`'s objective.
+    `ofstab`'s objective; without `K0`, a switching or harmonic family
+    starts from the best constant gain when that one stabilizes.  Discrete
+    time, BFGS works in variables whitened by the Levine–Athans curvature
+    and a trust-region Newton step with the exact Hessian finishes
+    (`ltpcontrol._analysis.output_feedback_lq`).
 
     Parameters
     ----------
@@ -213,7 +222,23 @@ def oflqr(sys, Q, R, *, X0=None, times=None, order=None, K0=None, maxiter=500, g
         time also one matrix per step, shape (N, ., .)).
     X0 : array_like, optional
         Covariance of the initial state (n, n); identity by default.
-    times, order, K0, maxiter, gtol, nsteps
+    times, order, K0
+        As in `ofstab`.  A discrete plant that the homotopy from zero does
+        not stabilize is restarted from the projected periodic LQR gain
+        ``K_k C_k⁺`` of smallest closed-loop multiplier over a log-spaced
+        scale.
+    maxiter : int, optional
+        Iterations of each phase (stabilization, BFGS; discrete time also
+        at most ``min(100, maxiter)`` Newton steps after each BFGS stage,
+        then trust-region Newton rounds along negative curvature when both
+        stall).
+    gtol : float, optional
+        Discrete time: relative tolerance of the Newton decrement
+        ``gᵀH⁻¹g <= gtol·J`` (exact Hessian H, positive definite: a
+        certified local minimum), or of the gradient whitened by the
+        Levine–Athans curvature Ĥ, ``gᵀĤ⁻¹g <= gtol·J`` (a stationary
+        point, reported as such); continuous time: BFGS gradient tolerance.
+    nsteps
         As in `ofstab`.
 
     Returns
@@ -236,15 +261,31 @@ def oflqr(sys, Q, R, *, X0=None, times=None, order=None, K0=None, maxiter=500, g
     >>> bool(abs(info.cost - np.trace(X(0.0))) < 1e-6 * info.cost)
     True
     """
+    return _oflqr(sys, Q, R, X0, times, order, K0, maxiter, gtol, nsteps, seed=True)
+
+
+def _oflqr(sys, Q, R, X0, times, order, K0, maxiter, gtol, nsteps, seed):
     prob = _problem(sys, times, order, Q, R, X0, nsteps)
     theta = prob.initial(K0)
     nit, message = 0, ''
+    if K0 is None and prob.basis.size > 1:
+        # warm start: the best constant gain, when the homotopy from zero
+        # finds one (the family's own homotopy is tried before any seed)
+        _, const = _oflqr(sys, Q, R, X0, None, None, None, maxiter, gtol, nsteps, seed=False)
+        nit = const.nit
+        if np.isfinite(const.cost):
+            theta = prob.basis.lift(const.params[0]).ravel()
     if not prob.log_radius(theta) < _STAB_TARGET:
-        theta, nit, message = _stabilize(prob, theta, maxiter, gtol, _STAB_TARGET)
+        theta, k, message = _stabilize(prob, theta, maxiter, gtol, _STAB_TARGET, seed=seed)
+        nit += k
         if not prob.log_radius(theta) < 0:
             return prob.result(theta, nit, "no stabilizing gain found in the family: "
                                + message, objective='lq')
-    theta, nit2, message = _minimize(prob.lq_objective, theta, maxiter, gtol)
+    if prob.discrete:
+        theta, nit2, converged, message = minimize_lq(prob.lq, theta, maxiter, gtol)
+        message = message if converged else message + ' (not converged)'
+    else:
+        theta, nit2, message = _minimize(prob.lq_objective, theta, maxiter, gtol)
     return prob.result(theta, nit + nit2, message, objective='lq')
 
 
@@ -256,11 +297,24 @@ class _Stop(Exception):
     pass
 
 
-def _stabilize(prob, theta, maxiter, gtol, target, rounds=8):
+def _stabilize(prob, theta, maxiter, gtol, target, rounds=8, seed=True):
     """Lower the dominant multiplier by a homotopy on the shift α (module notes):
     minimize the smooth shifted cost with α just above ``log|μ_max|``, then
     lower α; finish with BFGS on ``log|μ_max|`` itself.  Stops early once
-    ``log|μ_max| < target`` (when given)."""
+    ``log|μ_max| < target`` (when given).  Discrete plants use whitened
+    variables and the LQ weights (`output_feedback_lq.stabilize_lq`)."""
+    if prob.discrete:
+        theta, nit, message = _stabilize_discrete(prob, theta, maxiter, gtol, target)
+        if seed and not prob.log_radius(theta) < 0 and not np.any(theta):
+            # the homotopy from zero failed: restart from the best projected
+            # state-feedback gain
+            seed = _state_feedback_seed(prob)
+            if seed is not None:
+                seeded, k, message = _stabilize_discrete(prob, seed, maxiter, gtol, target)
+                nit += k
+                if prob.log_radius(seeded) < prob.log_radius(theta):
+                    theta = seeded
+        return theta, nit, message
     f = prob.log_radius(theta)
     nit, message = 0, ''
     for _ in range(rounds):
@@ -319,6 +373,49 @@ def _minimize(fun, theta0, maxiter, gtol, stop_below=None):
 # Problems
 #
 
+def _stabilize_discrete(prob, theta, maxiter, gtol, target):
+    theta, f, nit = stabilize_lq(prob.shifted_lq, theta, prob.log_radius,
+                                 -np.inf if target is None else target, maxiter)
+    if target is not None and f < target:
+        return theta, nit, 'stabilized'
+    theta_new, k, message = _minimize(prob.stab_objective, theta, maxiter, gtol,
+                                      stop_below=target)
+    if prob.log_radius(theta_new) <= f:
+        theta = theta_new
+    return theta, nit + k, message
+
+
+def _state_feedback_seed(prob):
+    """A start for discrete stabilization: the periodic LQR gains ``K_k`` (the
+    problem's weights, else identities) at up to ten steps, projected on the
+    outputs (``K_k C_k⁺``) and used as constant gains scaled by 10^-3..10^3;
+    the one of smallest ``|μ_max|`` (parameters θ), None when dlqr fails."""
+    n, m = prob.n, prob.m
+    Q = prob.Q.mean(0) if hasattr(prob, 'Q') else np.eye(n)
+    R = prob.R.mean(0) if hasattr(prob, 'R') else np.eye(m)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore')
+            Kd = dlqr(prob.sys, Q, R)[0]
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError, ControlArgument):
+        return None
+    N = prob.N
+    steps = np.unique(np.linspace(0, N - 1, min(N, 10)).astype(int))
+    Ks = np.asarray(Kd.sample(N), float).reshape(N, m, n)
+    F0 = Ks[steps] @ np.linalg.pinv(prob.C[steps])                  # (k, m, p)
+    F = (np.logspace(-3, 3, 25)[:, None, None, None] * F0).reshape(-1, m, prob.p)
+    if not np.all(np.isfinite(F)):
+        return None
+    M = np.broadcast_to(np.eye(n), (F.shape[0], n, n))
+    with np.errstate(all='ignore'):
+        for k in range(N):
+            M = (prob.A[k] - prob.B[k] @ F @ prob.C[k]) @ M
+        r = np.abs(np.linalg.eigvals(np.nan_to_num(M, nan=1e300, posinf=1e300,
+                                                   neginf=-1e300))).max(-1)
+    best = F[int(np.argmin(r))]
+    return prob.basis.lift(best).ravel()
+
+
 def _problem(sys, times, order, Q, R, X0, nsteps):
     sys = as_ltp(sys)
     if sys.nstates == 0 or sys.ninputs == 0 or sys.noutputs == 0:
@@ -327,64 +424,6 @@ def _problem(sys, times, order, Q, R, X0, nsteps):
     basis = _Basis(sys, times, order)
     cls = _DiscreteProblem if sys.isdtime(strict=True) else _ContinuousProblem
     return cls(sys, basis, Q, R, X0, nsteps)
-
-
-class _Basis:
-    """Switching indicators or harmonics ``φ_i`` of the gain family."""
-
-    def __init__(self, sys, times, order):
-        T = sys.period
-        self.period, self.discrete = T, sys.isdtime(strict=True)
-        if times is not None and order is not None:
-            raise ControlArgument("give times (switching gain) or order (harmonic gain), "
-                                  "not both")
-        if order is not None:
-            if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 0:
-                raise ValueError(f"order must be a non-negative integer, got {order!r}")
-            if self.discrete and 2 * order + 1 > sys.nsteps:
-                raise ValueError(f"order {order} needs {2 * order + 1} samples per period, "
-                                 f"the plant has {sys.nsteps}")
-            self.kind, self.order, self.size = 'harmonic', int(order), 2 * int(order) + 1
-            return
-        times = np.zeros(1) if times is None else real_array(times, 'times', ndim=1)
-        if len(times) == 0 or abs(times[0]) > 1e-12 * T:
-            raise ValueError("times must start at 0 (the partition must cover the period "
-                             f"from its start), got {times[:1]}")
-        if np.any(np.diff(times) <= 0) or times[-1] >= T or times[0] < 0:
-            raise ValueError(f"times must increase strictly within [0, {T}) (one period), "
-                             f"got {times}")
-        if self.discrete:
-            k = times / sys.dt
-            if np.any(np.abs(k - np.round(k)) > 1e-9 * max(1.0, k.max())):
-                raise ValueError(f"times must be multiples of dt={sys.dt} for a discrete "
-                                 f"plant, got {times}")
-            self.steps = np.round(k).astype(int)
-        self.kind, self.times, self.size = 'switching', times.copy(), len(times)
-
-    def values(self, t):
-        """``φ_i(t)``, shape (len(t), s)."""
-        t = np.mod(np.asarray(t, float), self.period)
-        if self.kind == 'switching':
-            idx = np.searchsorted(self.times, t + 1e-12 * self.period, side='right') - 1
-            return (idx[:, None] == np.arange(self.size)).astype(float)
-        w = 2 * np.pi / self.period * np.arange(1, self.order + 1)
-        out = np.empty((len(t), self.size))
-        out[:, 0] = 1.0
-        out[:, 1::2] = np.cos(t[:, None] * w)
-        out[:, 2::2] = np.sin(t[:, None] * w)
-        return out
-
-    def matrix(self, theta):
-        """The continuous-time gain F as a `PeriodicMatrix`."""
-        if self.kind == 'switching':
-            return PeriodicMatrix.switching(list(theta), self.times, self.period)
-        q = self.order
-        coeffs = np.zeros((2 * q + 1,) + theta.shape[1:], complex)
-        coeffs[q] = theta[0]
-        for j in range(1, q + 1):
-            c = 0.5 * (theta[2 * j - 1] - 1j * theta[2 * j])
-            coeffs[q + j], coeffs[q - j] = c, np.conj(c)
-        return PeriodicMatrix(coeffs, self.period)
 
 
 class _Problem:
@@ -629,6 +668,7 @@ class _DiscreteProblem(_Problem):
             self.Q = _per_step(Q, sys, 'Q', (n, n))
             self.R = _per_step(R, sys, 'R', (m, m))
             _check_weights(self.Q, self.R)
+            self.lq = DiscreteLQ(self.A, self.B, self.C, self.Q, self.R, self.X0, self.phi)
 
     def gain(self, params):
         F = np.einsum('ki,iab->kab', self.phi, params)
@@ -672,26 +712,19 @@ class _DiscreteProblem(_Problem):
         return f, np.einsum('ki,kab->iab', self.phi, G).ravel()
 
     def lq_objective(self, theta):
-        params = self.unpack(theta)
-        F, Ac = self._closed(params)
-        c = 1.0 if self.shift is None else np.exp(-self.shift / self.N)
-        Ac = c * Ac
-        logmod, _ = _log_multipliers(None, None, grid=None, factors=Ac)
-        if not logmod.max() < 0:
-            return np.inf, np.zeros_like(theta)
-        FC = F @ self.C
-        if self.shift is None:
-            Qc, RFC = self.Q + np.swapaxes(FC, 1, 2) @ self.R @ FC, self.R @ F @ self.C
-        else:                                        # stabilization: Q = I, R = 0
-            Qc, RFC = np.broadcast_to(np.eye(self.n), Ac.shape), 0.0
-        P = cyclic_lyap(Ac, Qc, adjoint=True, check=False)
-        W = np.zeros_like(Ac)
-        W[-1] = self.X0
-        Y = cyclic_lyap(Ac, W, check=False)
-        Pn = np.roll(P, -1, axis=0)                  # P_{k+1}
-        cost = float(np.trace(P[0] @ self.X0))
-        G = 2 * (RFC - c * np.swapaxes(self.B, 1, 2) @ Pn @ Ac) @ Y @ np.swapaxes(self.C, 1, 2)
-        return cost, np.einsum('ki,kab->iab', self.phi, G).ravel()
+        return self.lq(theta) if self.shift is None else self.shifted_lq(self.shift)(theta)
+
+    def shifted_lq(self, alpha):
+        """LQ cost of the loop scaled by ``e^{-α}`` per period (A and B scaled by
+        ``e^{-α/N}``), with the design weights, or Q = I, R = 0 (`ofstab`)."""
+        c = np.exp(-alpha / self.N)
+        n, N = self.n, self.N
+        Q = getattr(self, 'Q', None)
+        if Q is None:
+            Q, R = np.broadcast_to(np.eye(n), (N, n, n)), np.zeros((N, self.m, self.m))
+        else:
+            R = self.R
+        return DiscreteLQ(c * self.A, c * self.B, self.C, Q, R, self.X0, self.phi)
 
 
 #
