@@ -77,7 +77,7 @@ most frequent order instead of selecting it again.  That run gives E_rms =
 8 % at 1 Hz (step 26 %); at 1 Hz over its two draws 18 ± 2 % before and 13
 ± 2 % after the reduction to the significant harmonics; and for the LTP
 models (n_p, K) = (2, 3) in both draws, E_rms at 1 Hz 24 ± 3 % (21 HTFs),
-7 ± 1 % (subspace, checked harmonics) and 5.9 % (ML), Cramér-Rao spread
+7.2 ± 0.5 % (subspace, checked harmonics) and 5.9 % (ML), Cramér-Rao spread
 2.9 %, noise-free 4.6 %.  Its `check` asserts the claims in that setting.
 """
 
