@@ -42,9 +42,10 @@ import numpy as np  # noqa: E402
 
 import ltpcontrol as ltp  # noqa: E402
 from hopper import HOPPER_PARAMS, PERIOD, hopper_plant  # noqa: E402
-from plot_hopper_htf_identification import (BAND, DESIGN, DT, QUICK, QUICK_DESIGN,  # noqa: E402
-                                            chirp_experiment, estimate, fit_parameters,
-                                            limit_cycle, model_htf, switching_times)
+from plot_hopper_htf_identification import (BAND, DESIGN, DT, N_JOBS, QUICK,  # noqa: E402
+                                            QUICK_DESIGN, chirp_experiment, estimate,
+                                            fit_parameters, limit_cycle, model_htf,
+                                            switching_times)
 
 #: Delays of Table 3.1 (seconds).
 INPUT_DELAYS = (0.0, 0.040, 0.080)
@@ -74,7 +75,7 @@ def delay_output(exc, y, output_delay):
     return out
 
 
-def delay_experiments(design=DESIGN, n_jobs=2):
+def delay_experiments(design=DESIGN, n_jobs=N_JOBS):
     """Estimated HTFs of the nine delayed experiments of Table 3.1.
 
     Returns a list of ``((τ_u, τ_y), HTF)`` in the order of the table and the

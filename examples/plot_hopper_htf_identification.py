@@ -65,6 +65,9 @@ DESIGN = {'nreplicas': 9, 'duration': 30.0, 'f0': 0.0, 'f1': 7.0, 'amplitude': 0
           'gap': 6.0}
 #: Reduced design for quick runs and tests.
 QUICK_DESIGN = {**DESIGN, 'duration': 12.0, 'gap': 5.0}
+#: Simulation processes: one in the quick run (the documentation build runs beside
+#: the test suite, where more processes only compete for the cores).
+N_JOBS = 1 if QUICK else 2
 #: Number of harmonics on each side estimated (G_-3 ... G_3).
 NHARMONICS = 3
 #: Frequency band of the estimate and of the parametric fit (rad/s).
@@ -120,7 +123,7 @@ def _run_record(plant, x0, mode0, xbar, chirp, t, input_delay):
     return resp.outputs - np.resize(xbar, t.size)
 
 
-def chirp_experiment(plant, cycle, design=DESIGN, input_delay=0.0, n_jobs=2):
+def chirp_experiment(plant, cycle, design=DESIGN, input_delay=0.0, n_jobs=N_JOBS):
     """Simulate the phase-shifted chirp experiment on the hybrid plant.
 
     Parameters
@@ -229,7 +232,7 @@ def fit_parameters(H, switching, magnitude_only=False):
                        magnitude_only=magnitude_only, bounds=([1.0, 0.0], [1e4, 1e2]))
 
 
-def identify(k=HOPPER_PARAMS['k'], c=HOPPER_PARAMS['c'], design=DESIGN, n_jobs=2):
+def identify(k=HOPPER_PARAMS['k'], c=HOPPER_PARAMS['c'], design=DESIGN, n_jobs=N_JOBS):
     """Whole pipeline for one plant: data, estimate, fit and eigenvalues.
 
     Returns a dict with the plant ``orbit`` (exact multipliers), the
@@ -250,7 +253,7 @@ def identify(k=HOPPER_PARAMS['k'], c=HOPPER_PARAMS['c'], design=DESIGN, n_jobs=2
             'eig_exact': np.sort_complex(orbit.multipliers)}
 
 
-def eigen_sweep(stiffness, design=DESIGN, n_jobs=2, known=None):
+def eigen_sweep(stiffness, design=DESIGN, n_jobs=N_JOBS, known=None):
     """Fig. 3.7: eigenvalues of the identified and exact return maps versus k.
 
     `known` maps spring constants to results of `identify` already at hand.

@@ -25,8 +25,15 @@ a zero initial state for inputs of period π: ``sin 2t``, ``sign(sin 2t)`` and
 a sawtooth between -1 and 1.  The simulator steps at 400 Hz with inputs
 linear between steps (the records keep every 4th sample); the lifted
 response removes that interpolation's gain (``input_hold='foh'``).
+
+With ``LTP_EXAMPLES_QUICK=1`` (the documentation build) the Nelder-Mead
+stage of the particle swarm search stops after 1000 evaluations
+instead of its default ``200 n²`` = 7200.  Both searches print the same
+outcome for the three seeds (success, corrected distance 0, refit residual
+1.9e-07).
 """
 
+import os
 import time
 import warnings
 
@@ -40,6 +47,10 @@ from mathieu import mathieu_ltp
 T, TS, OVERSAMPLE = 0.5, 0.01, 4
 THESIS_ERRORS = (0.0003, 0.0049, 0.0056)
 THESIS_NRMSE = (0.0030, 0.0042, 0.0040)
+
+QUICK = os.environ.get('LTP_EXAMPLES_QUICK', '0') == '1'
+#: Nelder-Mead evaluations after the swarm in the quick run (default search: 7200).
+QUICK_NM_FEVALS = 1000
 
 true = mathieu_ltp()
 
@@ -79,7 +90,9 @@ for seed in range(3):
         warnings.simplefilter('always')
         _, pinfo = ltp.identify_ltp(G, T, 2, 1, q=50, realization='pso', seed=seed,
                                 return_info=True, realization_options={
-                                    'pso_options': {'iters': 200}})
+                                    'pso_options': {'iters': 200},
+                                    'minimize_options': ({'maxfev': QUICK_NM_FEVALS}
+                                                         if QUICK else None)})
     print(f"pso seed {seed}: success={pinfo.realization.success}, corrected distance "
           f"{pinfo.realization.corrected_distance:.2e}, refit residual "
           f"{pinfo.relative_residual:.1e}")

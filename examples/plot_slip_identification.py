@@ -43,6 +43,9 @@ from slip_model import METHODS, stride_trajectory  # noqa: E402
 
 QUICK = os.environ.get("LTP_EXAMPLES_QUICK", "0") == "1"
 N_HOPS, N_STRIDES, FOLDS, N_CLEAN = (15, 40, 5, 30) if QUICK else (50, 120, 30, 60)
+#: Worker processes for the fits: one in the quick run (the documentation build
+#: runs beside the test suite, where more processes only compete for the cores).
+N_JOBS = 1 if QUICK else -1
 ORDER = ("hard", "medium", "soft", "softer")
 start = time.time()
 rng = np.random.default_rng(2017)
@@ -83,7 +86,7 @@ model = MONOPOD.replace(m_b=vertical["m_b"], m_l=vertical["m_l"],
 # estimates; lossless predictors fit the stiffness only.
 
 jobs = [(s, m) for s in ORDER for m in METHODS]
-results = Parallel(n_jobs=-1)(
+results = Parallel(n_jobs=N_JOBS)(
     delayed(cross_validate)(runs[s], model.replace(k=vertical["springs"][s][0],
                                                    d=vertical["springs"][s][1]),
                             m, folds=FOLDS, vy0=vy0[s])
@@ -120,8 +123,9 @@ print(f"{'True':<9}" + "".join(f"{SPRINGS[s][0]:8.0f} / {SPRINGS[s][1]:5.1f}".rj
 # centrifugal term linearised at the rest length, while these legs compress
 # by up to a third), not of the fit: the same fit recovers ``k, d`` to
 # 1e-5 from transitions AAS itself predicts (see the tests).  The lossless
-# numerical SLIP needs a stiffer leg than the truth (+8 to +11 %), as in
-# Table 2.5 (+19 to +31 %).  Geyer's approximation is biased soft on its
+# numerical SLIP needs a stiffer leg than the truth (+8 to +11 % in the full
+# run, 60 clean strides per spring; +6 to +10 % in the reduced run of the
+# documentation build, 30 strides), as in Table 2.5 (+19 to +31 %).  Geyer's approximation is biased soft on its
 # own, and on these data its fit stays below the truth instead of the
 # thesis's +40 to +115 %.
 
@@ -133,7 +137,7 @@ clean_d_h, clean_vy0 = identify_flight_damping([clean_runs[s] for s in ORDER])
 clean_vy0 = dict(zip(ORDER, clean_vy0))
 clean_model = MONOPOD.replace(m_b=clean_vertical["m_b"], m_l=clean_vertical["m_l"],
                               d_v=clean_vertical["d_v"], d_h=clean_d_h)
-clean_fits = Parallel(n_jobs=-1)(
+clean_fits = Parallel(n_jobs=N_JOBS)(
     delayed(fit_leg)(clean_runs[s], clean_model.replace(k=clean_vertical["springs"][s][0],
                                                         d=clean_vertical["springs"][s][1]),
                      m, clean_vy0[s], max_nfev=100)

@@ -138,15 +138,20 @@ def identify(data, transient, lines):
                                 name='vhop_identified')
 
 
-def records(progress=False):
+def records(progress=False, n_jobs=None):
     """Plant, orbit and the noise-free records of step 1: ``(plant, orbit, (t, u, y),
-    transient, lines)``, the lines one row per band."""
+    transient, lines)``, the lines one row per band.
+
+    The records are simulated by `n_jobs` processes (default: one in the quick
+    run, which the documentation build runs beside the test suite, two otherwise).
+    """
+    n_jobs = (1 if QUICK else 2) if n_jobs is None else n_jobs
     plant = vhop_plant()
     orbit = vhop_orbit(plant)
     wp = 2 * np.pi / PERIOD
     excs = [ltp.multisine(('band', b * wp / 2, (b + 1) * wp / 2), PERIOD,
                           dt=PERIOD / NSAMPLES, **MULTISINE) for b in range(NBANDS)]
-    data = record_experiments(plant, orbit, excs, progress=progress)
+    data = record_experiments(plant, orbit, excs, progress=progress, n_jobs=n_jobs)
     lines = np.array([exc.frequencies for exc in excs])
     return plant, orbit, data, MULTISINE['settle'] * PERIOD, lines
 

@@ -107,9 +107,11 @@ def vhop_plant(**params):
                        target='stance', name='flight', jacobian=_flight_jacobian,
                        input_jacobian=_flight_input),
     ]
-    return ltp.HybridPlant(modes, lambda t, x, u, p: [x[0]],
-                           states=['h', 'h_t', 'hdot', 'hdot_t'], inputs=['u_c'],
-                           outputs=['h'], params={**VHOP_PARAMS, **params}, name='vhop')
+    plant = ltp.HybridPlant(modes, lambda t, x, u, p: [x[0]],
+                            states=['h', 'h_t', 'hdot', 'hdot_t'], inputs=['u_c'],
+                            outputs=['h'], params={**VHOP_PARAMS, **params}, name='vhop')
+    plant._vhop_params = tuple(sorted(plant.params.items()))
+    return plant
 
 
 def release_state(height=0.3, params=VHOP_PARAMS):
@@ -122,15 +124,37 @@ def release_state(height=0.3, params=VHOP_PARAMS):
     return np.array([height, height - leg, 0.0, 0.0])
 
 
+#: Orbits already computed in this process, by plant parameters and arguments.
+_ORBITS = {}
+
+
 def vhop_orbit(plant=None, height=0.3, warmup=20, **kwargs):
     """Hopping limit cycle reached after releasing the robot at `height`.
 
     Simulates `warmup` periods from `release_state` and then refines the
-    orbit by shooting (keywords go to `ltpcontrol.periodic_orbit`).
+    orbit by shooting (keywords go to `ltpcontrol.periodic_orbit`).  The
+    orbit of a plant made by `vhop_plant` is computed once per process for
+    the same parameters and arguments (the examples that use it run in one
+    documentation build); the same orbit object is returned again, so
+    callers must not modify it.
     """
     plant = vhop_plant() if plant is None else plant
-    return ltp.periodic_orbit(plant, PERIOD, release_state(height, plant.params), 'flight',
-                              warmup=warmup, **kwargs)
+    key = getattr(plant, '_vhop_params', None)
+    if key is not None and plant.params == dict(key):
+        key = (key, height, warmup, tuple(sorted(kwargs.items())))
+        try:
+            hash(key)
+        except TypeError:           # unhashable keywords: no reuse
+            key = None
+    else:
+        key = None
+    if key is not None and key in _ORBITS:
+        return _ORBITS[key]
+    orbit = ltp.periodic_orbit(plant, PERIOD, release_state(height, plant.params), 'flight',
+                               warmup=warmup, **kwargs)
+    if key is not None:
+        _ORBITS[key] = orbit
+    return orbit
 
 
 if __name__ == '__main__':
