@@ -169,7 +169,7 @@ class _FloquetFit:
             Xsel[a, n - m + L] = X.transpose(1, 0, 2, 3)
         JC = np.einsum('oz,nlwiq->qnowlzi', ey, Xsel[:, L - 2 * K:L + 2 * K + 1])
         # dG_n = dD_n, |n| <= K
-        JD = np.einsum('qr,na,oz,w->qnowazr', eu, np.eye(2 * Kd + 1, 2 * K + 1, Kd - K), ey,
+        JD = np.einsum('qr,na,oz,w->qnowazr', eu, np.eye(2 * Kd + 1, 2 * K + 1, K - Kd), ey,
                        np.ones(M))
         # J @ self.T, one series at a time (T is 0, 1 and ±j in blocks)
         J = np.hstack([_apply_conj_map(Jx.reshape(G.size, -1), h, size)
