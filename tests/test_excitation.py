@@ -180,3 +180,12 @@ def test_designs_in_channel_experiment_time_order():
     old = exc.inputs[0]
     with pytest.raises(ControlDimension, match=r"shape \(1, 2, L\)"):
         ltp.lifted_frequency_response((exc.time, old, y[0]), 2.0, 1)
+
+
+def test_multisine_signal_at_single_instants_equals_the_record():
+    # a variable-step simulator asks for one instant at a time: same values
+    # (same bits) as the whole record, for one and several experiments and inputs
+    for kw in ({}, {'nexperiments': 3}, {'nexperiments': 2, 'ninputs': 2}):
+        exc = multisine(('band', 3.0, 40.0), 0.33, dt=0.01, nperiods=30, settle=2, **kw)
+        for k in (0, 7, 1000, exc.time.size - 1):
+            np.testing.assert_array_equal(exc.signal(exc.time[k]), exc.inputs[..., k])

@@ -254,6 +254,11 @@ def _grid_frequencies(frequencies, window, name):
     return bins * step, bins
 
 
+#: samples x experiments up to which a sum-of-cosines signal is evaluated for all
+#: lines at once (larger requests line by line, memory samples x experiments)
+_BATCH = 64
+
+
 def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitude, what,
                      shifts=None):
     """Sum-of-cosines experiments; experiment r is delayed by r T / nexp (jointly
@@ -270,6 +275,12 @@ def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitud
         # u_r(t) = Σ_l a cos(ω_l (t - τ_r) + φ_l + shift), accumulated line by
         # line so that memory stays (experiments x samples)
         shifted = t[None, :] - delays[:, None]
+        if shifted.size <= _BATCH:
+            # few samples (a variable-step simulator asks for one at a time):
+            # all lines at once, summed in the order of the loop below (cumsum
+            # adds in sequence, so both paths give the same bits)
+            arg = omega[:, None, None] * shifted + phases[:, None, None] + shift
+            return amplitude * np.cumsum(np.cos(arg), axis=0)[-1]
         out = np.zeros(shifted.shape)
         for w, phi in zip(omega, phases):
             out += np.cos(w * shifted + phi + shift)

@@ -98,6 +98,19 @@ def _conj_map(H, size):
     return T
 
 
+def _apply_conj_map(J, H, size):
+    """``J @ _conj_map(H, size)`` by additions: the columns of ``Re P_h`` are those
+    of ``P_h`` plus those of ``P_{-h}``, the columns of ``Im P_h`` j times their
+    difference."""
+    J = J.reshape(J.shape[0], 2 * H + 1, size)
+    out = np.empty(J.shape, complex)
+    out[:, 0] = J[:, H]
+    pos, neg = J[:, H + 1:], J[:, H - 1::-1]              # P_h and P_{-h}, h = 1..H
+    out[:, 1::2] = pos + neg
+    out[:, 2::2] = 1j * (pos - neg)
+    return out.reshape(J.shape[0], -1)
+
+
 class _FloquetFit:
     """Real parameter vector θ = (B, C, D coefficients[, A]) of a model with H
     harmonics in B, 2K in C and K in D fitted to the data harmonics |n| <= Kd."""
@@ -112,6 +125,8 @@ class _FloquetFit:
         nb, nc = self.nb, self.nc
         T[:nb, :nb], T[nb:nb + nc, nb:nb + nc], T[nb + nc:, nb + nc:] = Tb, Tc, Td
         self.T = T if estimate_d else T[:, :nb + nc]
+        # (harmonics, size) of the coefficient series of θ, for `_apply_conj_map`
+        self.series = [(H, nx * nu), (2 * K, ny * nx)] + ([(K, ny * nu)] if estimate_d else [])
         self.ncoef = self.T.shape[1]
         Kd = self.Kd
         self.cpad = ((Kd + H - 2 * K,) * 2, (0, 0), (0, 0))   # C_l = 0 for 2K < |l| <= Kd+H
@@ -154,9 +169,11 @@ class _FloquetFit:
             Xsel[a, n - m + L] = X.transpose(1, 0, 2, 3)
         JC = np.einsum('oz,nlwiq->qnowlzi', ey, Xsel[:, L - 2 * K:L + 2 * K + 1])
         # dG_n = dD_n, |n| <= K
-        JD = np.einsum('qr,na,oz,w->qnowazr', eu, np.eye(2 * Kd + 1, 2 * K + 1, Kd - K), ey,
+        JD = np.einsum('qr,na,oz,w->qnowazr', eu, np.eye(2 * Kd + 1, 2 * K + 1, K - Kd), ey,
                        np.ones(M))
-        J = np.hstack([Jx.reshape(G.size, -1) for Jx in (JB, JC, JD)]) @ self.T
+        # J @ self.T, one series at a time (T is 0, 1 and ±j in blocks)
+        J = np.hstack([_apply_conj_map(Jx.reshape(G.size, -1), h, size)
+                       for Jx, (h, size) in zip((JB, JC, JD), self.series)])
         if self.fit_a:
             # dR_m = R_m dA R_m:  dG_n = Σ_m C_{n-m} R_m dA R_m B_m
             JA = np.einsum('nowmi,wmjq->qnowij', CR, X)
@@ -224,10 +241,9 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
         colnorm = np.linalg.norm(J, axis=0)
         colnorm = np.maximum(colnorm, 1e-8 * max(colnorm.max(), np.finfo(float).tiny))
         # one SVD per iteration: the damped step -V diag(s/(s²+μ)) U^T r for any μ
-        U, sv, Vt = _robust_svd(J / colnorm)
-        if U is None:
+        Utr, sv, Vt = _projected_svd(J / colnorm, r)
+        if Utr is None:
             break                                 # a Jacobian the SVD cannot take: stop
-        Utr = U.T @ r
         sv = np.where(sv > max(J.shape) * np.finfo(float).eps * sv[0], sv, 0.0)
         while True:
             with np.errstate(divide='ignore', invalid='ignore'):
@@ -260,6 +276,26 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
                           PeriodicMatrix(Dc, period), period, states=sys.state_labels,
                           **labels)
     return model, float(np.sqrt(f)), converged, nfev
+
+
+def _projected_svd(J, r):
+    """``(U^T r, s, V^T)`` of the thin SVD ``J = U diag(s) V^T``, without `U`.
+
+    A Householder QR of ``[J r]`` (R factor only) brings the tall ``m x p``
+    Jacobian to ``(p+1) x p`` with ``Q^T r`` beside it, whose SVD has the
+    singular values and right vectors of `J` (``U = Q U_R``); that is about
+    half the work of the SVD of `J` with its ``m x p`` left vectors.
+    ``(None, None, None)`` when `J` is not finite or the SVD fails
+    (`_robust_svd`).
+    """
+    if not np.all(np.isfinite(J)):
+        return None, None, None
+    p = J.shape[1]
+    R = scipy.linalg.qr(np.column_stack([J, r]), mode='r', check_finite=False)[0]
+    Ur, s, Vt = _robust_svd(R[:, :p])
+    if Ur is None:
+        return None, None, None
+    return Ur.T @ R[:, p], s, Vt
 
 
 def _robust_svd(J):

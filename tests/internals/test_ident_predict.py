@@ -13,7 +13,8 @@ from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
 import ltpcontrol._identification.ltp_subspace as subspace
-from ltpcontrol._identification.floquet_fit import _harmonic_data, _harmonic_response, fit_floquet
+from ltpcontrol._identification.floquet_fit import (_FloquetFit, _harmonic_data,
+                                                   _harmonic_response, fit_floquet)
 
 from examples.random_ltp_plants import design_lines, lifted_data, random_ltp
 from example_scripts import import_script
@@ -44,6 +45,25 @@ def test_fit_uses_all_data_harmonics():
     assert converged and res < 1e-10
     with pytest.raises(ValueError, match='harmonics'):
         fit_floquet(start, Gc[:, 6:9], LINES, 2)
+
+
+@pytest.mark.parametrize('estimate_d', [True, False])
+def test_fit_jacobian_equals_finite_differences(estimate_d):
+    """The refit's Jacobian (all of B, C, D and A, real parameters of complex
+    coefficient series) against central differences of its response."""
+    nx, ny, nu, K, H, Kd = 2, 2, 3, 1, 2, 4
+    fit = _FloquetFit(nx, ny, nu, K, H, T, estimate_d, True, Kd)
+    rng = np.random.default_rng(3)
+    theta = rng.standard_normal(fit.ncoef + nx * nx)
+    theta[fit.ncoef:] = (np.diag([-1.0, -2.5]) + 0.3 * rng.standard_normal((2, 2))).ravel()
+    omega = np.array([0.7, 2.9, 8.1])
+    G, J = fit.response_and_jacobian(theta, omega)
+    assert J.shape == (G.size, theta.size)
+    h = 1e-6
+    fd = np.stack([(fit.response_and_jacobian(theta + h * e, omega, jac=False)[0]
+                    - fit.response_and_jacobian(theta - h * e, omega, jac=False)[0]).ravel()
+                   / (2 * h) for e in np.eye(theta.size)], axis=1)
+    assert np.abs(J - fd).max() < 1e-7 * np.abs(fd).max()
 
 
 def test_periodic_a_model_predicts_in_time_domain():
