@@ -299,7 +299,8 @@ def gram(sys, type):
 
     Examples
     --------
-    >>> G = ct.rss(3, 1, 1, strictly_proper=True)
+    >>> G = ct.ss([[-1.0, 0.0, 0.0], [1.0, -2.0, 0.0], [0.0, 1.0, -3.0]],
+    ...           [[1.0], [0.0], [0.5]], [[0.0, 1.0, 1.0]], 0)
     >>> P = ltp.gram(ltp.ltpss(G, period=2.0), 'c')
     >>> np.allclose(P(0.7), ct.gram(G, 'c'))
     True

@@ -68,7 +68,8 @@ def hsvd(sys, t=None, *, nsteps=None):
 
     Examples
     --------
-    >>> G = ct.rss(3, 1, 1, strictly_proper=True)
+    >>> G = ct.ss([[-1.0, 0.0, 0.0], [1.0, -2.0, 0.0], [0.0, 1.0, -3.0]],
+    ...           [[1.0], [0.0], [0.5]], [[0.0, 1.0, 1.0]], 0)
     >>> hsv = ltp.hsvd(ltp.ltpss(G, period=1.0))
     >>> np.allclose(hsv[0], np.sort(ct.hankel_singular_values(G))[::-1])
     True
