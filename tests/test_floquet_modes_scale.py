@@ -187,14 +187,18 @@ def test_nonstiff_modes_agree_with_a_formed_product():
     assert np.abs(x[:, :-1] - expect).max() <= 1e-11
 
 
-def test_monodromy_memory_does_not_grow_with_the_steps():
-    rng = np.random.default_rng(2)
-    n = 8
+def _autonomous(n, seed):
+    """A random autonomous system with A(t) = A0 + cos(ωt) A1."""
+    rng = np.random.default_rng(seed)
     A0, A1 = rng.standard_normal((2, n, n))
     Ap = PeriodicMatrix.from_function(
         lambda t: A0 + np.cos(W * np.atleast_1d(t))[:, None, None] * A1, T, (n, n),
         check=False)
-    sys = ltpss(Ap, np.zeros((n, 0)), np.zeros((0, n)), np.zeros((0, 0)), period=T)
+    return ltpss(Ap, np.zeros((n, 0)), np.zeros((0, n)), np.zeros((0, 0)), period=T)
+
+
+def test_monodromy_memory_does_not_grow_with_the_steps():
+    sys = _autonomous(8, seed=2)
     peaks, results = [], []
     for steps in (2048, 8192):
         tracemalloc.start()
@@ -216,13 +220,7 @@ def test_stiff_monodromy_warns_and_points_to_the_exponents(stiff_case):
 
 
 def test_floquet_transform_refuses_a_table_that_cannot_fit_before_any_work():
-    rng = np.random.default_rng(4)
-    n = 20
-    A0, A1 = rng.standard_normal((2, n, n))
-    Ap = PeriodicMatrix.from_function(
-        lambda t: A0 + np.cos(W * np.atleast_1d(t))[:, None, None] * A1, T, (n, n),
-        check=False)
-    sys = ltpss(Ap, np.zeros((n, 0)), np.zeros((0, n)), np.zeros((0, 0)), period=T)
+    sys = _autonomous(20, seed=4)
     with pytest.raises(MemoryError, match='GB'):
         floquet_transform(sys, nsteps=2 * 10 ** 6)
 
