@@ -112,7 +112,9 @@ def monodromy(sys, nsteps=None):
         return out
     A, n = fast_form(sys.A), sys.nstates
     if nsteps is not None:
-        grid = step_grid(A, nsteps=check_positive_int(nsteps, 'nsteps'))
+        nsteps = check_positive_int(nsteps, 'nsteps')
+        check_allocation((nsteps + 1,), f"the step grid of nsteps={nsteps}")
+        grid = step_grid(A, nsteps=nsteps)
     else:
         norm = floquet_norm(A)
         stiff = sys.period * norm > STIFF
