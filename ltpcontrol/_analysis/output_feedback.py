@@ -210,8 +210,7 @@ def oflqr(sys, Q, R, *, X0=None, times=None, order=None, K0=None, maxiter=500, g
     `ofstab`'s objective; without `K0`, a switching or harmonic family
     starts from the best constant gain when that one stabilizes.  Discrete
     time, BFGS works in variables whitened by the Levine–Athans curvature
-    and a trust-region Newton step with the exact Hessian finishes
-    (`ltpcontrol._analysis.output_feedback_lq`).
+    and a trust-region Newton step with the exact Hessian finishes.
 
     Parameters
     ----------
