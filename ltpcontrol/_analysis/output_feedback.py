@@ -54,8 +54,7 @@ from scipy.optimize import minimize
 from control.exception import ControlArgument, ControlDimension
 
 from .._core.coerce import as_ltp
-from .._core.floquet import (PiecewiseChebyshev, _log_multipliers, chebyshev_nodes,
-                             floquet_multipliers)
+from .._core.floquet import _log_multipliers, floquet_multipliers
 from .._core.ltpsys import feedback
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .._core.steps import step_grid, step_integrals
@@ -63,7 +62,8 @@ from .._core.validation import real_array
 from .design import dlqr
 from .lyapunov import cyclic_lyap
 from .output_feedback_basis import Basis as _Basis
-from .output_feedback_lq import DiscreteLQ, minimize_lq, stabilize_lq
+from .output_feedback_inputs import _check_weights, _covariance, _is_zero, _per_step, _surrogate
+from .output_feedback_lq import DiscreteLQ, _minimize_lq, _stabilize_lq
 
 __all__ = ['ofstab', 'oflqr', 'OutputFeedbackResult']
 
@@ -71,8 +71,6 @@ __all__ = ['ofstab', 'oflqr', 'OutputFeedbackResult']
 _GAUSS = 6
 # log|μ_max| a stabilizing start for the LQ phase must reach
 _STAB_TARGET = -1e-3
-# degree of the Chebyshev surrogates of the continuous-time plant data per step
-_CHEB = 16
 
 
 @dataclass
@@ -281,7 +279,7 @@ def _oflqr(sys, Q, R, X0, times, order, K0, maxiter, gtol, nsteps, seed):
             return prob.result(theta, nit, "no stabilizing gain found in the family: "
                                + message, objective='lq')
     if prob.discrete:
-        theta, nit2, converged, message = minimize_lq(prob.lq, theta, maxiter, gtol)
+        theta, nit2, converged, message = _minimize_lq(prob.lq, theta, maxiter, gtol)
         message = message if converged else message + ' (not converged)'
     else:
         theta, nit2, message = _minimize(prob.lq_objective, theta, maxiter, gtol)
@@ -301,7 +299,7 @@ def _stabilize(prob, theta, maxiter, gtol, target, rounds=8, seed=True):
     minimize the smooth shifted cost with α just above ``log|μ_max|``, then
     lower α; finish with BFGS on ``log|μ_max|`` itself.  Stops early once
     ``log|μ_max| < target`` (when given).  Discrete plants use whitened
-    variables and the LQ weights (`output_feedback_lq.stabilize_lq`)."""
+    variables and the LQ weights (`output_feedback_lq._stabilize_lq`)."""
     if prob.discrete:
         theta, nit, message = _stabilize_discrete(prob, theta, maxiter, gtol, target)
         if seed and not prob.log_radius(theta) < 0 and not np.any(theta):
@@ -373,7 +371,7 @@ def _minimize(fun, theta0, maxiter, gtol, stop_below=None):
 #
 
 def _stabilize_discrete(prob, theta, maxiter, gtol, target):
-    theta, f, nit = stabilize_lq(prob.shifted_lq, theta, prob.log_radius,
+    theta, f, nit = _stabilize_lq(prob.shifted_lq, theta, prob.log_radius,
                                  -np.inf if target is None else target, maxiter)
     if target is not None and f < target:
         return theta, nit, 'stabilized'
@@ -724,84 +722,3 @@ class _DiscreteProblem(_Problem):
         else:
             R = self.R
         return DiscreteLQ(c * self.A, c * self.B, self.C, Q, R, self.X0, self.phi)
-
-
-#
-# Input helpers
-#
-
-def _covariance(X0, n):
-    if X0 is None:
-        return np.eye(n)
-    X0 = real_array(X0, 'X0', ndim=2)
-    if X0.shape != (n, n):
-        raise ControlDimension(f"X0 must have shape {(n, n)}, got {X0.shape}")
-    if np.abs(X0 - X0.T).max() > 1e-10 * max(1.0, np.abs(X0).max()) \
-            or np.linalg.eigvalsh(0.5 * (X0 + X0.T)).min() < -1e-12 * np.abs(X0).max():
-        raise ValueError("X0 must be symmetric positive semidefinite")
-    return 0.5 * (X0 + X0.T)
-
-
-def _per_step(M, sys, name, shape):
-    if M is None:
-        raise ControlArgument(f"{name} is required")
-    if isinstance(M, PeriodicMatrix) or callable(M):
-        arr = as_periodic(M, sys.period, name).sample(sys.nsteps)
-    else:
-        arr = real_array(M, name, ndim=(2, 3))
-        if arr.ndim == 3 and arr.shape[0] != sys.nsteps:
-            raise ControlDimension(f"{name} has {arr.shape[0]} matrices but the period has "
-                                   f"{sys.nsteps} steps")
-    if arr.shape[-2:] != shape:
-        raise ControlDimension(f"{name} must have shape {shape}, got {arr.shape[-2:]}")
-    return np.broadcast_to(arr, (sys.nsteps,) + shape).copy()
-
-
-def _check_weights(Q, R):
-    for M, name in ((Q, 'Q'), (R, 'R')):
-        if np.abs(M - np.swapaxes(M, 1, 2)).max() > 1e-10 * max(1.0, np.abs(M).max()):
-            raise ValueError(f"{name} must be symmetric")
-    if np.linalg.eigvalsh(Q).min() < -1e-12 * max(1.0, np.abs(Q).max()):
-        raise ValueError("Q must be positive semidefinite")
-    if np.linalg.eigvalsh(R).min() <= 0:
-        raise ValueError("R must be positive definite")
-
-
-class _Surrogate:
-    """``t -> [M(t) for M in mats]`` from Chebyshev interpolants on the grid steps."""
-
-    def __init__(self, mats, grid):
-        self.parts = []
-        nodes = (grid[:-1, None] + np.diff(grid)[:, None] * chebyshev_nodes(_CHEB)).ravel()
-        probe = grid[:-1] + 0.3817 * np.diff(grid)
-        for M in mats:
-            vals = M(nodes).reshape((len(grid) - 1, _CHEB + 1) + M.shape)
-            interp = PiecewiseChebyshev(grid, vals)
-            exact = M(probe)
-            err = np.abs(interp(probe) - exact).max() / max(1.0, np.abs(exact).max())
-            if err > 1e-10:
-                warnings.warn(f"the plant data vary fast within the steps of the period grid "
-                              f"(interpolation error {err:.1e}); increase nsteps", UserWarning,
-                              stacklevel=4)
-            self.parts.append(interp)
-
-        self.cache = {}
-
-    def __call__(self, t):
-        # the integrator asks for the same node sets at every evaluation of
-        # the objective: remember them (bounded)
-        t = np.atleast_1d(np.asarray(t, float))
-        key = t.tobytes()
-        if key not in self.cache:
-            if len(self.cache) > 64:
-                self.cache.clear()
-            self.cache[key] = [f(t) for f in self.parts]
-        return self.cache[key]
-
-
-_surrogate = _Surrogate
-
-
-def _is_zero(D):
-    probe = np.concatenate([np.arange(16) * D.period / 16, D.breakpoints])
-    return not np.any(D(probe))

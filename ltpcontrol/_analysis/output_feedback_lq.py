@@ -182,7 +182,7 @@ class DiscreteLQ:
         return cost, grad, 0.5 * (H + H.T)
 
 
-def trust_newton(fun, theta, maxiter, rtol, metric=None, stall=1e-7, floor=1e-8):
+def _trust_newton(fun, theta, maxiter, rtol, metric=None, stall=1e-7, floor=1e-8):
     """Trust-region Newton with the exact Hessian (Moré–Sorensen step from
     the eigendecomposition).
 
@@ -268,7 +268,7 @@ def _tr_step(w, V, c, radius):
     return V @ step(hi)
 
 
-def minimize_lq(lq, theta, maxiter, rtol, newton=True, bfgs_round=200, newton_size=2e7):
+def _minimize_lq(lq, theta, maxiter, rtol, newton=True, bfgs_round=200, newton_size=2e7):
     """Minimize the discrete LQ cost from a stabilizing θ.
 
     Rounds of BFGS in variables whitened by `DiscreteLQ.curvature` at the
@@ -276,7 +276,7 @@ def minimize_lq(lq, theta, maxiter, rtol, newton=True, bfgs_round=200, newton_si
     variables useless to BFGS) until a round ends on its own, lowers J by
     less than 1e-8 relative or reaches the first-order test below, at most
     `maxiter` iterations in all; then (`newton`)
-    at most ``min(100, maxiter)`` steps of `trust_newton` with the exact
+    at most ``min(100, maxiter)`` steps of `_trust_newton` with the exact
     Hessian, which certifies a local minimum (positive definite Hessian,
     Newton decrement ``<= rtol J``).  Otherwise (or when the Hessian would
     need more than `newton_size` numbers, directions x steps x n²) the
@@ -295,7 +295,7 @@ def minimize_lq(lq, theta, maxiter, rtol, newton=True, bfgs_round=200, newton_si
         if not newton:
             return theta, nit, True, 'BFGS'
         if d * lq.N * lq.n ** 2 <= newton_size:
-            theta, k, ok, dec = trust_newton(lambda t, h: lq(t, hessian=h), theta,
+            theta, k, ok, dec = _trust_newton(lambda t, h: lq(t, hessian=h), theta,
                                              min(100, maxiter), rtol)
             nit += k
             if ok:
@@ -321,7 +321,7 @@ def minimize_lq(lq, theta, maxiter, rtol, newton=True, bfgs_round=200, newton_si
 
 
 def _polish(lq, theta, maxiter, rtol):
-    """Last stage of `minimize_lq` on an indefinite, badly scaled Hessian
+    """Last stage of `_minimize_lq` on an indefinite, badly scaled Hessian
     where BFGS and Newton stall: trust-region Newton steps along the
     negative curvature, the trust region alternately a ball in variables
     whitened by the curvature and in variables scaled by the Hessian
@@ -334,7 +334,7 @@ def _polish(lq, theta, maxiter, rtol):
             break
         J0 = lq(theta)[0]
         metric = lq.curvature(theta) if rnd % 2 else None
-        theta_new, k, ok, _ = trust_newton(lambda t, h: lq(t, hessian=h), theta,
+        theta_new, k, ok, _ = _trust_newton(lambda t, h: lq(t, hessian=h), theta,
                                            min(100, maxiter - nit), rtol, metric=metric,
                                            stall=1e-9, floor=1e-12)
         nit += max(k, 1)
@@ -354,7 +354,7 @@ def _whitened_decrement(lq, theta):
 
 
 def _whitened_bfgs(lq, theta, maxiter, rtol, bfgs_round):
-    """BFGS rounds in whitened variables (`minimize_lq`); ``(θ, nit)``."""
+    """BFGS rounds in whitened variables (`_minimize_lq`); ``(θ, nit)``."""
     nit, J, d = 0, lq(theta)[0], theta.size
     while nit < maxiter:
         H = lq.curvature(theta)
@@ -382,7 +382,7 @@ def _whitened_bfgs(lq, theta, maxiter, rtol, bfgs_round):
     return theta, nit
 
 
-def stabilize_lq(make_lq, theta, log_radius, target, maxiter, rounds=10):
+def _stabilize_lq(make_lq, theta, log_radius, target, maxiter, rounds=10):
     """Lower ``f = log|μ_max|`` (per period) below `target` by minimizing the
     LQ cost of loops scaled by ``e^{-α}`` per period, ``α = max(f, 0) +
     log 1.01`` (finite at the start; the reference toolbox's homotopy),
@@ -393,7 +393,7 @@ def stabilize_lq(make_lq, theta, log_radius, target, maxiter, rounds=10):
         if f < target or nit >= maxiter:
             break
         lq = make_lq(max(f, 0.0) + np.log(1.01))
-        theta_new, k, _, _ = minimize_lq(lq, theta, min(50, maxiter - nit), 0.0, newton=False)
+        theta_new, k, _, _ = _minimize_lq(lq, theta, min(50, maxiter - nit), 0.0, newton=False)
         nit += k
         f_new = log_radius(theta_new)
         if not f_new < f:

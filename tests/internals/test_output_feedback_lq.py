@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from ltpcontrol._analysis.lyapunov import cyclic_lyap
-from ltpcontrol._analysis.output_feedback_lq import DiscreteLQ, cyclic_congruence, trust_newton
+from ltpcontrol._analysis.output_feedback_lq import DiscreteLQ, cyclic_congruence, _trust_newton
 
 
 def _lq(seed, N=5, n=3, m=2, p=2, pieces=(0, 3)):
@@ -52,7 +52,7 @@ def test_unstable_loop_has_infinite_cost():
 
 def test_trust_newton_certifies_a_local_minimum():
     lq, rng = _lq(4)
-    theta, nit, ok, dec = trust_newton(lambda t, h: lq(t, hessian=h), np.zeros(8), 50, 1e-12)
+    theta, nit, ok, dec = _trust_newton(lambda t, h: lq(t, hessian=h), np.zeros(8), 50, 1e-12)
     J, g, H = lq(theta, hessian=True)
     assert ok and dec <= 1e-12 * J
     assert np.linalg.eigvalsh(H).min() > 0
@@ -64,9 +64,9 @@ def test_trust_newton_certifies_a_local_minimum():
 @pytest.mark.parametrize("metric", [False, True])
 def test_trust_newton_whitened_by_the_curvature_certifies_the_same_minimum(metric):
     lq, rng = _lq(4)
-    ref, _, ok_ref, _ = trust_newton(lambda t, h: lq(t, hessian=h), np.zeros(8), 50, 1e-12)
+    ref, _, ok_ref, _ = _trust_newton(lambda t, h: lq(t, hessian=h), np.zeros(8), 50, 1e-12)
     M = lq.curvature(np.zeros(8)) if metric else None
-    theta, nit, ok, dec = trust_newton(lambda t, h: lq(t, hessian=h), np.zeros(8), 50, 1e-12,
+    theta, nit, ok, dec = _trust_newton(lambda t, h: lq(t, hessian=h), np.zeros(8), 50, 1e-12,
                                        metric=M, stall=1e-9, floor=1e-12)
     assert ok and ok_ref and dec <= 1e-12 * lq(theta)[0]
     np.testing.assert_allclose(theta, ref, rtol=1e-6, atol=1e-9)
