@@ -139,7 +139,8 @@ class CellSamples:
     Every piece ``[p_s, p_{s+1}]`` is cut into k equal cells; the cells are
     numbered piece by piece (cell ``c`` is cell ``c % k`` of piece ``c // k``).
     A and B are interpolated over a whole piece, so a piece spanning many
-    cells costs G calls of A and B.
+    cells costs G calls of A and B.  The pieces are phases counted from
+    `offset` (A and B are sampled at ``offset + τ``).
 
     Examples
     --------
@@ -152,14 +153,15 @@ class CellSamples:
     ((4, 2, 1, 1), True)
     """
 
-    def __init__(self, A, B, pieces, k, G):
+    def __init__(self, A, B, pieces, k, G, offset=0.0):
         pieces = np.asarray(pieces, float)
         self.A, self.B, self.G, self.pieces = A, B, int(G), pieces
+        self.offset = float(offset)
         self.n, self.m = A.shape[0], B.shape[1]
         plen = np.diff(pieces)
         self.refine(k)
         self.nodes, self.weights = chebyshev_first_kind(self.G)
-        tau = (pieces[:-1, None] + plen[:, None] * self.nodes).ravel()
+        tau = (pieces[:-1, None] + plen[:, None] * self.nodes).ravel() + self.offset
         Ns, n, m = len(plen), self.n, self.m
         check_allocation((Ns * self.G, n, n + m), f"A and B at {Ns * self.G} points")
         vals = np.empty((Ns * self.G, n, n + m))
@@ -336,11 +338,12 @@ def interpolate(table, frac, cells, xi):
 class CellTable:
     """Data of the cells of one period and of their first and last parts.
 
-    ``edges`` (N + 1,) and ``lens`` (N,) of the cells, ``frac`` the
-    Chebyshev-Lobatto fractions of the part lengths, ``fwd`` and ``bwd``
-    the tuples (Φ, W, Z) of ``[e_j, e_j + ℓ_i]`` and ``[e_{j+1} - ℓ_i,
-    e_{j+1}]``, ``ℓ_i = frac_i lens_j``, each of shape (N, D + 1, ...);
-    ``fwd[q][:, -1]`` are the whole cells.
+    ``edges`` (N + 1,) and ``lens`` (N,) of the cells, phases counted from
+    ``offset`` (cell j is ``[offset + e_j, offset + e_{j+1}]`` modulo the
+    period), ``frac`` the Chebyshev-Lobatto fractions of the part lengths,
+    ``fwd`` and ``bwd`` the tuples (Φ, W, Z) of ``[e_j, e_j + ℓ_i]`` and
+    ``[e_{j+1} - ℓ_i, e_{j+1}]``, ``ℓ_i = frac_i lens_j``, each of shape
+    (N, D + 1, ...); ``fwd[q][:, -1]`` are the whole cells.
 
     Examples
     --------
@@ -351,10 +354,21 @@ class CellTable:
     >>> table = CellTable(np.array([0.0, 1.0]), np.array([1.0]), frac, (P, W, Z), (P, W, Z))
     >>> bool(table.first(np.array([0]), np.array([1.0]))[0][0, 0, 0] == np.exp(-1.0))
     True
+    >>> table.weights(np.array([0.0, 0.5]), np.array([0, 0])).round(12)
+    array([[ 1.,  0.,  0.],
+           [ 0.,  1., -0.]])
     """
 
-    def __init__(self, edges, lens, frac, fwd, bwd):
+    def __init__(self, edges, lens, frac, fwd, bwd, offset=0.0):
         self.edges, self.lens, self.frac, self.fwd, self.bwd = edges, lens, frac, fwd, bwd
+        self.offset = float(offset)
+        # node values -> Chebyshev coefficients of the degree-D interpolant
+        self._to_coeffs = np.linalg.inv(_chebyshev_basis(2 * frac - 1, len(frac)))
+
+    def weights(self, length, j):
+        """Interpolation weights (S, D + 1) of the part lengths `length` of cells `j`."""
+        xi = np.clip(length / self.lens[j], 0.0, 1.0)
+        return _chebyshev_basis(2 * xi - 1, len(self.frac)) @ self._to_coeffs
 
     def first(self, j, length, parts=(0, 1, 2)):
         """(Φ, W, Z) (or the `parts` asked for) of ``[e_j, e_j + length]``."""
@@ -363,3 +377,16 @@ class CellTable:
     def last(self, j, length, parts=(0, 1, 2)):
         """(Φ, W, Z) (or the `parts` asked for) of ``[e_{j+1} - length, e_{j+1}]``."""
         return interpolate(tuple(self.bwd[q] for q in parts), self.frac, j, length / self.lens[j])
+
+
+def _chebyshev_basis(s, K):
+    """``T_k(s)`` for k < K at the points s of [-1, 1], shape (S, K)."""
+    out = np.empty((K, len(s)))
+    out[0] = 1.0
+    if K > 1:
+        out[1] = s
+    two_s = 2 * s
+    for k in range(2, K):
+        np.multiply(two_s, out[k - 1], out=out[k])
+        out[k] -= out[k - 2]
+    return out.T

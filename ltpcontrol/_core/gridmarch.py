@@ -119,9 +119,11 @@ def grid_march(A, B, C, D, t, u, x0, hold, rtol, states=True):
                 table = _phase_table(A, B, float(h[0]), T, rtol)
             if table is None and repeat is None:
                 # any other grid: march over the cells of a phase table
-                cells = _cell_table(A, B, h, T, rtol)
-                if cells is not None:
-                    return cell_march(cells, C, D, t, u, x0, hold, states)
+                cells = _cell_table(A, B, h, T, rtol, t)
+                marched = None if cells is None else cell_march(cells, C, D, t, u, x0,
+                                                                hold, states)
+                if marched is not None:
+                    return marched
             elif table is None:
                 table = _table_steps(A, B, h, T, rtol)
     if repeat is not None:
@@ -301,8 +303,13 @@ class _PhaseInterpolant:
         return X[:, :, :n], X[:, :, n:n + m], X[:, :, n + m:]
 
 
-def _cell_table(A, B, h, T, rtol):
-    """The phase table of the steps `h` (module notes), or None when not exact enough."""
+def _cell_table(A, B, h, T, rtol, t=None):
+    """The phase table of the steps `h` (module notes), or None when not exact enough.
+
+    With the samples `t` of a plant without switching, the cells are the
+    fewest (offset at will) that hold at most one sample each
+    (`_cell_layout`); otherwise they are shorter than the shortest step.
+    """
     hmin = float(h.min())
     tol = max(_TABLE_TOL, 0.1 * rtol)
     # pieces of about _PIECE_CELLS cells (split at the switching instants),
@@ -311,9 +318,11 @@ def _cell_table(A, B, h, T, rtol):
     # count of the ladder meets the tolerance
     N0 = max(16, math.floor(T / hmin) + 1)
     bps = np.mod(np.concatenate([A.breakpoints, B.breakpoints]), T)
-    # a multiple of 5 pieces: the cells of a period have a divisor near the
-    # block length of the periodic march
-    Ns = -(-N0 // (5 * _PIECE_CELLS)) * 5
+    Ns = -(-N0 // _PIECE_CELLS)
+    offset = 0.0
+    layout = None if (t is None or bps.size) else _cell_layout(t, T, Ns)
+    if layout is not None:
+        Ns, offset = layout
     pieces = np.union1d(np.linspace(0, T, Ns + 1), bps)
     pieces = pieces[np.concatenate([[True], np.diff(pieces) > 1e-12 * T])]
     pieces[-1] = T
@@ -322,7 +331,7 @@ def _cell_table(A, B, h, T, rtol):
         return None
     # A and B on every piece at the fewest Chebyshev points that resolve them
     for G in _SAMPLES:
-        cells = CellSamples(A, B, pieces, k0, G)
+        cells = CellSamples(A, B, pieces, k0, G, offset)
         if cells.tail() <= tol:
             break
     else:
@@ -338,7 +347,50 @@ def _cell_table(A, B, h, T, rtol):
         return None
     frac, nsub = config
     fwd, bwd = _partial_table(cells, frac, nsub)
-    return CellTable(cells.edges, cells.lens, frac, fwd, bwd)
+    return CellTable(cells.edges, cells.lens, frac, fwd, bwd, offset)
+
+
+def _cell_layout(t, T, most):
+    """``(pieces, offset)``: the fewest pieces of `_PIECE_CELLS` equal cells with one sample each.
+
+    Cells of width w hold at most one sample each when every step shorter
+    than w has a cell edge inside it: the offset of the edges (modulo w)
+    must lie in the arc ``(t_k, t_{k+1}]`` of every such step.  The arcs are
+    intersected on 256 bins for piece counts from the mean step on; the
+    offset is the middle of the widest common run.  None when no count
+    below `most` works.
+    """
+    h = np.diff(t)
+    bins = 256
+    first = max(1, math.ceil(T / (_PIECE_CELLS * float(np.mean(h)))))
+    for Ns in sorted({min(most, int(first * 1.06 ** i)) for i in range(8)}):
+        if Ns >= most:
+            break
+        w = T / (Ns * _PIECE_CELLS)
+        short = h < w
+        if not np.any(short):
+            return Ns, 0.0
+        # bin centres (i + 1/2) w / bins inside (s, s + h]: i0 <= i <= i1
+        s0 = np.mod(t[:-1][short], w) / w * bins
+        i0 = np.floor(s0 - 0.5).astype(np.int64) + 1
+        i1 = np.floor(s0 + h[short] / w * bins - 0.5).astype(np.int64)
+        cover = np.bincount(i0, minlength=2 * bins + 2) \
+            - np.bincount(i1 + 1, minlength=2 * bins + 2)
+        cover = np.cumsum(cover)[:2 * bins]
+        count = cover[:bins] + cover[bins:]
+        ok = count == short.sum()
+        if ok.sum() < 3:
+            continue
+        if ok.all():
+            return Ns, 0.0
+        # the middle of the widest run of allowed bins (circular): the widest
+        # gap between consecutive forbidden bins
+        bad = np.flatnonzero(~ok)
+        gaps = np.diff(np.append(bad, bad[0] + bins))
+        i = int(np.argmax(gaps))
+        at = (bad[i] + gaps[i] / 2 + 0.5) % bins          # a bin centre
+        return Ns, at * w / bins
+    return None
 
 
 def _table_steps(A, B, h, T, rtol):
@@ -413,10 +465,17 @@ def _table_config(A, B, cells, rtol, tol):
     xi = np.tile([0.0731, 0.2917, 0.6180], len(probe))
     j = np.repeat(probe, 3)
     length = xi * (edges[j + 1] - edges[j])
-    exact = _pieces(A, B, np.concatenate([edges[j], edges[j + 1] - length]),
+    exact = _pieces(A, B, np.concatenate([edges[j], edges[j + 1] - length]) + cells.offset,
                     np.concatenate([length, length]), rtol, A.shape[0])
     sub = np.repeat(np.arange(len(probe)), 3)
-    for D, nsub in _LADDER:
+    # the Chebyshev coefficients of e^{Aℓ} on a cell decay as 2 (ρ/4)^k / k!,
+    # ρ = |A| h: start from the first degree whose next coefficient is below tol
+    rho = np.sqrt(A.shape[0]) * float((cells.cell_norms() * cells.lens).max())
+    start = 0
+    while start < len(_LADDER) - 1 and \
+            2 * (rho / 4) ** (_LADDER[start][0] + 1) / math.factorial(_LADDER[start][0] + 1) > tol:
+        start += 1
+    for D, nsub in _LADDER[start:]:
         nodes, _ = lobatto(D)
         err = 0.0
         for end, table in enumerate(_partial_table(cells, nodes, nsub, probe)):
@@ -452,25 +511,26 @@ def _partial_table(cells, frac, nsub, which=None):
     """
     n, m = cells.n, cells.m
     D = len(frac) - 1
-    Phi, W1, Z1 = cells.interval_data(frac, nsub, which)
+    E = np.concatenate(cells.interval_data(frac, nsub, which), axis=3)   # (Nc, D, n, n+2m)
     lens = cells.lens if which is None else cells.lens[which]
-    Nc = len(lens)
-    start = lens[:, None] * frac                               # (Nc, D+1)
+    start = (lens[:, None] * frac)[..., None, None]                        # (Nc, D+1, 1, 1)
     dd = np.diff(start, axis=1)
-    P = np.empty((Nc, D + 1, n, n))
-    W = np.zeros((Nc, D + 1, n, m))
-    Z = np.zeros((Nc, D + 1, n, m))
-    P[:, 0] = np.eye(n)
-    Pb, Wb, Zb = P.copy(), W.copy(), Z.copy()
+    W, Z = slice(n, n + m), slice(n + m, None)
+    # data [Φ | W | Z] of I1 followed by I2: Φ2 [Φ1 | W1 | Z1] + [0 | W2 | Z2 + |I1| W2]
+    fwd = np.empty((len(lens), D + 1) + E.shape[2:])
+    fwd[:, 0] = np.eye(n, E.shape[3])
+    bwd = fwd.copy()
     for i in range(D):
         # forward: [e_j, e_j + ℓ_i] then sub-interval i
-        P[:, i + 1], W[:, i + 1], Z[:, i + 1] = _compose(
-            (P[:, i], W[:, i], Z[:, i]), (Phi[:, i], W1[:, i], Z1[:, i]), start[:, i])
+        np.matmul(E[:, i, :, :n], fwd[:, i], out=fwd[:, i + 1])
+        fwd[:, i + 1, :, W] += E[:, i, :, W]
+        fwd[:, i + 1, :, Z] += E[:, i, :, Z] + start[:, i] * E[:, i, :, W]
         # backward: sub-interval D-1-i then [e_{j+1} - ℓ_i, e_{j+1}]
         k = D - 1 - i
-        Pb[:, i + 1], Wb[:, i + 1], Zb[:, i + 1] = _compose(
-            (Phi[:, k], W1[:, k], Z1[:, k]), (Pb[:, i], Wb[:, i], Zb[:, i]), dd[:, k])
-    return (P, W, Z), (Pb, Wb, Zb)
+        np.matmul(bwd[:, i, :, :n], E[:, k], out=bwd[:, i + 1])
+        bwd[:, i + 1, :, W] += bwd[:, i, :, W]
+        bwd[:, i + 1, :, Z] += bwd[:, i, :, Z] + dd[:, k] * bwd[:, i, :, W]
+    return (fwd[..., :n], fwd[..., W], fwd[..., Z]), (bwd[..., :n], bwd[..., W], bwd[..., Z])
 
 
 def _pieces(A, B, a, length, rtol, n):
@@ -483,11 +543,3 @@ def _pieces(A, B, a, length, rtol, n):
         Pl, G0, G1 = step_transitions(A, B, a[live], length[live], rtol)
         P[live], W[live], Z[live] = Pl, G0, G1 * length[live][:, None, None]
     return P, W, Z
-
-
-def _compose(first, second, len1):
-    """Data of ``I1`` followed by ``I2`` (module notes); len1 the length of I1."""
-    P1, W1, Z1 = first
-    P2, W2, Z2 = second
-    len1 = np.broadcast_to(np.asarray(len1, float), (len(P1),))[:, None, None]
-    return P2 @ P1, P2 @ W1 + W2, P2 @ Z1 + Z2 + len1 * W2

@@ -141,30 +141,38 @@ def test_substep_error_estimate_scales_as_the_fifth_power():
     assert 16 < excess[0] / excess[1] < 64            # 2^5 = 32
 
 
-@pytest.mark.parametrize("N, J", [(680, 20400), (12, 500), (7, 300)])
-def test_forced_march_equals_the_recurrence(N, J):
-    # blocks of a divisor of N, block starts by the same march (first case)
-    from ltpcontrol._core.cellmarch import forced_march
-    rng = np.random.default_rng(N)
-    Phi = 0.4 * rng.normal(size=(N, 2, 2))
-    f, x0 = rng.normal(size=(2, 3, J)), rng.normal(size=(2, 3))
-    x = forced_march(Phi, f, x0)
-    ref, xs = np.empty_like(x), x0
-    for c in range(J):
-        ref[:, :, c] = xs
-        xs = Phi[c % N] @ xs + f[:, :, c]
-    assert rel(x, ref) < 1e-13
-
-
-@pytest.mark.parametrize("budget", [2 ** 21, 50])
-def test_products_by_phase_equal_the_loop(monkeypatch, budget):
-    # cells laid out by phase (offset o), in one chunk of periods or many
+@pytest.mark.parametrize("N, P, R, budget", [(400, 30, 1, 2 ** 21), (12, 40, 3, 2 ** 21),
+                                             (7, 9, 2, 2 ** 21), (12, 40, 3, 50)])
+def test_phase_march_equals_the_recurrence(monkeypatch, N, P, R, budget):
+    # blocks of a divisor of N (7: blocks of one phase), periods in one chunk or many
     import ltpcontrol._core.cellmarch as cellmarch
     monkeypatch.setattr(cellmarch, '_CHUNK_ENTRIES', budget)
-    rng = np.random.default_rng(3)
-    N, J, o = 7, 40, 5
-    F, z = rng.normal(size=(N, 3, 2)), rng.normal(size=(2, 2, J))
-    ref = np.stack([F[(c + o) % N] @ z[:, :, c] for c in range(J)], axis=2)
-    assert rel(cellmarch._by_phase(F, z, o), ref) < 1e-14
-    pick = np.array([0, 3, 17, 39, 21])
-    assert rel(cellmarch._by_phase(F, z, o, pick=pick), ref[:, :, pick]) < 1e-14
+    rng = np.random.default_rng(N)
+    Phi = 0.5 * rng.normal(size=(N, 2, 2))
+    f = rng.normal(size=(N, 2, P * R))
+    x = cellmarch.phase_march(Phi, f, R)
+    ref, xs = np.empty_like(x), np.zeros((2, R))
+    for p in range(P):
+        for c in range(N):
+            ref[c, :, p * R:(p + 1) * R] = xs
+            xs = Phi[c] @ xs + f[c, :, p * R:(p + 1) * R]
+    assert rel(x, ref) < 1e-12
+
+
+def test_cell_layout_holds_one_sample_per_cell():
+    # a grid jittered about T/400: 400 cells; a random walk of steps: the
+    # shortest step decides; either way no cell holds two samples
+    rng = np.random.default_rng(1)
+    jittered = np.arange(4000) / 400 + rng.uniform(-0.2, 0.2, 4000) / 400
+    walk = np.cumsum(np.r_[0.0, rng.uniform(0.8, 1.2, 3000) / 50])
+    for t, most in ((jittered, 84), (walk, 8)):
+        layout = gridmarch._cell_layout(t, 1.0, most)
+        if layout is None:
+            assert t is walk
+            continue
+        Ns, offset = layout
+        N = Ns * gridmarch._PIECE_CELLS
+        cell = np.floor((t - offset) * N).astype(np.int64)
+        assert np.all(np.diff(cell) >= 1)
+        if t is jittered:
+            assert N == 400
