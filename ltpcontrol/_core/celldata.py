@@ -372,11 +372,15 @@ class CellTable:
 
     def first(self, j, length, parts=(0, 1, 2)):
         """(Φ, W, Z) (or the `parts` asked for) of ``[e_j, e_j + length]``."""
-        return interpolate(tuple(self.fwd[q] for q in parts), self.frac, j, length / self.lens[j])
+        rows = np.arange(len(j))
+        return interpolate(tuple(self.fwd[q][j] for q in parts), self.frac, rows,
+                           length / self.lens[j])
 
     def last(self, j, length, parts=(0, 1, 2)):
         """(Φ, W, Z) (or the `parts` asked for) of ``[e_{j+1} - length, e_{j+1}]``."""
-        return interpolate(tuple(self.bwd[q] for q in parts), self.frac, j, length / self.lens[j])
+        rows = np.arange(len(j))
+        return interpolate(tuple(self.bwd[q][j] for q in parts), self.frac, rows,
+                           length / self.lens[j])
 
 
 def _chebyshev_basis(s, K):

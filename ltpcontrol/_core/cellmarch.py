@@ -109,12 +109,11 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     # in the cell: its jump below makes up the difference)
     cells = np.arange(P * N)
     tau = (base + cells // N) * T + table.offset + edges[cells % N]
-    before = cells <= g0
     k = np.concatenate([[0], np.cumsum(np.bincount(g, minlength=P * N))[:-1]]) - 1
-    k[before] = 0
+    k[:g0 + 1] = 0
     a = u[:, :, k] + sigma[:, :, k] * (tau - t[k])                 # (m, R, P N)
     sig = sigma[:, :, k]
-    a[:, :, before], sig[:, :, before] = 0.0, 0.0
+    a[:, :, :g0 + 1], sig[:, :, :g0 + 1] = 0.0, 0.0
     ab = _by_phase(np.concatenate([a, sig]), N, P)                  # (N, 2m, P R)
     # forcing: the whole cells' W a + Z σ, by phase, ...
     WZ = np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2)
@@ -122,17 +121,18 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     # ... plus, for a sample inside the cell, the jump and the change of slope
     # through its last part [t_k, e_{c+1}]: Σ_i w_i (W_i, Z_i) at the lengths
     inner = np.flatnonzero((g > g0) & (g < gL))
-    if len(inner):
+    if len(inner) and m:
         c = g[inner]
         sc = sig[:, :, c]
         jump = np.concatenate([u[:, :, inner] - (a[:, :, c] + sc * (t[inner] - tau[c])),
                                sigma[:, :, inner] - sc])                      # (2m, R, S)
-        WZb = np.concatenate([table.bwd[1], table.bwd[2]], axis=3)           # (N, D1, n, 2m)
+        WZb = np.concatenate([table.bwd[1], table.bwd[2]], axis=3).reshape(N, -1)
         w = table.weights(lens[j[inner]] - ell[inner], j[inner])             # (S, D1)
         step = max(1, _CHUNK_ENTRIES // max(1, D1 * n * 2 * m))
         for s0 in range(0, len(inner), step):
             i = slice(s0, s0 + step)
-            data = np.einsum('sd,sdnq->snq', w[i], WZb[j[inner[i]]])
+            rows = np.take(WZb, j[inner[i]], axis=0).reshape(-1, D1, n, 2 * m)
+            data = np.einsum('sd,sdnq->snq', w[i], rows)
             col = (g[inner[i]] // N)[:, None] * R + np.arange(R)
             f[j[inner[i]][:, None], :, col] += np.einsum('snq,qrs->srn', data, jump[:, :, i])
     # the first sample: its cell's last part carries x0 to the next cell,
@@ -159,10 +159,10 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
                 continue
             cols = slice(p0 * R, p1 * R)
             z = np.concatenate([X[:, :, cols], ab[:, :, cols]], axis=1).transpose(0, 2, 1)
-            V = np.matmul(z, FfT).reshape(-1, D1, n)                          # (N P R, D1, n)
+            V = np.matmul(z, FfT).reshape(-1, D1 * n)                        # (N P R, D1 n)
             rows = (j[rest[s0:s1]] * (p1 - p0) + period[s0:s1] - p0)[:, None] * R \
                 + np.arange(R)
-            Vs = V[rows]                                                      # (S, R, D1, n)
+            Vs = np.take(V, rows.ravel(), axis=0).reshape(-1, R, D1, n)       # (S, R, D1, n)
             x[:, :, 1 + s0:1 + s1] = np.einsum('sd,srdn->nrs', w[s0:s1], Vs)
     y = np.empty((p, R, L))
     chunk = max(256, _CHUNK_ENTRIES // max(1, p * (n + m)))

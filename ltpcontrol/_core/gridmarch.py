@@ -55,6 +55,7 @@ import numpy as np
 from .celldata import CellSamples, CellTable, interpolate, lobatto
 from .cellmarch import cell_march
 from .march import periodic_march
+from .threads import small_blas
 from .transition import step_transitions
 
 __all__ = []
@@ -106,6 +107,12 @@ def grid_march(A, B, C, D, t, u, x0, hold, rtol, states=True):
     >>> bool(np.allclose(y[0, 0], 1 - np.exp(-t)))
     True
     """
+    # the small products of every path run on one BLAS thread, entered once
+    with small_blas(A.shape[0] + 2 * B.shape[1]):
+        return _grid_march(A, B, C, D, t, u, x0, hold, rtol, states)
+
+
+def _grid_march(A, B, C, D, t, u, x0, hold, rtol, states):
     T = A.period
     h = np.diff(t)
     repeat = _repeat_length(t, h, T)
