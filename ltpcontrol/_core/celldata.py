@@ -58,7 +58,29 @@ def chebyshev_first_kind(G):
     return 0.5 - 0.5 * np.cos(theta), (-1.0) ** np.arange(G) * np.sin(theta)
 
 
-def _magnus6(M1, M2, M3, h):
+#: up to this many states, the short steps' products are taken entry by entry
+_ENTRYWISE_STATES = 4
+
+
+def _rows_product(X, Y):
+    """``X Y`` of stacks of first rows (..., n, d) (zero rows below): ``X[..., :n] @ Y``."""
+    return X[..., :X.shape[-2]] @ Y
+
+
+def _entries_product(X, Y):
+    """The same for stacks stored entry by entry, (n, d, S): ``Σ_j X[:, j] Y[j]``.
+
+    For a few states this is a few vector operations over the stack, where
+    a batched matrix product pays a call per small matrix.
+    """
+    n = X.shape[0]
+    out = X[:, 0, None] * Y[0]
+    for j in range(1, n):
+        out += X[:, j, None] * Y[j]
+    return out
+
+
+def _magnus6(M1, M2, M3, h, entrywise=False):
     """Sixth-order Magnus exponent from M at the three Gauss points of a step h.
 
     With ``α1 = h M2``, ``α2 = √15/3 h (M3 - M1)``, ``α3 = 10/3 h (M3 - 2 M2 + M1)``:
@@ -67,13 +89,14 @@ def _magnus6(M1, M2, M3, h):
 
     The augmented M has zero rows below its first n (module notes), and so
     have all the α, commutators and Ω: the arguments and the result are
-    those first n rows (shape (..., n, d)), and a product ``X Y`` of two
-    such matrices is ``X[:, :n] Y`` (n²d instead of d³ multiplications).
+    those first n rows (shape (..., n, d), or (n, d, S) entry by entry with
+    `entrywise`), and a product ``X Y`` of two such matrices is
+    ``X[:, :n] Y`` (n²d instead of d³ multiplications).
     """
-    n = M1.shape[-2]
+    product = _entries_product if entrywise else _rows_product
 
     def comm(X, Y):
-        return X[..., :n] @ Y - Y[..., :n] @ X
+        return product(X, Y) - product(Y, X)
 
     a1 = h * M2
     a2 = (np.sqrt(15) / 3) * h * (M3 - M1)
@@ -83,32 +106,43 @@ def _magnus6(M1, M2, M3, h):
     return a1 + a3 / 12 + comm(C1 - 20 * a1 - a3, a2 + C2) / 240
 
 
-def _expm_small(X):
-    """e^X of a stack of first rows (..., n, d) (zero rows below); the same first rows.
+def _expm_small(X, entrywise=False):
+    """e^X of a stack of first rows (S, n, d) (zero rows below); the same first rows.
 
-    Taylor series when every 1-norm is at most 0.25 (Horner on the first
-    rows: ``X E = [X11 E11, X11 E12 + X12]`` since E's last rows are
-    ``[0, I]``), else scaling and squaring of the whole matrices.
+    With `entrywise` the stack is stored entry by entry, (n, d, S).  Taylor
+    series when every 1-norm is at most 0.25 (Horner on the first rows:
+    ``X E = [X11 E11, X11 E12 + X12]`` since E's last rows are ``[0, I]``),
+    else scaling and squaring of the whole matrices.
     """
-    S, n, d = X.shape
-    norms = np.abs(X).sum(axis=-2).max(axis=-1)
+    if entrywise:
+        n, d, S = X.shape
+        norms = np.abs(X).sum(axis=0).max(axis=0)
+    else:
+        S, n, d = X.shape
+        norms = np.abs(X).sum(axis=-2).max(axis=-1)
     top = float(norms.max()) if len(norms) else 0.0
     if top > _TAYLOR_NORM:
         full = np.zeros((S, d, d))
-        full[:, :n] = X
-        return expm_batch(full)[:, :n]
+        full[:, :n] = np.moveaxis(X, -1, 0) if entrywise else X
+        E = expm_batch(full)[:, :n]
+        return np.ascontiguousarray(np.moveaxis(E, 0, -1)) if entrywise else E
     # the truncation error top^(K+1)/(K+1)! below 2^-54
     K, term = 1, top
     while term > 2.0 ** -54 and K < 30:
         K += 1
         term *= top / K
-    eye = np.eye(n, d)
-    X11 = X[:, :, :n]
+    eye = np.eye(n, d)[:, :, None] if entrywise else np.eye(n, d)
     tail = np.zeros_like(X)
-    tail[:, :, n:] = X[:, :, n:]
+    if entrywise:
+        X11 = X[:, :n]
+        tail[:, n:] = X[:, n:]
+    else:
+        X11 = X[:, :, :n]
+        tail[:, :, n:] = X[:, :, n:]
+    product = _entries_product if entrywise else np.matmul
     E = eye + X / K
     for j in range(K - 1, 0, -1):
-        E = X11 @ E
+        E = product(X11, E)
         E += tail
         E /= j
         E += eye
@@ -259,10 +293,18 @@ class CellSamples:
                 M[..., n + m:] = sigma[:, None, None] * vals[..., n:]
                 if ratio is not None:
                     M *= ratio[:n]
-                M = M.reshape(k, D, nsub, 3, n, d)
-                delta = (self.lens[sel, None, None] * width[:, None] / nsub)[..., None, None]
-                Omega = _magnus6(M[:, :, :, 0], M[:, :, :, 1], M[:, :, :, 2], delta)
-                E = _expm_small(Omega.reshape(-1, n, d))
+                delta = self.lens[sel, None, None] * width[:, None] / nsub      # (k, D, 1)
+                if n <= _ENTRYWISE_STATES:
+                    # entry by entry: (3, n, d, steps)
+                    M = np.ascontiguousarray(M.reshape(-1, 3, n, d).transpose(1, 2, 3, 0))
+                    delta = np.broadcast_to(delta, (k, D, nsub)).ravel()
+                    Omega = _magnus6(M[0], M[1], M[2], delta, entrywise=True)
+                    E = np.moveaxis(_expm_small(Omega, entrywise=True), -1, 0)
+                else:
+                    M = M.reshape(k, D, nsub, 3, n, d)
+                    Omega = _magnus6(M[:, :, :, 0], M[:, :, :, 1], M[:, :, :, 2],
+                                     delta[..., None, None])
+                    E = _expm_small(Omega.reshape(-1, n, d))
                 if nsub > 1:
                     full = np.zeros((len(E), d, d))
                     full[:, :n] = E

@@ -52,7 +52,8 @@ from fractions import Fraction
 
 import numpy as np
 
-from .celldata import CellSamples, CellTable, interpolate, lobatto
+from .celldata import (_ENTRYWISE_STATES, CellSamples, CellTable, _entries_product,
+                       interpolate, lobatto)
 from .cellmarch import cell_march
 from .march import periodic_march
 from .threads import small_blas
@@ -518,25 +519,48 @@ def _partial_table(cells, frac, nsub, which=None):
     """
     n, m = cells.n, cells.m
     D = len(frac) - 1
-    E = np.concatenate(cells.interval_data(frac, nsub, which), axis=3)   # (Nc, D, n, n+2m)
+    E = np.concatenate(cells.interval_data(frac, nsub, which), axis=3)   # (Nc, D, n, d)
+    d = E.shape[3]
     lens = cells.lens if which is None else cells.lens[which]
-    start = (lens[:, None] * frac)[..., None, None]                        # (Nc, D+1, 1, 1)
+    start = lens[:, None] * frac                                         # (Nc, D+1)
     dd = np.diff(start, axis=1)
-    W, Z = slice(n, n + m), slice(n + m, None)
-    # data [Φ | W | Z] of I1 followed by I2: Φ2 [Φ1 | W1 | Z1] + [0 | W2 | Z2 + |I1| W2]
-    fwd = np.empty((len(lens), D + 1) + E.shape[2:])
-    fwd[:, 0] = np.eye(n, E.shape[3])
+    # the sub-intervals' data [Φ | W | Z] as stacks S[i] of position i: entry
+    # by entry for a few states, (D, n, d, Nc), else (D, Nc, n, d)
+    entrywise = n <= _ENTRYWISE_STATES
+    if entrywise:
+        S = np.ascontiguousarray(E.transpose(1, 2, 3, 0))
+        start, dd = start.T[:, None, None, :], dd.T[:, None, None, :]
+        eye = np.eye(n, d)[:, :, None]
+    else:
+        S = E.swapaxes(0, 1)
+        start, dd = start.T[..., None, None], dd.T[..., None, None]
+        eye = np.eye(n, d)
+
+    def col(X, c):
+        return X[:, c] if entrywise else X[..., c]
+
+    def product(X, Y, out):
+        if entrywise:
+            np.copyto(out, _entries_product(X, Y))
+        else:
+            np.matmul(X, Y, out=out)
+    # data of I1 followed by I2: Φ2 [Φ1 | W1 | Z1] + [0 | W2 | Z2 + |I1| W2]
+    Ph, W, Z = slice(0, n), slice(n, n + m), slice(n + m, None)
+    fwd = np.empty((D + 1,) + S.shape[1:])
+    fwd[0] = eye
     bwd = fwd.copy()
     for i in range(D):
         # forward: [e_j, e_j + ℓ_i] then sub-interval i
-        np.matmul(E[:, i, :, :n], fwd[:, i], out=fwd[:, i + 1])
-        fwd[:, i + 1, :, W] += E[:, i, :, W]
-        fwd[:, i + 1, :, Z] += E[:, i, :, Z] + start[:, i] * E[:, i, :, W]
+        product(col(S[i], Ph), fwd[i], fwd[i + 1])
+        col(fwd[i + 1], W)[...] += col(S[i], W)
+        col(fwd[i + 1], Z)[...] += col(S[i], Z) + start[i] * col(S[i], W)
         # backward: sub-interval D-1-i then [e_{j+1} - ℓ_i, e_{j+1}]
         k = D - 1 - i
-        np.matmul(bwd[:, i, :, :n], E[:, k], out=bwd[:, i + 1])
-        bwd[:, i + 1, :, W] += bwd[:, i, :, W]
-        bwd[:, i + 1, :, Z] += bwd[:, i, :, Z] + dd[:, k] * bwd[:, i, :, W]
+        product(col(bwd[i], Ph), S[k], bwd[i + 1])
+        col(bwd[i + 1], W)[...] += col(bwd[i], W)
+        col(bwd[i + 1], Z)[...] += col(bwd[i], Z) + dd[k] * col(bwd[i], W)
+    order = (3, 0, 1, 2) if entrywise else (1, 0, 2, 3)
+    fwd, bwd = (np.ascontiguousarray(v.transpose(order)) for v in (fwd, bwd))
     return (fwd[..., :n], fwd[..., W], fwd[..., Z]), (bwd[..., :n], bwd[..., W], bwd[..., Z])
 
 
