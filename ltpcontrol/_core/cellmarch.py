@@ -43,9 +43,12 @@ O(N P R n² + N n³) and memory is bounded per chunk of periods.
 
 import numpy as np
 
+from .celldata import _ENTRYWISE_STATES
+
 __all__ = []
 
 _CHUNK_ENTRIES = 2 ** 21       # entries of a chunk's per-cell arrays
+_CACHE_ENTRIES = 2 ** 16       # entries of the per-sample work arrays (cache-sized)
 
 
 def cell_march(table, C, D, t, u, x0, hold, states=True):
@@ -118,23 +121,27 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     # forcing: the whole cells' W a + Z σ, by phase, ...
     WZ = np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2)
     f = np.matmul(WZ, ab)                                           # (N, n, P R)
-    # ... plus, for a sample inside the cell, the jump and the change of slope
-    # through its last part [t_k, e_{c+1}]: Σ_i w_i (W_i, Z_i) at the lengths
+    # ... plus, for a sample inside the cell, the jump (zero-order hold) or the
+    # change of slope (first-order hold: the input is continuous) through its
+    # last part [t_k, e_{c+1}]: Σ_i w_i (W_i or Z_i) at the lengths.  The
+    # weights of the last part's length are those of the first part's,
+    # reversed (the lengths are symmetric about half a cell).
+    w = table.weights(ell[1:], j[1:])                                        # (L-1, D1)
     inner = np.flatnonzero((g > g0) & (g < gL))
     if len(inner) and m:
         c = g[inner]
-        sc = sig[:, :, c]
-        jump = np.concatenate([u[:, :, inner] - (a[:, :, c] + sc * (t[inner] - tau[c])),
-                               sigma[:, :, inner] - sc])                      # (2m, R, S)
-        WZb = np.concatenate([table.bwd[1], table.bwd[2]], axis=3).reshape(N, -1)
-        w = table.weights(lens[j[inner]] - ell[inner], j[inner])             # (S, D1)
-        step = max(1, _CHUNK_ENTRIES // max(1, D1 * n * 2 * m))
+        if hold == 'foh':
+            kink, part = sigma[:, :, inner] - sig[:, :, c], table.bwd[2]
+        else:
+            kink, part = u[:, :, inner] - a[:, :, c], table.bwd[1]
+        part = part.reshape(N, -1)                                            # (N, D1 n m)
+        step = max(1, _CACHE_ENTRIES // max(1, D1 * n * m))
         for s0 in range(0, len(inner), step):
             i = slice(s0, s0 + step)
-            rows = np.take(WZb, j[inner[i]], axis=0).reshape(-1, D1, n, 2 * m)
-            data = np.einsum('sd,sdnq->snq', w[i], rows)
+            rows = np.take(part, j[inner[i]], axis=0).reshape(-1, D1, n, m)
+            data = np.einsum('sd,sdnq->snq', w[inner[i] - 1, ::-1], rows)
             col = (g[inner[i]] // N)[:, None] * R + np.arange(R)
-            f[j[inner[i]][:, None], :, col] += np.einsum('snq,qrs->srn', data, jump[:, :, i])
+            f[j[inner[i]][:, None], :, col] += np.einsum('snq,qrs->srn', data, kink[:, :, i])
     # the first sample: its cell's last part carries x0 to the next cell,
     # entered as the forcing of cell g0 (all earlier cells force nothing)
     Pb, Wb, Zb = table.last(j[:1], lens[j[:1]] - ell[:1])
@@ -145,11 +152,26 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     # (rows: cells of every period and trace), then interpolated in ℓ
     x = np.empty((n, R, L))
     x[:, :, 0] = x0
-    if L > 1:
+    if L > 1 and n <= _ENTRYWISE_STATES:
+        # a few states: every sample's data Σ_i w_i [Φ_i | W_i | Z_i], entry by
+        # entry, from the small table, applied to its cell's (x, a, σ)
+        g1, j1 = g[1:], j[1:]
+        Xt = X.reshape(N, n, P, R).transpose(1, 3, 2, 0).reshape(n, R, P * N)   # time order
+        z = np.concatenate([Xt[:, :, g1], a[:, :, g1], sig[:, :, g1]])       # (n+2m, R, S)
+        Ff = np.concatenate(table.fwd, axis=3).reshape(N, D1, -1)
+        step = max(1, _CACHE_ENTRIES // Ff[0].size)
+        for s0 in range(0, L - 1, step):
+            i = slice(s0, s0 + step)
+            rows = np.take(Ff, j1[i], axis=0)                                 # (S, D1, n(n+2m))
+            data = np.einsum('sd,sde->es', w[i], rows).reshape(n, n + 2 * m, -1)
+            x[:, :, 1 + s0:1 + s0 + data.shape[2]] = \
+                np.einsum('nes,ers->nrs', data, z[:, :, i])
+    elif L > 1:
+        # the data at the table's lengths applied to (x(e_c), a_c, σ_c), by
+        # phase (rows: cells of every period and trace), then interpolated
         rest = np.arange(1, L)
         FfT = np.concatenate(table.fwd, axis=3).reshape(N, D1 * n, n + 2 * m) \
             .transpose(0, 2, 1)                                               # (N, n+2m, D1 n)
-        w = table.weights(ell[rest], j[rest])
         period = g[rest] // N
         per = max(1, _CHUNK_ENTRIES // max(1, N * D1 * n * R))
         for p0 in range(0, P, per):
@@ -164,12 +186,35 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
                 + np.arange(R)
             Vs = np.take(V, rows.ravel(), axis=0).reshape(-1, R, D1, n)       # (S, R, D1, n)
             x[:, :, 1 + s0:1 + s1] = np.einsum('sd,srdn->nrs', w[s0:s1], Vs)
+    return (x if states else None), outputs(C, D, t, x, u)
+
+
+def outputs(C, D, t, x, u):
+    """``y = C(t) x + D(t) u`` at the samples: x (n, R, L), u (m, R, L) -> (p, R, L).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.cellmarch import outputs
+    >>> C = ltp.PeriodicMatrix.constant([[2.0]], 1.0)
+    >>> D = ltp.PeriodicMatrix([[[0.5]], [[1.0]], [[0.5]]], 1.0)      # 1 + cos ωt
+    >>> outputs(C, D, np.array([0.0, 0.5]), np.ones((1, 1, 2)), np.ones((1, 1, 2)))[0, 0]
+    array([4., 2.])
+    """
+    (n, R, L), m, p = x.shape, u.shape[0], C.shape[0]
     y = np.empty((p, R, L))
     chunk = max(256, _CHUNK_ENTRIES // max(1, p * (n + m)))
     for s0 in range(0, L, chunk):
         i = slice(s0, s0 + chunk)
-        y[:, :, i] = _apply(C(t[i]), x[:, :, i]) + _apply(D(t[i]), u[:, :, i])
-    return (x if states else None), y
+        for M, v, first in ((C, x, True), (D, u, False)):
+            if M.is_constant:
+                out = np.tensordot(M(t[0]), v[:, :, i], axes=1)
+            else:
+                out = _apply(M(t[i]), v[:, :, i])
+            if first:
+                y[:, :, i] = out
+            else:
+                y[:, :, i] += out
+    return y
 
 
 def _by_phase(z, N, P):
