@@ -405,12 +405,20 @@ class CellTable:
         self.edges, self.lens, self.frac, self.fwd, self.bwd = edges, lens, frac, fwd, bwd
         self.offset = float(offset)
         # node values -> Chebyshev coefficients of the degree-D interpolant
-        self._to_coeffs = np.linalg.inv(_chebyshev_basis(2 * frac - 1, len(frac)))
+        self._to_coeffs = np.linalg.inv(_chebyshev_basis(2 * frac - 1, len(frac)).T)
 
     def weights(self, length, j):
-        """Interpolation weights (S, D + 1) of the part lengths `length` of cells `j`."""
+        """Interpolation weights (S, D + 1) of the part lengths `length` of cells `j`.
+
+        The transpose (D + 1, S) is contiguous.
+        """
         xi = np.clip(length / self.lens[j], 0.0, 1.0)
-        return _chebyshev_basis(2 * xi - 1, len(self.frac)) @ self._to_coeffs
+        basis = _chebyshev_basis(2 * xi - 1, len(self.frac))              # (D+1, S)
+        # Σ_k T_k(ξ) c_k over the coefficients, one vector operation per k
+        out = self._to_coeffs[0][:, None] * basis[0]
+        for k in range(1, len(basis)):
+            out += self._to_coeffs[k][:, None] * basis[k]
+        return out.T
 
     def first(self, j, length, parts=(0, 1, 2)):
         """(Φ, W, Z) (or the `parts` asked for) of ``[e_j, e_j + length]``."""
@@ -426,7 +434,7 @@ class CellTable:
 
 
 def _chebyshev_basis(s, K):
-    """``T_k(s)`` for k < K at the points s of [-1, 1], shape (S, K)."""
+    """``T_k(s)`` for k < K at the points s of [-1, 1], shape (K, S)."""
     out = np.empty((K, len(s)))
     out[0] = 1.0
     if K > 1:
@@ -435,4 +443,4 @@ def _chebyshev_basis(s, K):
     for k in range(2, K):
         np.multiply(two_s, out[k - 1], out=out[k])
         out[k] -= out[k - 2]
-    return out.T
+    return out

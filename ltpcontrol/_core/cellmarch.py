@@ -41,6 +41,8 @@ a period).  No step's transition matrix is formed; the work is
 O(N P R n² + N n³) and memory is bounded per chunk of periods.
 """
 
+import math
+
 import numpy as np
 
 from .celldata import _ENTRYWISE_STATES
@@ -48,7 +50,7 @@ from .celldata import _ENTRYWISE_STATES
 __all__ = []
 
 _CHUNK_ENTRIES = 2 ** 21       # entries of a chunk's per-cell arrays
-_CACHE_ENTRIES = 2 ** 16       # entries of the per-sample work arrays (cache-sized)
+_CHUNK_CELLS = 8192            # cells of the periods marched at a time
 
 
 def cell_march(table, C, D, t, u, x0, hold, states=True):
@@ -88,7 +90,6 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     N = len(lens)
     n, R = x0.shape
     m, L = u.shape[0], len(t)
-    p = C.shape[0]
     D1 = len(table.frac)
     # cell of every sample (phases counted from the table's offset), numbered
     # g = P N + j from the start of the period of t[0]
@@ -105,87 +106,91 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     sigma = np.zeros((m, R, L))
     if hold == 'foh':
         sigma[:, :, :-1] = np.diff(u, axis=2) / np.diff(t)
-    g0, gL = int(g[0]), int(g[-1])
-    P = gL // N + 1
-    # input value and slope at the start of every cell of the P periods, from
-    # the last sample before the cell (a sample at a cell's start is counted
-    # in the cell: its jump below makes up the difference)
-    cells = np.arange(P * N)
-    tau = (base + cells // N) * T + table.offset + edges[cells % N]
-    k = np.concatenate([[0], np.cumsum(np.bincount(g, minlength=P * N))[:-1]]) - 1
-    k[:g0 + 1] = 0
-    a = u[:, :, k] + sigma[:, :, k] * (tau - t[k])                 # (m, R, P N)
-    sig = sigma[:, :, k]
-    a[:, :, :g0 + 1], sig[:, :, :g0 + 1] = 0.0, 0.0
-    ab = _by_phase(np.concatenate([a, sig]), N, P)                  # (N, 2m, P R)
-    # forcing: the whole cells' W a + Z σ, by phase, ...
+    g0, P = int(g[0]), int(g[-1]) // N + 1
+    # the last sample before every cell of the record (a sample at a cell's
+    # start is counted in the cell: its jump below makes up the difference)
+    last = np.concatenate([[0], np.cumsum(np.bincount(g, minlength=P * N))[:-1]]) - 1
+    # the table's data: whole cells' (W, Z); the kink's part, the jump
+    # (zero-order hold) or the change of slope (first-order hold: the input is
+    # continuous) through the last part [t_k, e_{c+1}]: W or Z of the last
+    # parts, whose lengths' weights are those of the first part, reversed (the
+    # lengths are symmetric about half a cell); the first parts' [Φ | W | Z]
     WZ = np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2)
-    f = np.matmul(WZ, ab)                                           # (N, n, P R)
-    # ... plus, for a sample inside the cell, the jump (zero-order hold) or the
-    # change of slope (first-order hold: the input is continuous) through its
-    # last part [t_k, e_{c+1}]: Σ_i w_i (W_i or Z_i) at the lengths.  The
-    # weights of the last part's length are those of the first part's,
-    # reversed (the lengths are symmetric about half a cell).
-    w = table.weights(ell[1:], j[1:])                                        # (L-1, D1)
-    inner = np.flatnonzero((g > g0) & (g < gL))
-    if len(inner) and m:
-        c = g[inner]
-        if hold == 'foh':
-            kink, part = sigma[:, :, inner] - sig[:, :, c], table.bwd[2]
-        else:
-            kink, part = u[:, :, inner] - a[:, :, c], table.bwd[1]
-        part = part.reshape(N, -1)                                            # (N, D1 n m)
-        step = max(1, _CACHE_ENTRIES // max(1, D1 * n * m))
-        for s0 in range(0, len(inner), step):
-            i = slice(s0, s0 + step)
-            rows = np.take(part, j[inner[i]], axis=0).reshape(-1, D1, n, m)
-            data = np.einsum('sd,sdnq->snq', w[inner[i] - 1, ::-1], rows)
-            col = (g[inner[i]] // N)[:, None] * R + np.arange(R)
-            f[j[inner[i]][:, None], :, col] += np.einsum('snq,qrs->srn', data, kink[:, :, i])
+    kpart = (table.bwd[2] if hold == 'foh' else table.bwd[1])[:, ::-1]      # (N, D1, n, m)
+    first = np.concatenate(table.fwd, axis=3)                              # (N, D1, n, n+2m)
+    entrywise = n <= _ENTRYWISE_STATES
+    if entrywise:
+        # a few states: per length, a table of the samples' data, entry by entry
+        tabs = [np.concatenate([first[:, d].reshape(N, -1), kpart[:, d].reshape(N, -1)],
+                               axis=1) for d in range(D1)]
+    else:
+        FfT = first.reshape(N, D1 * n, n + 2 * m).transpose(0, 2, 1)       # (N, n+2m, D1 n)
+        krows = np.ascontiguousarray(kpart).reshape(N, -1)                  # (N, D1 n m)
     # the first sample: its cell's last part carries x0 to the next cell,
     # entered as the forcing of cell g0 (all earlier cells force nothing)
     Pb, Wb, Zb = table.last(j[:1], lens[j[:1]] - ell[:1])
-    f[g0, :, :R] = Pb[0] @ x0 + Wb[0] @ u[:, :, 0] + Zb[0] @ sigma[:, :, 0]
-    X = phase_march(table.fwd[0][:, -1], f, R)                            # (N, n, P R)
-    # states at the samples from the first part [e_c, t_k] of their cell: the
-    # data at the table's lengths applied to (x(e_c), a_c, σ_c), by phase
-    # (rows: cells of every period and trace), then interpolated in ℓ
+    x1 = Pb[0] @ x0 + Wb[0] @ u[:, :, 0] + Zb[0] @ sigma[:, :, 0]
     x = np.empty((n, R, L))
     x[:, :, 0] = x0
-    if L > 1 and n <= _ENTRYWISE_STATES:
-        # a few states: every sample's data Σ_i w_i [Φ_i | W_i | Z_i], entry by
-        # entry, from the small table, applied to its cell's (x, a, σ)
-        g1, j1 = g[1:], j[1:]
-        Xt = X.reshape(N, n, P, R).transpose(1, 3, 2, 0).reshape(n, R, P * N)   # time order
-        z = np.concatenate([Xt[:, :, g1], a[:, :, g1], sig[:, :, g1]])       # (n+2m, R, S)
-        Ff = np.concatenate(table.fwd, axis=3).reshape(N, D1, -1)
-        step = max(1, _CACHE_ENTRIES // Ff[0].size)
-        for s0 in range(0, L - 1, step):
-            i = slice(s0, s0 + step)
-            rows = np.take(Ff, j1[i], axis=0)                                 # (S, D1, n(n+2m))
-            data = np.einsum('sd,sde->es', w[i], rows).reshape(n, n + 2 * m, -1)
-            x[:, :, 1 + s0:1 + s0 + data.shape[2]] = \
-                np.einsum('nes,ers->nrs', data, z[:, :, i])
-    elif L > 1:
-        # the data at the table's lengths applied to (x(e_c), a_c, σ_c), by
-        # phase (rows: cells of every period and trace), then interpolated
-        rest = np.arange(1, L)
-        FfT = np.concatenate(table.fwd, axis=3).reshape(N, D1 * n, n + 2 * m) \
-            .transpose(0, 2, 1)                                               # (N, n+2m, D1 n)
-        period = g[rest] // N
-        per = max(1, _CHUNK_ENTRIES // max(1, N * D1 * n * R))
-        for p0 in range(0, P, per):
-            p1 = min(P, p0 + per)
-            s0, s1 = np.searchsorted(period, [p0, p1])
-            if s1 == s0:
-                continue
-            cols = slice(p0 * R, p1 * R)
-            z = np.concatenate([X[:, :, cols], ab[:, :, cols]], axis=1).transpose(0, 2, 1)
-            V = np.matmul(z, FfT).reshape(-1, D1 * n)                        # (N P R, D1 n)
-            rows = (j[rest[s0:s1]] * (p1 - p0) + period[s0:s1] - p0)[:, None] * R \
-                + np.arange(R)
-            Vs = np.take(V, rows.ravel(), axis=0).reshape(-1, R, D1, n)       # (S, R, D1, n)
-            x[:, :, 1 + s0:1 + s1] = np.einsum('sd,srdn->nrs', w[s0:s1], Vs)
+    start = np.zeros((n, R))
+    per = max(1, _CHUNK_CELLS // N)
+    for p0 in range(0, P, per):
+        # the periods [p0, p1): their cells c0 .. c1 - 1 and samples k0 .. k1 - 1
+        p1 = min(P, p0 + per)
+        c0, c1 = p0 * N, p1 * N
+        k0, k1 = np.searchsorted(g, [c0, c1])
+        k0 = max(k0, 1)
+        cells = np.arange(c0, c1)
+        tau = (base + cells // N) * T + table.offset + edges[cells % N]
+        kc = np.maximum(last[c0:c1], 0)
+        a = u[:, :, kc] + sigma[:, :, kc] * (tau - t[kc])                  # (m, R, cells)
+        sig = sigma[:, :, kc]
+        if c0 <= g0:
+            a[:, :, :g0 + 1 - c0], sig[:, :, :g0 + 1 - c0] = 0.0, 0.0
+        ab = _by_phase(np.concatenate([a, sig]), N, p1 - p0)            # (N, 2m, Pc R)
+        f = np.matmul(WZ, ab)                                           # (N, n, Pc R)
+        ks = np.arange(k0, k1)
+        gs, js = g[ks] - c0, j[ks]
+        w = table.weights(ell[ks], js).T                                # (D1, s)
+        kink = sigma[:, :, ks] - sig[:, :, gs] if hold == 'foh' else u[:, :, ks] - a[:, :, gs]
+        if entrywise:
+            data = w[0][:, None] * np.take(tabs[0], js, axis=0)        # (s, n(n+2m) + n m)
+            for d in range(1, D1):
+                data += w[d][:, None] * np.take(tabs[d], js, axis=0)
+            if m:
+                kdata = data[:, n * (n + 2 * m):].reshape(len(ks), n, m)
+                fk = sum(kdata[:, :, q].T[:, None, :] * kink[q][None] for q in range(m))
+        elif m:
+            G = np.take(krows, js, axis=0).reshape(-1, D1, n, m)
+            fk = np.einsum('ds,sdnq,qrs->nrs', w, G, kink)
+        if m and len(ks):
+            # in time order, then by phase
+            ft = np.zeros((n, R, c1 - c0))
+            ft[:, :, gs] = fk
+            f += _by_phase(ft, N, p1 - p0)
+        if c0 <= g0:
+            f[g0 - c0, :, :R] = x1
+        X, start = phase_march(table.fwd[0][:, -1], f, R, start)       # (N, n, Pc R)
+        if not len(ks):
+            continue
+        # states at the samples from the first part [e_c, t_k] of their cell,
+        # applied to (x(e_c), a_c, σ_c)
+        if entrywise:
+            Xt = X.reshape(N, n, p1 - p0, R).transpose(1, 3, 2, 0).reshape(n, R, c1 - c0)
+            z = np.concatenate([Xt[:, :, gs], a[:, :, gs], sig[:, :, gs]])  # (n+2m, R, s)
+            Fd = data[:, :n * (n + 2 * m)].reshape(len(ks), n, n + 2 * m)
+            xs = Fd[:, :, 0].T[:, None, :] * z[0][None]
+            for e in range(1, n + 2 * m):
+                xs += Fd[:, :, e].T[:, None, :] * z[e][None]
+            x[:, :, k0:k1] = xs
+        else:
+            # the data at the table's lengths applied by phase (rows: cells
+            # of every period and trace), then interpolated
+            z = np.concatenate([X, ab], axis=1).transpose(0, 2, 1)         # (N, Pc R, n+2m)
+            V = np.matmul(z, FfT).reshape(-1, D1 * n)                    # (N Pc R, D1 n)
+            rows = ((gs % N) * (p1 - p0) + gs // N)[:, None] * R + np.arange(R)
+            Vs = np.take(V, rows.ravel(), axis=0).reshape(-1, R, D1, n)   # (s, R, D1, n)
+            x[:, :, k0:k1] = np.einsum('ds,srdn->nrs', w, Vs)
     return (x if states else None), outputs(C, D, t, x, u)
 
 
@@ -229,8 +234,8 @@ def _apply(M, v):
     return (M @ v.transpose(2, 0, 1)).transpose(1, 2, 0)
 
 
-def phase_march(Phi, f, R):
-    """States of ``x_{c+1} = Φ_{c mod N} x_c + f_c`` from ``x_0 = 0`` over P periods.
+def phase_march(Phi, f, R, start=None):
+    """States of ``x_{c+1} = Φ_{c mod N} x_c + f_c`` from ``x_0 = start`` over P periods.
 
     `f` (N, n, P R) holds the forcing of phase c of period p, trace r at
     ``[c, :, p R + r]``; the result has the same layout (the state at the
@@ -240,20 +245,25 @@ def phase_march(Phi, f, R):
     products ``Φ(c, c_0)``; a loop over the B blocks gives the block starts
     from a zero period start and the period's product Ψ; the period starts
     follow ``s_{p+1} = Ψ s_p + z_p``.  Periods are taken in chunks within a
-    fixed budget.
+    fixed budget.  Returns the states and the state after the last period
+    (`start` and the result (n, R); default start 0).
 
     Examples
     --------
     >>> from ltpcontrol._core.cellmarch import phase_march
     >>> Phi = np.array([[[0.5]], [[2.0]]])
     >>> f = np.ones((2, 1, 3))                                  # three periods, one trace
-    >>> phase_march(Phi, f, 1)[:, 0]                            # cells 0, 1 of each period
+    >>> X, end = phase_march(Phi, f, 1)
+    >>> X[:, 0]                                                 # cells 0, 1 of each period
     array([[0. , 3. , 6. ],
            [1. , 2.5, 4. ]])
+    >>> end
+    array([[9.]])
     """
     N, n, K = f.shape
     P = K // R
-    divisors = [d for d in range(1, N + 1) if N % d == 0]
+    small = [d for d in range(1, math.isqrt(N) + 1) if N % d == 0]
+    divisors = small + [N // d for d in small]
     b = min(divisors, key=lambda d: abs(np.log(d / np.sqrt(N))))
     B = N // b
     Pb = Phi.reshape(B, b, n, n)
@@ -270,7 +280,7 @@ def phase_march(Phi, f, R):
     Psi = M[B]
     X = np.empty_like(f)
     per = max(1, _CHUNK_ENTRIES // max(1, 2 * N * n * R))
-    s = np.zeros((n, R))
+    s = np.zeros((n, R)) if start is None else start
     for p0 in range(0, P, per):
         cols = slice(p0 * R, min(P, p0 + per) * R)
         k = cols.stop - cols.start
@@ -293,7 +303,7 @@ def phase_march(Phi, f, R):
             s = Psi @ s + zend[:, i]
         Sb = M[:B] @ starts.reshape(n, k) + Y[:B]                  # (B, n, k)
         X[:, :, cols] = (O[:, :b] @ Sb[:, None] + Z[:, :b]).reshape(N, n, k)
-    return X
+    return X, s
 
 
 def _cell_of(edges, theta):

@@ -122,17 +122,19 @@ def _grid_march(A, B, C, D, t, u, x0, hold, rtol, states):
         # steps longer than or not dividing the period: a cell table, when worthwhile
         count = len(h) if repeat is None else repeat[0]
         if count > 2 * math.ceil(T / h.min()) or (repeat is not None and repeat[1] > 1):
-            if repeat is None and np.allclose(h, h[0], rtol=1e-10, atol=0):
-                # a uniform grid: the step data are smooth periodic functions of the phase
-                table = _phase_table(A, B, float(h[0]), T, rtol)
-            if table is None and repeat is None:
-                # any other grid: march over the cells of a phase table
+            if repeat is None:
+                # a grid whose phases never repeat: march over the cells of a
+                # phase table
                 cells = _cell_table(A, B, h, T, rtol, t)
                 marched = None if cells is None else cell_march(cells, C, D, t, u, x0,
                                                                 hold, states)
                 if marched is not None:
                     return marched
-            elif table is None:
+                if np.allclose(h, h[0], rtol=1e-10, atol=0):
+                    # a uniform grid: the step data are smooth periodic functions
+                    # of the phase
+                    table = _phase_table(A, B, float(h[0]), T, rtol)
+            else:
                 table = _table_steps(A, B, h, T, rtol)
     if repeat is not None:
         # the step data repeat every q steps: march with period q

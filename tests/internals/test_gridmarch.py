@@ -150,13 +150,15 @@ def test_phase_march_equals_the_recurrence(monkeypatch, N, P, R, budget):
     rng = np.random.default_rng(N)
     Phi = 0.5 * rng.normal(size=(N, 2, 2))
     f = rng.normal(size=(N, 2, P * R))
-    x = cellmarch.phase_march(Phi, f, R)
-    ref, xs = np.empty_like(x), np.zeros((2, R))
+    x0 = rng.normal(size=(2, R))
+    x, end = cellmarch.phase_march(Phi, f, R, x0.copy())
+    ref, xs = np.empty_like(x), x0
     for p in range(P):
         for c in range(N):
             ref[c, :, p * R:(p + 1) * R] = xs
             xs = Phi[c] @ xs + f[c, :, p * R:(p + 1) * R]
     assert rel(x, ref) < 1e-12
+    assert rel(end, xs) < 1e-12
 
 
 def test_cell_layout_holds_one_sample_per_cell():
