@@ -412,13 +412,30 @@ class CellTable:
 
         The transpose (D + 1, S) is contiguous.
         """
-        xi = np.clip(length / self.lens[j], 0.0, 1.0)
-        basis = _chebyshev_basis(2 * xi - 1, len(self.frac))              # (D+1, S)
+        basis = self.basis(length, j)                                        # (D+1, S)
         # Σ_k T_k(ξ) c_k over the coefficients, one vector operation per k
         out = self._to_coeffs[0][:, None] * basis[0]
         for k in range(1, len(basis)):
             out += self._to_coeffs[k][:, None] * basis[k]
         return out.T
+
+    def basis(self, length, j):
+        """Chebyshev polynomials ``T_k(2ξ - 1)`` (D + 1, S), ξ = `length` / (cell j's length)."""
+        xi = np.clip(length / self.lens[j], 0.0, 1.0)
+        return _chebyshev_basis(2 * xi - 1, len(self.frac))
+
+    def coefficients(self, values, reverse=False):
+        """Chebyshev coefficients in ξ of a table (N, D + 1, ...) at the lengths.
+
+        With `reverse` those of the table read at ``1 - ξ`` (the last parts'
+        data at the first part's length: ``T_k(-s) = (-1)^k T_k(s)``).
+        """
+        out = np.tensordot(values, self._to_coeffs, axes=([1], [1]))        # (N, ..., D+1)
+        out = np.moveaxis(out, -1, 1)
+        if reverse:
+            out = out * ((-1.0) ** np.arange(out.shape[1]))[(slice(None),) + (None,) *
+                                                              (out.ndim - 2)]
+        return np.ascontiguousarray(out)
 
     def first(self, j, length, parts=(0, 1, 2)):
         """(Φ, W, Z) (or the `parts` asked for) of ``[e_j, e_j + length]``."""

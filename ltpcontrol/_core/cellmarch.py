@@ -45,12 +45,9 @@ import math
 
 import numpy as np
 
-from .celldata import _ENTRYWISE_STATES
-
 __all__ = []
 
 _CHUNK_ENTRIES = 2 ** 21       # entries of a chunk's per-cell arrays
-_CHUNK_CELLS = 8192            # cells of the periods marched at a time
 
 
 def cell_march(table, C, D, t, u, x0, hold, states=True):
@@ -114,18 +111,18 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     # (zero-order hold) or the change of slope (first-order hold: the input is
     # continuous) through the last part [t_k, e_{c+1}]: W or Z of the last
     # parts, whose lengths' weights are those of the first part, reversed (the
-    # lengths are symmetric about half a cell); the first parts' [Φ | W | Z]
+    # lengths are symmetric about half a cell); the first parts' [Φ | W | Z];
+    # the last two as Chebyshev coefficients in the first part's ξ = ℓ / h_c
     WZ = np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2)
-    kpart = (table.bwd[2] if hold == 'foh' else table.bwd[1])[:, ::-1]      # (N, D1, n, m)
-    first = np.concatenate(table.fwd, axis=3)                              # (N, D1, n, n+2m)
-    entrywise = n <= _ENTRYWISE_STATES
-    if entrywise:
-        # a few states: per length, a table of the samples' data, entry by entry
-        tabs = [np.concatenate([first[:, d].reshape(N, -1), kpart[:, d].reshape(N, -1)],
-                               axis=1) for d in range(D1)]
-    else:
-        FfT = first.reshape(N, D1 * n, n + 2 * m).transpose(0, 2, 1)       # (N, n+2m, D1 n)
-        krows = np.ascontiguousarray(kpart).reshape(N, -1)                  # (N, D1 n m)
+    kpart = table.bwd[2] if hold == 'foh' else table.bwd[1]                # (N, D1, n, m)
+    # one table (N, D1, E) of the coefficients of every sample's data
+    E1 = n * (n + 2 * m)
+    tab = np.concatenate([table.coefficients(np.concatenate(table.fwd, axis=3))
+                          .reshape(N, D1, E1),
+                          table.coefficients(kpart, reverse=True).reshape(N, D1, n * m)],
+                         axis=2)
+    tabT = np.ascontiguousarray(tab.transpose(0, 2, 1))                     # (N, E, D1)
+    march = PhaseMarch(table.fwd[0][:, -1])
     # the first sample: its cell's last part carries x0 to the next cell,
     # entered as the forcing of cell g0 (all earlier cells force nothing)
     Pb, Wb, Zb = table.last(j[:1], lens[j[:1]] - ell[:1])
@@ -133,11 +130,12 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     x = np.empty((n, R, L))
     x[:, :, 0] = x0
     start = np.zeros((n, R))
-    per = max(1, _CHUNK_CELLS // N)
+    per = max(1, _CHUNK_ENTRIES // (N * max(tab.shape[2], R * (n + 2 * m))))
     for p0 in range(0, P, per):
-        # the periods [p0, p1): their cells c0 .. c1 - 1 and samples k0 .. k1 - 1
+        # the periods [p0, p1): their cells c0 .. c1 - 1 and samples k0 .. k1 - 1;
+        # every signal by phase: (N, rows, Pc R)
         p1 = min(P, p0 + per)
-        c0, c1 = p0 * N, p1 * N
+        Pc, c0, c1 = p1 - p0, p0 * N, p1 * N
         k0, k1 = np.searchsorted(g, [c0, c1])
         k0 = max(k0, 1)
         cells = np.arange(c0, c1)
@@ -147,50 +145,47 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
         sig = sigma[:, :, kc]
         if c0 <= g0:
             a[:, :, :g0 + 1 - c0], sig[:, :, :g0 + 1 - c0] = 0.0, 0.0
-        ab = _by_phase(np.concatenate([a, sig]), N, p1 - p0)            # (N, 2m, Pc R)
+        ab = _by_phase(np.concatenate([a, sig]), N, Pc)                 # (N, 2m, Pc R)
         f = np.matmul(WZ, ab)                                           # (N, n, Pc R)
+        # every (cell, period)'s data Σ_k T_k(ξ) tab_k, by phase: one product
+        # per cell over the periods (zero where the cell holds no sample);
+        # row j Pc + period
         ks = np.arange(k0, k1)
-        gs, js = g[ks] - c0, j[ks]
-        w = table.weights(ell[ks], js).T                                # (D1, s)
-        kink = sigma[:, :, ks] - sig[:, :, gs] if hold == 'foh' else u[:, :, ks] - a[:, :, gs]
-        if entrywise:
-            data = w[0][:, None] * np.take(tabs[0], js, axis=0)        # (s, n(n+2m) + n m)
-            for d in range(1, D1):
-                data += w[d][:, None] * np.take(tabs[d], js, axis=0)
-            if m:
-                kdata = data[:, n * (n + 2 * m):].reshape(len(ks), n, m)
-                fk = sum(kdata[:, :, q].T[:, None, :] * kink[q][None] for q in range(m))
-        elif m:
-            G = np.take(krows, js, axis=0).reshape(-1, D1, n, m)
-            fk = np.einsum('ds,sdnq,qrs->nrs', w, G, kink)
+        gs = g[ks] - c0
+        row = j[ks] * Pc + gs // N
+        # rows are gathered, not scattered: every (cell, period) names its
+        # sample, or an appended zero row
+        which = np.full(N * Pc, len(ks))
+        which[row] = np.arange(len(ks))
+        Tk = np.concatenate([table.basis(ell[ks], j[ks]).T, np.zeros((1, D1))])
+        Tk = np.take(Tk, which, axis=0)
+        data = np.matmul(tabT, Tk.reshape(N, Pc, D1).transpose(0, 2, 1))   # (N, E, Pc)
         if m and len(ks):
-            # in time order, then by phase
-            ft = np.zeros((n, R, c1 - c0))
-            ft[:, :, gs] = fk
-            f += _by_phase(ft, N, p1 - p0)
+            kink = sigma[:, :, ks] - sig[:, :, gs] if hold == 'foh' \
+                else u[:, :, ks] - a[:, :, gs]                               # (m, R, s)
+            Kp = np.concatenate([kink.transpose(2, 0, 1), np.zeros((1, m, R))])
+            Kp = np.take(Kp, which, axis=0).reshape(N, Pc, m, R)
+            fk = np.empty((N, n, Pc, R))
+            for i in range(n):
+                fk[:, i] = data[:, E1 + i * m, :, None] * Kp[:, :, 0]
+                for q in range(1, m):
+                    fk[:, i] += data[:, E1 + i * m + q, :, None] * Kp[:, :, q]
+            f += fk.reshape(N, n, Pc * R)
         if c0 <= g0:
             f[g0 - c0, :, :R] = x1
-        X, start = phase_march(table.fwd[0][:, -1], f, R, start)       # (N, n, Pc R)
+        X, start = march(f, R, start)                                   # (N, n, Pc R)
         if not len(ks):
             continue
         # states at the samples from the first part [e_c, t_k] of their cell,
         # applied to (x(e_c), a_c, σ_c)
-        if entrywise:
-            Xt = X.reshape(N, n, p1 - p0, R).transpose(1, 3, 2, 0).reshape(n, R, c1 - c0)
-            z = np.concatenate([Xt[:, :, gs], a[:, :, gs], sig[:, :, gs]])  # (n+2m, R, s)
-            Fd = data[:, :n * (n + 2 * m)].reshape(len(ks), n, n + 2 * m)
-            xs = Fd[:, :, 0].T[:, None, :] * z[0][None]
+        z = np.concatenate([X, ab], axis=1).reshape(N, n + 2 * m, Pc, R)
+        xp = np.empty((N, Pc, n, R))
+        for i in range(n):
+            e0 = i * (n + 2 * m)
+            xp[:, :, i] = data[:, e0, :, None] * z[:, 0]
             for e in range(1, n + 2 * m):
-                xs += Fd[:, :, e].T[:, None, :] * z[e][None]
-            x[:, :, k0:k1] = xs
-        else:
-            # the data at the table's lengths applied by phase (rows: cells
-            # of every period and trace), then interpolated
-            z = np.concatenate([X, ab], axis=1).transpose(0, 2, 1)         # (N, Pc R, n+2m)
-            V = np.matmul(z, FfT).reshape(-1, D1 * n)                    # (N Pc R, D1 n)
-            rows = ((gs % N) * (p1 - p0) + gs // N)[:, None] * R + np.arange(R)
-            Vs = np.take(V, rows.ravel(), axis=0).reshape(-1, R, D1, n)   # (s, R, D1, n)
-            x[:, :, k0:k1] = np.einsum('ds,srdn->nrs', w, Vs)
+                xp[:, :, i] += data[:, e0 + e, :, None] * z[:, e]
+        x[:, :, k0:k1] = np.take(xp.reshape(N * Pc, n, R), row, axis=0).transpose(1, 2, 0)
     return (x if states else None), outputs(C, D, t, x, u)
 
 
@@ -234,76 +229,80 @@ def _apply(M, v):
     return (M @ v.transpose(2, 0, 1)).transpose(1, 2, 0)
 
 
-def phase_march(Phi, f, R, start=None):
-    """States of ``x_{c+1} = Φ_{c mod N} x_c + f_c`` from ``x_0 = start`` over P periods.
+class PhaseMarch:
+    """States of ``x_{c+1} = Φ_{c mod N} x_c + f_c`` over whole periods, P at a time.
 
-    `f` (N, n, P R) holds the forcing of phase c of period p, trace r at
-    ``[c, :, p R + r]``; the result has the same layout (the state at the
-    start of every cell).  The period is cut into B blocks of b phases (b a
-    divisor of N near √N): a loop over the b positions marches every block
-    of every period from a zero start at once and forms the block-local
-    products ``Φ(c, c_0)``; a loop over the B blocks gives the block starts
-    from a zero period start and the period's product Ψ; the period starts
-    follow ``s_{p+1} = Ψ s_p + z_p``.  Periods are taken in chunks within a
-    fixed budget.  Returns the states and the state after the last period
+    The period is cut into B blocks of b phases (b a divisor of N near √N);
+    the block-local products ``Φ(c, c_0)``, the products from the period
+    start to every block start and the period's product Ψ are formed once.
+    A call takes the forcing `f` (N, n, P R) of phase c of period p, trace
+    r at ``[c, :, p R + r]``: a loop over the b positions marches every
+    block of every period from a zero start at once, a loop over the B
+    blocks gives the block starts from a zero period start, and the period
+    starts follow ``s_{p+1} = Ψ s_p + z_p``.  It returns the states at the
+    start of every cell (same layout) and the state after the last period
     (`start` and the result (n, R); default start 0).
 
     Examples
     --------
-    >>> from ltpcontrol._core.cellmarch import phase_march
-    >>> Phi = np.array([[[0.5]], [[2.0]]])
-    >>> f = np.ones((2, 1, 3))                                  # three periods, one trace
-    >>> X, end = phase_march(Phi, f, 1)
+    >>> from ltpcontrol._core.cellmarch import PhaseMarch
+    >>> march = PhaseMarch(np.array([[[0.5]], [[2.0]]]))
+    >>> X, end = march(np.ones((2, 1, 3)), 1)                 # three periods, one trace
     >>> X[:, 0]                                                 # cells 0, 1 of each period
     array([[0. , 3. , 6. ],
            [1. , 2.5, 4. ]])
     >>> end
     array([[9.]])
     """
-    N, n, K = f.shape
-    P = K // R
-    small = [d for d in range(1, math.isqrt(N) + 1) if N % d == 0]
-    divisors = small + [N // d for d in small]
-    b = min(divisors, key=lambda d: abs(np.log(d / np.sqrt(N))))
-    B = N // b
-    Pb = Phi.reshape(B, b, n, n)
-    # block-local products Φ(c, c_0), the same for every chunk
-    O = np.empty((B, b + 1, n, n))
-    O[:, 0] = np.eye(n)
-    for i in range(b):
-        np.matmul(Pb[:, i], O[:, i], out=O[:, i + 1])
-    # products from the period start to every block start, and Ψ
-    M = np.empty((B + 1, n, n))
-    M[0] = np.eye(n)
-    for i in range(B):
-        M[i + 1] = O[i, b] @ M[i]
-    Psi = M[B]
-    X = np.empty_like(f)
-    per = max(1, _CHUNK_ENTRIES // max(1, 2 * N * n * R))
-    s = np.zeros((n, R)) if start is None else start
-    for p0 in range(0, P, per):
-        cols = slice(p0 * R, min(P, p0 + per) * R)
-        k = cols.stop - cols.start
-        fb = f[:, :, cols].reshape(B, b, n, k)
-        # forced parts of every block from a zero block start
-        Z = np.empty((B, b + 1, n, k))
-        Z[:, 0] = 0.0
+
+    def __init__(self, Phi):
+        N, n, _ = Phi.shape
+        small = [d for d in range(1, math.isqrt(N) + 1) if N % d == 0]
+        b = min(small + [N // d for d in small], key=lambda d: abs(np.log(d / np.sqrt(N))))
+        B = N // b
+        self.Pb = Phi.reshape(B, b, n, n)
+        # block-local products Φ(c, c_0)
+        self.O = np.empty((B, b + 1, n, n))
+        self.O[:, 0] = np.eye(n)
         for i in range(b):
-            np.matmul(Pb[:, i], Z[:, i], out=Z[:, i + 1])
-            Z[:, i + 1] += fb[:, i]
-        # block starts from a zero period start
-        Y = np.empty((B + 1, n, k))
-        Y[0] = 0.0
+            np.matmul(self.Pb[:, i], self.O[:, i], out=self.O[:, i + 1])
+        # products from the period start to every block start, and Ψ
+        self.M = np.empty((B + 1, n, n))
+        self.M[0] = np.eye(n)
         for i in range(B):
-            Y[i + 1] = O[i, b] @ Y[i] + Z[i, b]
-        zend = Y[B].reshape(n, -1, R)
-        starts = np.empty((n, zend.shape[1], R))
-        for i in range(zend.shape[1]):
-            starts[:, i] = s
-            s = Psi @ s + zend[:, i]
-        Sb = M[:B] @ starts.reshape(n, k) + Y[:B]                  # (B, n, k)
-        X[:, :, cols] = (O[:, :b] @ Sb[:, None] + Z[:, :b]).reshape(N, n, k)
-    return X, s
+            self.M[i + 1] = self.O[i, b] @ self.M[i]
+
+    def __call__(self, f, R, start=None):
+        B, b, n, _ = self.Pb.shape
+        O, M, Pb, Psi = self.O, self.M, self.Pb, self.M[-1]
+        N, _, K = f.shape
+        P = K // R
+        X = np.empty_like(f)
+        per = max(1, _CHUNK_ENTRIES // max(1, 2 * N * n * R))
+        s = np.zeros((n, R)) if start is None else start
+        for p0 in range(0, P, per):
+            cols = slice(p0 * R, min(P, p0 + per) * R)
+            k = cols.stop - cols.start
+            fb = f[:, :, cols].reshape(B, b, n, k)
+            # forced parts of every block from a zero block start
+            Z = np.empty((B, b + 1, n, k))
+            Z[:, 0] = 0.0
+            for i in range(b):
+                np.matmul(Pb[:, i], Z[:, i], out=Z[:, i + 1])
+                Z[:, i + 1] += fb[:, i]
+            # block starts from a zero period start
+            Y = np.empty((B + 1, n, k))
+            Y[0] = 0.0
+            for i in range(B):
+                Y[i + 1] = O[i, b] @ Y[i] + Z[i, b]
+            zend = Y[B].reshape(n, -1, R)
+            starts = np.empty((n, zend.shape[1], R))
+            for i in range(zend.shape[1]):
+                starts[:, i] = s
+                s = Psi @ s + zend[:, i]
+            Sb = M[:B] @ starts.reshape(n, k) + Y[:B]                  # (B, n, k)
+            X[:, :, cols] = (O[:, :b] @ Sb[:, None] + Z[:, :b]).reshape(N, n, k)
+        return X, s
 
 
 def _cell_of(edges, theta):

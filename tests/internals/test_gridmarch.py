@@ -151,7 +151,7 @@ def test_phase_march_equals_the_recurrence(monkeypatch, N, P, R, budget):
     Phi = 0.5 * rng.normal(size=(N, 2, 2))
     f = rng.normal(size=(N, 2, P * R))
     x0 = rng.normal(size=(2, R))
-    x, end = cellmarch.phase_march(Phi, f, R, x0.copy())
+    x, end = cellmarch.PhaseMarch(Phi)(f, R, x0.copy())
     ref, xs = np.empty_like(x), x0
     for p in range(P):
         for c in range(N):
