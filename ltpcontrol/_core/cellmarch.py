@@ -115,13 +115,17 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     # the last two as Chebyshev coefficients in the first part's ξ = ℓ / h_c
     WZ = np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2)
     kpart = table.bwd[2] if hold == 'foh' else table.bwd[1]                # (N, D1, n, m)
-    # one table (N, D1, E) of the coefficients of every sample's data
-    E1 = n * (n + 2 * m)
-    tab = np.concatenate([table.coefficients(np.concatenate(table.fwd, axis=3))
-                          .reshape(N, D1, E1),
+    # the coefficients of every sample's data: the kink's part, and the first
+    # part's [Φ | W | Z] when that is fewer numbers (D1 > n + 2m) than its
+    # products with (x, a, σ) at the D1 orders, which are formed otherwise
+    firstC = table.coefficients(np.concatenate(table.fwd, axis=3))          # (N, D1, n, n+2m)
+    by_products = D1 > n + 2 * m
+    E1 = 0 if by_products else n * (n + 2 * m)
+    tab = np.concatenate([firstC.reshape(N, D1, -1)[:, :, :E1],
                           table.coefficients(kpart, reverse=True).reshape(N, D1, n * m)],
                          axis=2)
     tabT = np.ascontiguousarray(tab.transpose(0, 2, 1))                     # (N, E, D1)
+    firstC = firstC.reshape(N, D1 * n, n + 2 * m)
     march = PhaseMarch(table.fwd[0][:, -1])
     # the first sample: its cell's last part carries x0 to the next cell,
     # entered as the forcing of cell g0 (all earlier cells force nothing)
@@ -178,13 +182,22 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
             continue
         # states at the samples from the first part [e_c, t_k] of their cell,
         # applied to (x(e_c), a_c, σ_c)
-        z = np.concatenate([X, ab], axis=1).reshape(N, n + 2 * m, Pc, R)
+        z = np.concatenate([X, ab], axis=1)                             # (N, n+2m, Pc R)
         xp = np.empty((N, Pc, n, R))
-        for i in range(n):
-            e0 = i * (n + 2 * m)
-            xp[:, :, i] = data[:, e0, :, None] * z[:, 0]
-            for e in range(1, n + 2 * m):
-                xp[:, :, i] += data[:, e0 + e, :, None] * z[:, e]
+        if E1:
+            z = z.reshape(N, n + 2 * m, Pc, R)
+            for i in range(n):
+                e0 = i * (n + 2 * m)
+                xp[:, :, i] = data[:, e0, :, None] * z[:, 0]
+                for e in range(1, n + 2 * m):
+                    xp[:, :, i] += data[:, e0 + e, :, None] * z[:, e]
+        else:
+            V = np.matmul(firstC, z).reshape(N, D1, n, Pc, R)
+            Tp = Tk.reshape(N, Pc, D1)
+            out = Tp[:, None, :, 0, None] * V[:, 0]
+            for d in range(1, D1):
+                out += Tp[:, None, :, d, None] * V[:, d]                  # (N, n, Pc, R)
+            xp[...] = out.transpose(0, 2, 1, 3)
         x[:, :, k0:k1] = np.take(xp.reshape(N * Pc, n, R), row, axis=0).transpose(1, 2, 0)
     return (x if states else None), outputs(C, D, t, x, u)
 
