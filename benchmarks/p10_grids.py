@@ -37,14 +37,16 @@ outputs against the same exact discretization computed step by step
 record, to 1e-11 relative; the aligned run against the same reference.
 The target is a time ratio of at most 2 (ours / aligned).
 
-Where the time goes on the non-uniform rows (CPU time, loaded machine):
-the aligned 2-state call is almost all fixed cost (about 10 ms for 12000
-or 24000 samples), while the cell table of a jittered grid (about 680
-cells of a period, six Magnus sub-intervals each, forward and backward
-parts) alone costs 1.5-2x that, and the cell march adds about 1.2 µs per
-sample; for 20 states the table (about 2/3 of the call) outweighs the
-march.  Rows P10e and P10i need a cheaper table (fewer cells or fewer
-sub-intervals) to reach the target, not only a faster march.
+Timing: every grid's call alternates with its aligned peer's, ``pairs``
+times, and the ratio is the median of the pairs' ratios, so that a burst
+of load on a shared machine hits both sides of a pair alike.
+
+Where the time goes on the non-uniform rows: the cell table of a jittered
+grid (400 cells of a period, one sample each, Chebyshev-Lobatto lengths of
+degree 6) costs about as much as the aligned grid's 400 step integrations;
+the march then costs about 0.3-0.5 µs per sample for the 2-state plant
+against about 0.1 µs on the aligned grid, so the ratio grows slowly with
+the record (P10i); for 20 states the table is about two thirds of the call.
 """
 
 import numpy as np

@@ -396,9 +396,10 @@ class CellTable:
     >>> table = CellTable(np.array([0.0, 1.0]), np.array([1.0]), frac, (P, W, Z), (P, W, Z))
     >>> bool(table.first(np.array([0]), np.array([1.0]))[0][0, 0, 0] == np.exp(-1.0))
     True
-    >>> table.weights(np.array([0.0, 0.5]), np.array([0, 0])).round(12)
-    array([[ 1.,  0.,  0.],
-           [ 0.,  1., -0.]])
+    >>> C = table.coefficients(P)                       # e^{-ξ} in Chebyshev polynomials
+    >>> T = table.basis(np.array([0.25]), np.array([0]))
+    >>> bool(abs(np.einsum('ks,k->s', T, C[0, :, 0, 0])[0] - np.exp(-0.25)) < 0.01)
+    True
     """
 
     def __init__(self, edges, lens, frac, fwd, bwd, offset=0.0):
@@ -406,18 +407,6 @@ class CellTable:
         self.offset = float(offset)
         # node values -> Chebyshev coefficients of the degree-D interpolant
         self._to_coeffs = np.linalg.inv(_chebyshev_basis(2 * frac - 1, len(frac)).T)
-
-    def weights(self, length, j):
-        """Interpolation weights (S, D + 1) of the part lengths `length` of cells `j`.
-
-        The transpose (D + 1, S) is contiguous.
-        """
-        basis = self.basis(length, j)                                        # (D+1, S)
-        # Σ_k T_k(ξ) c_k over the coefficients, one vector operation per k
-        out = self._to_coeffs[0][:, None] * basis[0]
-        for k in range(1, len(basis)):
-            out += self._to_coeffs[k][:, None] * basis[k]
-        return out.T
 
     def basis(self, length, j):
         """Chebyshev polynomials ``T_k(2ξ - 1)`` (D + 1, S), ξ = `length` / (cell j's length)."""

@@ -27,18 +27,20 @@ first part ``[e_c, t_k]``:
 
     x(t_k) = Φ_f x(e_c) + W_f a_c + Z_f σ_{k-1}.
 
-Both are linear in the data at the table's D + 1 lengths, so every
-product is taken with those data, and only the results (n numbers per
-length) are interpolated in ℓ at the samples.
+The data of a part are polynomials in its length ℓ (degree D, from the
+table's D + 1 lengths): as Chebyshev coefficients in ξ = ℓ / h_c, a
+sample's data are ``Σ_k T_k(2ξ - 1) data_k`` (the last part's, at
+``1 - ξ``, take the signs ``(-1)^k``).
 
 Layout: the cells of the record are an N × P grid (phase × period), every
-signal stored as (phase, rows, periods × traces), so that every per-cell
-product is one batched product over the N phases, and the march is a loop
-over the N phases with all periods and traces at once (the forced parts
-from zero period starts and the partial products ``Φ(c, 0)``), then a
-short loop over the periods (``s_{p+1} = Ψ s_p + z_p``, Ψ the product over
-a period).  No step's transition matrix is formed; the work is
-O(N P R n² + N n³) and memory is bounded per chunk of periods.
+signal stored as (phase, rows, periods × traces).  Every (cell, period)
+gets the Chebyshev polynomials of its sample (zero without one), so that
+the samples' data, the kinks' forcing and the states at the samples are
+batched products over the N phases, with all periods and traces at once;
+the samples are gathered from and into that grid by rows.  The march over
+the cells is blocked over the period (`PhaseMarch`).  No step's transition
+matrix is formed; the work is O(N P R n² + N n³) per march, and the
+record is taken in chunks of periods within a fixed budget.
 """
 
 import math
@@ -134,7 +136,7 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     x = np.empty((n, R, L))
     x[:, :, 0] = x0
     start = np.zeros((n, R))
-    per = max(1, _CHUNK_ENTRIES // (N * max(tab.shape[2], R * (n + 2 * m))))
+    per = max(1, _CHUNK_ENTRIES // (N * max(tab.shape[2], R * (n + 2 * m), R * D1 * n)))
     for p0 in range(0, P, per):
         # the periods [p0, p1): their cells c0 .. c1 - 1 and samples k0 .. k1 - 1;
         # every signal by phase: (N, rows, Pc R)

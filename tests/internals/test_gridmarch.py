@@ -178,3 +178,28 @@ def test_cell_layout_holds_one_sample_per_cell():
         assert np.all(np.diff(cell) >= 1)
         if t is jittered:
             assert N == 400
+
+
+@pytest.mark.parametrize("n, m, hold", [(2, 1, 'foh'), (2, 1, 'zoh'), (6, 2, 'foh')])
+def test_cell_march_in_chunks_equals_the_per_step_march(monkeypatch, n, m, hold):
+    # both ways to the samples' states (entries of the first parts, or their
+    # products with the states: n + 2m below or above the table's D + 1),
+    # two traces, periods taken one chunk at a time or all at once
+    import ltpcontrol._core.cellmarch as cellmarch
+    rng = np.random.default_rng(n + m)
+    c = 0.4 * rng.normal(size=(3, n, n)) + 0.4j * rng.normal(size=(3, n, n))
+    c[2] = c[0].conj()
+    c[1] = c[1].real - 1.5 * np.eye(n)
+    sys = ltp.ltpss(ltp.PeriodicMatrix(c, 1.0), rng.normal(size=(n, m)),
+                    rng.normal(size=(1, n)), 0, period=1.0)
+    t = np.arange(1201) / 40 + 0.1
+    t[1:-1] += rng.uniform(-0.2, 0.2, 1199) / 40
+    U = rng.normal(size=(m, 2, len(t)))
+    X0 = rng.normal(size=(n, 2))
+    whole = ltp.forced_response(sys, t, U, X0, input_hold=hold)
+    monkeypatch.setattr(cellmarch, '_CHUNK_ENTRIES', 1)             # one period a chunk
+    chunked = ltp.forced_response(sys, t, U, X0, input_hold=hold)
+    assert rel(chunked.states, whole.states) < 1e-13
+    ref = direct(monkeypatch, sys, t, U, X0=X0, input_hold=hold)
+    assert rel(whole.states, ref.states) < 1e-11
+    assert rel(whole.outputs, ref.outputs) < 1e-11
