@@ -419,12 +419,12 @@ class CellTable:
         With `reverse` those of the table read at ``1 - ξ`` (the last parts'
         data at the first part's length: ``T_k(-s) = (-1)^k T_k(s)``).
         """
-        out = np.tensordot(values, self._to_coeffs, axes=([1], [1]))        # (N, ..., D+1)
-        out = np.moveaxis(out, -1, 1)
+        N, D1 = values.shape[:2]
+        flat = np.ascontiguousarray(values).reshape(N, D1, -1)
+        out = np.matmul(self._to_coeffs, flat)                               # (N, D+1, ...)
         if reverse:
-            out = out * ((-1.0) ** np.arange(out.shape[1]))[(slice(None),) + (None,) *
-                                                              (out.ndim - 2)]
-        return np.ascontiguousarray(out)
+            out *= ((-1.0) ** np.arange(D1))[:, None]
+        return out.reshape(values.shape)
 
     def first(self, j, length, parts=(0, 1, 2)):
         """(Φ, W, Z) (or the `parts` asked for) of ``[e_j, e_j + length]``."""

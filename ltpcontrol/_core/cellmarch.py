@@ -118,11 +118,10 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     WZ = np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2)
     kpart = table.bwd[2] if hold == 'foh' else table.bwd[1]                # (N, D1, n, m)
     # the coefficients of every sample's data: the kink's part, and the first
-    # part's [Φ | W | Z] when that is fewer numbers (D1 > n + 2m) than its
+    # part's [Φ | W | Z] when that is fewer numbers (n + 2m <= D1) than its
     # products with (x, a, σ) at the D1 orders, which are formed otherwise
     firstC = table.coefficients(np.concatenate(table.fwd, axis=3))          # (N, D1, n, n+2m)
-    by_products = D1 > n + 2 * m
-    E1 = 0 if by_products else n * (n + 2 * m)
+    E1 = n * (n + 2 * m) if n + 2 * m <= D1 else 0
     tab = np.concatenate([firstC.reshape(N, D1, -1)[:, :, :E1],
                           table.coefficients(kpart, reverse=True).reshape(N, D1, n * m)],
                          axis=2)
