@@ -527,7 +527,10 @@ def input_function(plant, inputs, timepts):
     m = plant.ninputs
     if callable(inputs):
         def ufun(t):
-            return _matrix(inputs(t), (m, 1), 'inputs(t)')[:, 0]
+            u = np.asarray(inputs(t), float)
+            if u.size != m:
+                raise ControlDimension(f"inputs(t) returned shape {u.shape}, expected ({m}, 1)")
+            return u.reshape(m)
         return ufun
     arr = real_array(inputs, 'inputs', ndim=(0, 1, 2))
     if arr.ndim == 0:
@@ -626,7 +629,17 @@ class Flow:
     def _system(plant, i, ufun, params, x, variational, factored):
         n = plant.nstates
         if not variational:
-            return (lambda s, z: plant.dynamics(s, z, ufun(s), params, mode=i)), x
+            # `HybridPlant.dynamics` without its per-call mode dispatch: the
+            # solver calls this a dozen times per step
+            f, name = plant.modes[i].updfcn, plant.mode_names[i]
+
+            def field(s, z):
+                dx = np.asarray(f(s, z, ufun(s), params), float).reshape(-1)
+                if dx.size != n:
+                    raise ControlDimension(f"updfcn of mode {name!r} returned "
+                                           f"{dx.size} values, expected {n}")
+                return dx
+            return field, x
 
         def rhs(s, z):
             u = ufun(s)
