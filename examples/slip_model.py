@@ -438,7 +438,7 @@ def _stance_aas(rhod0, theta0, p0, kappa, c, gravity_correction=True,
         # (2.20): p_hat = p_td + t_lo/4 (rho_td sin theta_td + rho_lo sin theta_lo)
         p_new = p0 + stance.t_lo / 4 * (np.sin(theta0) + rho_lo * np.sin(theta_lo))
         p_new = np.where(np.isfinite(p_new), p_new, p0)
-        converged = np.allclose(p_new, p_hat, rtol=0, atol=1e-11)
+        converged = bool(np.all(np.abs(p_new - p_hat) <= 1e-11))   # allclose(atol=1e-11)
         p_hat = p_new
         stance = _aas_evaluator(theta0, p_hat, kappa, c, rhod0)
         if converged:
