@@ -129,9 +129,9 @@ def push_study(plant, orbit, controller, mode, dv, nstrides, dt, *, progress=Fal
 
 def _simulate_experiment(plant, orbit, exc, row, solver):
     signal = exc.signal
+    # a scalar time gives the (channels, experiments) values at that instant
     resp = ltp.simulate_hybrid(plant, exc.time, orbit.x0, orbit.mode0,
-                               inputs=lambda s: np.atleast_1d(signal(np.atleast_1d(s))[0, row]),
-                               **solver)
+                               inputs=lambda s: signal(s)[0, row], **solver)
     ybar = [plant.outfcn(tk, xk, orbit.u0, orbit.params)[0]
             for tk, xk in zip(exc.time, orbit(exc.time).T)]
     return np.atleast_2d(resp.outputs)[0] - np.array(ybar)

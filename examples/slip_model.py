@@ -242,7 +242,11 @@ def descent_time(z0, z_td, d_v, g):
     drop = z0 - z_td
     t = np.sqrt(2 * np.maximum(drop, 0) / g)
     for _ in range(30):
-        _, z, _, vz = flight_state(t, 0.0, z0, 0.0, 0.0, 0.0, d_v, g)
+        # z and vz of `flight_state` from rest (vz0 = 0), without the horizontal part
+        xv = d_v * t
+        ratio = _expm1_ratio(xv)
+        z = z0 + 0.0 * t * ratio - g * t ** 2 * _expm1_ratio2(xv)
+        vz = 0.0 * np.exp(-xv) - g * t * ratio
         step = np.where(vz < 0, (z - z_td) / np.where(vz < 0, vz, -1.0), 0.0)
         t = t - step
         if np.all(np.abs(step) <= 1e-15 * np.maximum(t, 1e-3)):
@@ -378,14 +382,19 @@ def _aas_evaluator(theta0, p, kappa, c, rhod0, p_td=None):
     t_b = np.mod(np.pi / 2 - phi - phi2, np.pi) / wd
     t_top = t_b + np.pi / wd            # next maximum of rho
 
+    # factors of `force` that do not depend on t (the Newton iteration calls it often)
+    rate_t, rho_mean = -xi * w, F / w ** 2
+    amp_d, amp_dd, neg_kappa, two_phi2 = -M * w, M * w ** 2, -kappa, 2 * phi2
+
     def force(t):
         # leg force kappa (1 - rho) - c rhod and its derivative, with
         # rhodd = M w^2 e^{-xi w t} cos(wd t + phi + 2 phi2) from (2.12)
-        decay = np.exp(-xi * w * t)
-        rho = M * decay * np.cos(wd * t + phi) + F / w ** 2
-        rhod = -M * w * decay * np.cos(wd * t + phi + phi2)
-        rhodd = M * w ** 2 * decay * np.cos(wd * t + phi + 2 * phi2)
-        return kappa * (1 - rho) - c * rhod, -kappa * rhod - c * rhodd
+        decay = np.exp(rate_t * t)
+        arg = wd * t + phi
+        rho = M * decay * np.cos(arg) + rho_mean
+        rhod = amp_d * decay * np.cos(arg + phi2)
+        rhodd = amp_dd * decay * np.cos(arg + two_phi2)
+        return kappa * (1 - rho) - c * rhod, neg_kappa * rhod - c * rhodd
 
     lifts = (force(t_top)[0] < 0) & (rhod0 < 0) & (xi < 1)
     t_lo = np.where(lifts, _newton_root(force, t_b, t_top), np.nan)
@@ -429,7 +438,7 @@ def _stance_aas(rhod0, theta0, p0, kappa, c, gravity_correction=True,
         # (2.20): p_hat = p_td + t_lo/4 (rho_td sin theta_td + rho_lo sin theta_lo)
         p_new = p0 + stance.t_lo / 4 * (np.sin(theta0) + rho_lo * np.sin(theta_lo))
         p_new = np.where(np.isfinite(p_new), p_new, p0)
-        converged = np.allclose(p_new, p_hat, rtol=0, atol=1e-11)
+        converged = bool(np.all(np.abs(p_new - p_hat) <= 1e-11))   # allclose(atol=1e-11)
         p_hat = p_new
         stance = _aas_evaluator(theta0, p_hat, kappa, c, rhod0)
         if converged:
@@ -487,7 +496,7 @@ def _stance_numeric(rhod0, theta0, p0, kappa, c, rtol=1e-10, atol=1e-12):
     def rhs(_, x):
         # x has shape (4 n,) or (4 n, m): blocks rho, theta, rhod, thetad
         rho, theta, rhod, thetad = x.reshape((4, n) + x.shape[1:])
-        kap, cc = (v.reshape((n,) + (1,) * (x.ndim - 1)) for v in (kappa, c))
+        kap, cc = (kappa, c) if x.ndim == 1 else (kappa[:, None], c[:, None])
         rhodd = rho * thetad ** 2 - kap * (rho - 1) - cc * rhod - np.cos(theta)  # (2.9)
         thetadd = (np.sin(theta) - 2 * rhod * thetad) / rho                     # (2.10)
         return np.concatenate([rhod, thetad, rhodd, thetadd])

@@ -269,17 +269,19 @@ def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitud
                          f"of dt={dt}")
     _warn_half_multiples(omega, period, 1e-9 * np.max(omega), what)
     delays = np.arange(nexp) * period / nexp
+    # broadcast views made once: a variable-step simulator calls `single` per step
+    delay_col, omega3, phases3 = delays[:, None], omega[:, None, None], phases[:, None, None]
 
     def single(t, shift=0.0):
         t = np.atleast_1d(np.asarray(t, dtype=float))
         # u_r(t) = Σ_l a cos(ω_l (t - τ_r) + φ_l + shift), accumulated line by
         # line so that memory stays (experiments x samples)
-        shifted = t[None, :] - delays[:, None]
+        shifted = t[None, :] - delay_col
         if shifted.size <= _BATCH:
             # few samples (a variable-step simulator asks for one at a time):
             # all lines at once, summed in the order of the loop below (cumsum
             # adds in sequence, so both paths give the same bits)
-            arg = omega[:, None, None] * shifted + phases[:, None, None] + shift
+            arg = omega3 * shifted + phases3 + shift
             return amplitude * np.cumsum(np.cos(arg), axis=0)[-1]
         out = np.zeros(shifted.shape)
         for w, phi in zip(omega, phases):

@@ -111,6 +111,17 @@ def _apply_conj_map(J, H, size):
     return out.reshape(J.shape[0], -1)
 
 
+def _zero_pad(x, pad):
+    """``np.pad(x, pad)`` (zeros) for pads along the first axis only, without
+    `numpy.pad`'s general machinery (the refit unpacks at every evaluation)."""
+    p = pad[0][0]
+    if p < 0 or pad[0][1] != p or any(q != (0, 0) for q in pad[1:]):
+        return np.pad(x, pad)
+    out = np.zeros((x.shape[0] + 2 * p,) + x.shape[1:], x.dtype)
+    out[p:p + x.shape[0]] = x
+    return out
+
+
 class _FloquetFit:
     """Real parameter vector θ = (B, C, D coefficients[, A]) of a model with H
     harmonics in B, 2K in C and K in D fitted to the data harmonics |n| <= Kd."""
@@ -145,8 +156,8 @@ class _FloquetFit:
         if self.fit_a:
             A = theta[self.ncoef:].reshape(nx, nx)
         return (A, c[:nb].reshape(2 * H + 1, nx, nu),
-                np.pad(c[nb:nb + nc].reshape(4 * K + 1, ny, nx), self.cpad),
-                np.pad(c[nb + nc:].reshape(2 * K + 1, ny, nu), self.dpad))
+                _zero_pad(c[nb:nb + nc].reshape(4 * K + 1, ny, nx), self.cpad),
+                _zero_pad(c[nb + nc:].reshape(2 * K + 1, ny, nu), self.dpad))
 
     def response_and_jacobian(self, theta, omega, A=None, jac=True):
         """Harmonic response (nu, 2Kd+1, ny, M) and its Jacobian (nu (2Kd+1) ny M, len θ)."""

@@ -527,7 +527,10 @@ def input_function(plant, inputs, timepts):
     m = plant.ninputs
     if callable(inputs):
         def ufun(t):
-            return _matrix(inputs(t), (m, 1), 'inputs(t)')[:, 0]
+            u = np.asarray(inputs(t), float)
+            if u.size != m:
+                raise ControlDimension(f"inputs(t) returned shape {u.shape}, expected ({m}, 1)")
+            return u.reshape(m)
         return ufun
     arr = real_array(inputs, 'inputs', ndim=(0, 1, 2))
     if arr.ndim == 0:
@@ -561,12 +564,19 @@ class Flow:
     condition number exceeds ``c = _RESTART`` or its norm leaves ``[1e-2,
     c]``, so that every factor is computed to about ``c rtol`` relative to
     each of its singular values (multipliers of stiff orbits).
+
+    With sorted ``samples`` (times in ``[t0, tf]``) the flow keeps only the
+    states and modes at those times (`sampled`, right-continuous at events)
+    and no dense output: the solver then interpolates only in the steps that
+    hold a sample, with the same interpolants and so the same values as
+    `evaluate` of a dense flow.
     """
 
     def __init__(self, plant, t0, tf, x0, mode, ufun, params, rtol, atol, method,
-                 max_events, variational=False, factored=False):
+                 max_events, variational=False, factored=False, samples=None):
         n = plant.nstates
         self.segments, self.events, self.saltations = [], [], []
+        sampled_t, sampled_x, sampled_modes = [], [], []
         self.factors, self.trace_integral = [], 0.0
         t, x, i = t0, np.array(x0, float), mode
         phi = np.eye(n)
@@ -583,13 +593,33 @@ class Flow:
                 events.append(event)
             if variational and factored:
                 events.append(_restart_event(n))
+            t_eval = None
+            if samples is not None:
+                t_eval = samples[np.searchsorted(samples, t, side='left'):
+                                 np.searchsorted(samples, tf, side='right')]
             sol = solve_ivp(rhs, (t, tf), z0, method=method, rtol=rtol,
                             atol=_variational_atol(atol, n, len(z0)) if variational else atol,
-                            events=events or None, dense_output=True)
+                            events=events or None, dense_output=samples is None,
+                            t_eval=t_eval if t_eval is not None and t_eval.size else None)
             if sol.status == -1:
                 raise IntegrationError(f"integration failed in mode {plant.mode_names[i]!r} "
                                        f"at t={sol.t[-1]:.6g}: {sol.message}")
-            t_end, z_end = sol.t[-1], sol.y[:, -1]
+            if samples is None:
+                t_end, z_end = sol.t[-1], sol.y[:, -1]
+            else:
+                # the solver's own end of the segment (an event or tf), not a sample
+                # (samples end at tf: the last one is the state there)
+                t_end = sol.t_events[0][-1] if sol.status == 1 else tf
+                z_end = sol.y_events[0][-1] if sol.status == 1 else sol.y[:, -1]
+                if t_eval is not None and t_eval.size:
+                    # (none when the segment ends before its first sample)
+                    ts = np.asarray(sol.t, float)
+                    ys = np.asarray(sol.y, float).reshape(len(z0), ts.size)
+                    # a sample at the event belongs to the mode entered there
+                    keep = ts < t_end if sol.status == 1 else slice(None)
+                    sampled_t.append(ts[keep])
+                    sampled_x.append(ys[:n, keep])
+                    sampled_modes.append(np.full(sampled_t[-1].size, i))
             self.segments.append((t, t_end, i, sol.sol))
             x = z_end[:n]
             if variational:
@@ -620,13 +650,26 @@ class Flow:
                 raise IntegrationError(f"more than max_events={max_events} events before "
                                        f"t={t:.6g} (Zeno or chattering behaviour?)")
         self.x_final, self.mode_final, self.phi = x, i, phi
+        if samples is not None:
+            self.sampled = (np.concatenate(sampled_x, axis=1) if sampled_x else np.empty((n, 0)),
+                            np.concatenate(sampled_modes) if sampled_modes else np.empty(0, int))
         self.nstates, self.rtol, self.factored = n, rtol, bool(variational and factored)
 
     @staticmethod
     def _system(plant, i, ufun, params, x, variational, factored):
         n = plant.nstates
         if not variational:
-            return (lambda s, z: plant.dynamics(s, z, ufun(s), params, mode=i)), x
+            # `HybridPlant.dynamics` without its per-call mode dispatch: the
+            # solver calls this a dozen times per step
+            f, name = plant.modes[i].updfcn, plant.mode_names[i]
+
+            def field(s, z):
+                dx = np.asarray(f(s, z, ufun(s), params), float).reshape(-1)
+                if dx.size != n:
+                    raise ControlDimension(f"updfcn of mode {name!r} returned "
+                                           f"{dx.size} values, expected {n}")
+                return dx
+            return field, x
 
         def rhs(s, z):
             u = ufun(s)
@@ -762,8 +805,8 @@ def simulate_hybrid(plant, timepts, initial_state, mode0=0, inputs=0.0, params=N
     params = plant_params(plant, params)
     ufun = input_function(plant, inputs, timepts)
     flow = Flow(plant, timepts[0], timepts[-1], x0, mode0, ufun, params, variational=False,
-                 **opts)
-    states, modes = flow.evaluate(timepts)
+                samples=timepts, **opts)
+    states, modes = flow.sampled
     states[:, -1], modes[-1] = flow.x_final, flow.mode_final
     u = np.array([ufun(t) for t in timepts]).reshape(len(timepts), plant.ninputs).T
     y = np.column_stack([plant.output(t, states[:, k], u[:, k], params)
