@@ -129,10 +129,9 @@ class _FloquetFit:
         self.series = [(H, nx * nu), (2 * K, ny * nx)] + ([(K, ny * nu)] if estimate_d else [])
         self.ncoef = self.T.shape[1]
         Kd = self.Kd
-        # C_l = 0 for 2K < |l| <= Kd+H and D_n = 0 for K < |n| <= Kd: the fitted
-        # series sit in the middle of zero arrays (offsets cpad, dpad)
-        self.cpad, self.dpad = Kd + H - 2 * K, Kd - K
-        self._last = None                 # (θ, A, unpacked, R, G) of the last response
+        self.cpad = ((Kd + H - 2 * K,) * 2, (0, 0), (0, 0))   # C_l = 0 for 2K < |l| <= Kd+H
+        self.dpad = ((Kd - K,) * 2, (0, 0), (0, 0))           # D_n = 0 for K < |n| <= Kd
+        self._last = None                 # (θ, A, Ω, then A, B, C, D, R, G) of the last response
 
     def pack(self, sys):
         K, H = self.K, self.H
@@ -146,26 +145,24 @@ class _FloquetFit:
         c = self.T @ theta[:self.ncoef]
         if self.fit_a:
             A = theta[self.ncoef:].reshape(nx, nx)
-        Cc = np.zeros((4 * K + 1 + 2 * self.cpad, ny, nx), c.dtype)
-        Cc[self.cpad:self.cpad + 4 * K + 1] = c[nb:nb + nc].reshape(4 * K + 1, ny, nx)
-        Dc = np.zeros((2 * K + 1 + 2 * self.dpad, ny, nu), c.dtype)
-        Dc[self.dpad:self.dpad + 2 * K + 1] = c[nb + nc:].reshape(2 * K + 1, ny, nu)
-        return A, c[:nb].reshape(2 * H + 1, nx, nu), Cc, Dc
+        return (A, c[:nb].reshape(2 * H + 1, nx, nu),
+                np.pad(c[nb:nb + nc].reshape(4 * K + 1, ny, nx), self.cpad),
+                np.pad(c[nb + nc:].reshape(2 * K + 1, ny, nu), self.dpad))
 
     def response_and_jacobian(self, theta, omega, A=None, jac=True):
         """Harmonic response (nu, 2Kd+1, ny, M) and its Jacobian (nu (2Kd+1) ny M, len θ)."""
         K, H, nx, ny, nu, Kd = self.K, self.H, self.nx, self.ny, self.nu, self.Kd
         last = self._last
-        if (last is not None and last[0].shape == theta.shape and np.array_equal(last[0], theta)
-                and last[1] is A and last[2] is omega):
-            # the point of the last call (an accepted step): its response as it was
+        if (last is not None and last[1] is A and last[2] is omega
+                and last[0].shape == theta.shape and np.array_equal(last[0], theta)):
+            # the point of the last call (a step the fit accepted): its response as it was
             A, Bc, Cc, Dc, R, G = last[3:]
         else:
-            A_given = A
+            given = A
             A, Bc, Cc, Dc = self.unpack(theta, A)
             R = _resolvents(A, omega, self.wp, H)
             G = _model_response(R, Bc, Cc, Dc, Kd, H)
-            self._last = (theta.copy(), A_given, omega, A, Bc, Cc, Dc, R, G)
+            self._last = (theta.copy(), given, omega, A, Bc, Cc, Dc, R, G)
         if not jac:
             return G, None
         M, m = omega.size, np.arange(-H, H + 1)
