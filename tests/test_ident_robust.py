@@ -119,7 +119,8 @@ def test_compare_ltp_bad_input():
 def test_select_structure_finds_order_and_harmonics():
     plant = random_ltp(3, 2, 1)
     # 3K + 1 harmonics: every produced one; 40 lines (30 once every 4th is held out) hold
-    # the lifted order 14 of the largest candidate, 120 give the same choice and errors
+    # the lifted order 14 of the largest candidate; held-out errors 0.59, 0.58, 0.26, 5e-6,
+    # on 120 lines 0.58, 0.58, 0.26, 5e-6
     G = lifted_data(plant, 10, design_lines(T, 40), DT)
     sel = ltp.select_structure(G, T, [1, 2], [1, 3])
     assert sel.best == (2, 3)
