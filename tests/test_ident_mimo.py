@@ -115,13 +115,13 @@ def _check(plant, K, **kw):
 
 @pytest.mark.slow
 def test_random_mimo_plants():
-    """9 random 2 x 2 plants (n_p = 2-4, three of each, periodic A, B, C), K = 3,
+    """6 random 2 x 2 plants (n_p = 2-4, two of each, periodic A, B, C), K = 3,
     default settings: a model for every one, HTF error at unseen frequencies and
     Floquet exponents within 1e-3 (measured <= 1.1e-6 and 4.8e-6 over 30 plants;
     with B(t) of K harmonics 1.3e-4 and 5.7e-4, and one plant of the 30 of
     examples/generic_identification_study.py misses by 1.7e-3)."""
     worst = np.zeros(2)
-    for seed in range(9):
+    for seed in range(6):
         info, cmp = _check(_mimo(seed), 3)
         # lifted data of K harmonics leave the model's outer ones unvalidated
         assert not info.success and 'neither fitted nor validated' in info.message
@@ -146,6 +146,10 @@ def test_ml_refinement_and_structure_selection_mimo():
     with pytest.raises(ltp.ControlDimension if hasattr(ltp, 'ControlDimension')
                        else ValueError, match='std'):
         ltp.refine_ltp(model, G, std=np.ones(3))
-    sel = ltp.select_structure(lifted_data(plant, 10, LINES, DT), T, [1, 2], [1, 3])
+    # 40 lines (30 once every 4th is held out) hold the lifted order (2K+1) n_p = 14 of
+    # the largest candidate; held-out errors 0.32, 0.32 (n_p = 1), 0.013, 4e-6 (n_p = 2),
+    # on 120 lines 0.31, 0.30, 0.014, 4e-6: the same choice
+    sel = ltp.select_structure(lifted_data(plant, 10, design_lines(T, 40), DT), T, [1, 2],
+                               [1, 3])
     assert sel.best == (2, 3)
     assert sel.validation_error[1, 1] < 1e-3 < sel.validation_error[0, 1]

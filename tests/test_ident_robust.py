@@ -22,17 +22,18 @@ def _identify(plant, K, **kw):
                                 return_info=True, **kw)
 
 
-PLANTS = [(seed, n, ny) for seed in range(4) for n, ny in ((2, 1), (3, 2), (4, 1))]
+PLANTS = [(seed, n, ny) for seed in range(2) for n, ny in ((2, 1), (3, 2), (4, 1))]
 
 
 @pytest.mark.slow
 def test_random_plants():
-    """12 plants, n_p = 2-4, harmonics up to 2 in A, B, C, one and two outputs,
+    """6 plants, n_p = 2-4, harmonics up to 2 in A, B, C, one and two outputs,
     default settings: a model for every one; K = 3: HTF error at unseen
     frequencies and Floquet exponents (modulo jω_p) within 1e-3 for all (the
     refit's B(t) gets K + 1 harmonics where the data call for them); K = 4
     (first 3 plants; all 30 plants at K = 3 and 4 in
-    examples/generic_identification_study.py)."""
+    examples/generic_identification_study.py, and the five of them whose
+    exponents need the wider B(t) in test_refit_harmonics_remove_exponent_bias)."""
     worst = {3: [0.0, 0.0], 4: [0.0, 0.0]}
     for i, (seed, n, ny) in enumerate(PLANTS):
         plant = random_ltp(seed, n, ny)
@@ -117,7 +118,10 @@ def test_compare_ltp_bad_input():
 
 def test_select_structure_finds_order_and_harmonics():
     plant = random_ltp(3, 2, 1)
-    G = lifted_data(plant, 10, LINES, DT)                 # 3K + 1: every produced harmonic
+    # 3K + 1 harmonics: every produced one; 40 lines (30 once every 4th is held out) hold
+    # the lifted order 14 of the largest candidate; held-out errors 0.59, 0.58, 0.26, 5e-6,
+    # on 120 lines 0.58, 0.58, 0.26, 5e-6
+    G = lifted_data(plant, 10, design_lines(T, 40), DT)
     sel = ltp.select_structure(G, T, [1, 2], [1, 3])
     assert sel.best == (2, 3)
     assert sel.validation_error[1, 1] < 1e-3 < sel.validation_error[0, 1]

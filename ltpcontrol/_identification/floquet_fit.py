@@ -142,6 +142,7 @@ class _FloquetFit:
         Kd = self.Kd
         self.cpad = ((Kd + H - 2 * K,) * 2, (0, 0), (0, 0))   # C_l = 0 for 2K < |l| <= Kd+H
         self.dpad = ((Kd - K,) * 2, (0, 0), (0, 0))           # D_n = 0 for K < |n| <= Kd
+        self._last = None                 # (θ, A, Ω, then A, B, C, D, R, G) of the last response
 
     def pack(self, sys):
         K, H = self.K, self.H
@@ -162,9 +163,17 @@ class _FloquetFit:
     def response_and_jacobian(self, theta, omega, A=None, jac=True):
         """Harmonic response (nu, 2Kd+1, ny, M) and its Jacobian (nu (2Kd+1) ny M, len θ)."""
         K, H, nx, ny, nu, Kd = self.K, self.H, self.nx, self.ny, self.nu, self.Kd
-        A, Bc, Cc, Dc = self.unpack(theta, A)
-        R = _resolvents(A, omega, self.wp, H)
-        G = _model_response(R, Bc, Cc, Dc, Kd, H)
+        last = self._last
+        if (last is not None and last[1] is A and last[2] is omega
+                and last[0].shape == theta.shape and np.array_equal(last[0], theta)):
+            # the point of the last call (a step the fit accepted): its response as it was
+            A, Bc, Cc, Dc, R, G = last[3:]
+        else:
+            given = A
+            A, Bc, Cc, Dc = self.unpack(theta, A)
+            R = _resolvents(A, omega, self.wp, H)
+            G = _model_response(R, Bc, Cc, Dc, Kd, H)
+            self._last = (theta.copy(), given, omega, A, Bc, Cc, Dc, R, G)
         if not jac:
             return G, None
         M, m = omega.size, np.arange(-H, H + 1)

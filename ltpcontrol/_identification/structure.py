@@ -177,7 +177,7 @@ def select_structure(data, period, nstates, nharmonics, *, holdout=4, criterion=
     --------
     >>> sys = ltp.ltpss([[-2.0]], lambda t: np.array([[1 + 0.5 * np.cos(4 * np.pi * t)]]),
     ...                 [[1.0]], 0, period=0.5)
-    >>> w = np.pi / 2 * np.array([k for k in range(1, 48) if k % 4])
+    >>> w = np.pi / 2 * np.array([k for k in range(1, 24) if k % 4])
     >>> exc = ltp.sine_experiments(w, 0.5, dt=0.0125, nperiods=8, settle=12)
     >>> resp = ltp.forced_response(sys, exc.time, exc.inputs)
     >>> sel = ltp.select_structure(resp, 0.5, [1, 2], [0, 1, 2], transient=6.0)
