@@ -21,7 +21,8 @@ from ._frequency.htf import HTF, HTFModel, HTFData, htf
 from ._frequency.htfplot import htf_response, bode_htf, htf_map_plot
 from ._core.discretize import sample_system, d2c
 from ._core.lifting import lift
-from ._orbits.hybrid import HybridMode, HybridPlant, simulate_hybrid, saltation_matrix
+from ._orbits.hybrid import simulate_hybrid, saltation_matrix
+from ._orbits.hybrid_plant import HybridMode, HybridPlant
 from ._orbits.orbits import PeriodicOrbit, periodic_orbit, period_map, linearize_orbit
 from ._orbits.autonomous import limit_cycle, poincare_map
 from ._orbits.continuation import Bifurcation, OrbitBranch, orbit_continuation

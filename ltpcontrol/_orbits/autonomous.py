@@ -26,7 +26,8 @@ import numpy as np
 from control.exception import ControlArgument, ControlDimension
 from scipy.optimize import brentq
 
-from .hybrid import central_jacobian, constant_input, Flow, plant_params, solver_settings
+from .hybrid import constant_input, Flow, plant_params, solver_settings
+from .hybrid_plant import central_jacobian
 from .settings import inexact_options, newton_solver_settings
 from .orbits import PeriodicOrbit, as_hybrid, time_mismatch, _floor_hint
 from .._core.validation import check_period, check_positive, check_positive_int, real_array

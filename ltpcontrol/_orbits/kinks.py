@@ -21,7 +21,7 @@ that stay on their side of ``d``.
 
 import numpy as np
 
-from .hybrid import central_jacobian
+from .hybrid_plant import central_jacobian
 
 __all__ = []
 

@@ -19,7 +19,8 @@ import numpy as np
 import control as ct
 from control.exception import ControlArgument, ControlDimension
 
-from .hybrid import Flow, HybridMode, HybridPlant, central_jacobian
+from .hybrid import Flow
+from .hybrid_plant import HybridMode, HybridPlant, central_jacobian
 from .._core.ltpsys import LTPStateSpace
 from .orbits import as_hybrid, check_orbit_of
 from .tabulate import tabulate

@@ -18,8 +18,9 @@ import numpy as np
 from control import NonlinearIOSystem
 from control.exception import ControlArgument, ControlDimension
 
-from .hybrid import (HybridMode, HybridPlant, central_jacobian, constant_input,
-                      Flow, IntegrationError, plant_params, solver_settings, _RESTART)
+from .hybrid import (constant_input, Flow, IntegrationError, plant_params, solver_settings,
+                     _RESTART)
+from .hybrid_plant import HybridMode, HybridPlant, central_jacobian
 from .settings import inexact_options, newton_solver_settings
 from .multipliers import product_multipliers
 from .tabulate import tabulate
