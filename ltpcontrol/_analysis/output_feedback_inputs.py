@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
-from .._core.floquet import PiecewiseChebyshev, chebyshev_nodes
+from .._core.chebyshev import PiecewiseChebyshev, chebyshev_nodes
 from .._core.periodic_matrix import PeriodicMatrix, as_periodic
 from .._core.validation import real_array
 

@@ -137,7 +137,6 @@ class DiscreteLQ:
     def __call__(self, theta, hessian=False):
         """``(J, grad)`` or ``(J, grad, hess)``; J = inf for an unstable loop."""
         self.nev += 1
-        N, n = self.N, self.n
         params = np.asarray(theta, float).reshape(self.s, self.m, self.p)
         F = np.einsum('ki,iab->kab', self.phi, params)
         FC = F @ self.C

@@ -14,7 +14,7 @@ import warnings
 
 import numpy as np
 
-from .._core.floquet import PiecewiseChebyshev, chebyshev_nodes, piecewise_chebyshev
+from .._core.chebyshev import PiecewiseChebyshev, chebyshev_nodes, piecewise_chebyshev
 from .._core.pm_ops import register_func
 from .._core.transition import step_transitions
 from .gain_table import _GRID_STEPS, _coarse_edges

@@ -31,7 +31,7 @@ from .ltpsys import ltpss
 from .periodic_matrix import PeriodicMatrix
 from .periodic_schur import product_eigenvalues
 from .periodic_vectors import cyclic_eigenvectors
-from .chebyshev import PiecewiseChebyshev, chebyshev_nodes, piecewise_chebyshev  # noqa: F401
+from .chebyshev import chebyshev_nodes, piecewise_chebyshev
 from .steps import floquet_grid, floquet_norm, step_grid
 from .graded import STIFF, stiff_log_multipliers
 from .fastform import constant_value, fast_form
@@ -731,7 +731,7 @@ def _chebyshev_transform(A, grid, G, E, R):
     exactly and P is evaluated by barycentric interpolation.
     """
     n = G.shape[1]
-    period, starts, h = grid[-1], grid[:-1], np.diff(grid)
+    starts, h = grid[:-1], np.diff(grid)
     cheb = chebyshev_nodes(_CHEB_DEG)
     zero = PeriodicMatrix.constant(np.zeros((n, 0)), A.period)
     nodes = starts[:, None] + h[:, None] * cheb                        # (M, D+1)

@@ -24,6 +24,7 @@ from control.exception import ControlDimension
 from control.timeresp import _default_time_vector, _timeresp_aliases
 from scipy.integrate import solve_ivp
 
+from .cellmarch import outputs
 from .gridmarch import grid_march
 from .march import periodic_march
 from .coerce import as_ltp
@@ -354,13 +355,12 @@ def _solve_ivp(sys, t, u, x0, hold, rtol):
 
 
 def _outputs(sys, t, x, u):
-    if sys.isdtime():
-        N = sys.nsteps
-        idx = np.round(t / sys.dt).astype(int) % N
-        C, D = sys.C.sample(N)[idx], sys.D.sample(N)[idx]
-    else:
-        C, D = sys.C(t), sys.D(t)
-    # y_l = C(t_l) x_l + D(t_l) u_l, batched over time
+    if not sys.isdtime():
+        return outputs(sys.C, sys.D, t, x, u)
+    N = sys.nsteps
+    idx = np.round(t / sys.dt).astype(int) % N
+    C, D = sys.C.sample(N)[idx], sys.D.sample(N)[idx]
+    # y_l = C_l x_l + D_l u_l, batched over time
     y = C @ x.transpose(2, 0, 1) + D @ u.transpose(2, 0, 1)
     return y.transpose(1, 2, 0)
 

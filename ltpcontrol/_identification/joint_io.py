@@ -36,7 +36,7 @@ the ``std`` it starts from.
 """
 
 import numpy as np
-from control.exception import ControlArgument, ControlDimension
+from control.exception import ControlArgument
 
 from .._frequency.htf import HTFData
 from .._core.validation import check_positive_int
