@@ -23,6 +23,13 @@
     when systems of different periods are combined.
 ``period.rtol`` : float, default 1e-9
     Relative tolerance of the rational period ratio ``T_1/T_2 = p/q``.
+``timeresp.compiled`` : bool, default True
+    `forced_response` on long grids whose phases never repeat (at least
+    20 000 samples, at most 8 states) marches with a compiled kernel when
+    numba is installed (``pip install ltpcontrol[fast]``).  The kernel is
+    compiled at its first use and cached on disk (a few seconds, once per
+    environment).  False: always the NumPy march (same results to
+    rounding).
 
 Examples
 --------
@@ -46,6 +53,7 @@ _DEFAULTS = {
                                                                               'False'),
     'period.max_multiple': 100,
     'period.rtol': 1e-9,
+    'timeresp.compiled': True,
 }
 
 #: Current settings (see the module docstring for the keys).

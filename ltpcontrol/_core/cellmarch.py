@@ -47,9 +47,14 @@ import math
 
 import numpy as np
 
+from ..config import _get
+from . import cellkernel
+
 __all__ = []
 
-_CHUNK_ENTRIES = 2 ** 21       # entries of a chunk's per-cell arrays
+_CHUNK_ENTRIES = 2 ** 21       # entries of a chunk's arrays
+_FEW_COLUMNS = 8              # constant output matrices with fewer columns: rows summed
+_CELL_ENTRIES = 2 ** 19        # entries of a block of phases of the cell march (cache-sized)
 
 
 def cell_march(table, C, D, t, u, x0, hold, states=True):
@@ -90,117 +95,184 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     n, R = x0.shape
     m, L = u.shape[0], len(t)
     D1 = len(table.frac)
-    # cell of every sample (phases counted from the table's offset), numbered
-    # g = P N + j from the start of the period of t[0]
-    shifted = t - table.offset
-    base = np.floor(shifted[0] / T)
-    wraps = np.floor(shifted / T)
-    theta = shifted - wraps * T
-    j = _cell_of(edges, theta)
-    g = (wraps - base).astype(np.int64) * N + j
-    ell = np.clip(theta - edges[j], 0.0, lens[j])                 # first part
+    wraps, j, xi, base = _cells_of_samples(table, t)
+    g = wraps.astype(np.int64) * N + j
     if np.any(np.diff(g) == 0):
         return None                     # two samples in one cell: not this table
-    # slopes of the held input on [t_k, t_{k+1}) (zero after the last sample)
+    # slopes of the held input on [t_k, t_{k+1}) (zero after the last sample);
+    # q rows of the held input in the cells' forcing: a (and σ, first-order hold)
     sigma = np.zeros((m, R, L))
     if hold == 'foh':
         sigma[:, :, :-1] = np.diff(u, axis=2) / np.diff(t)
+    q = 2 * m if hold == 'foh' else m
     g0, P = int(g[0]), int(g[-1]) // N + 1
     # the last sample before every cell of the record (a sample at a cell's
-    # start is counted in the cell: its jump below makes up the difference)
-    last = np.concatenate([[0], np.cumsum(np.bincount(g, minlength=P * N))[:-1]]) - 1
-    # the table's data: whole cells' (W, Z); the kink's part, the jump
+    # start is counted in the cell: its jump below makes up the difference);
+    # for the cell of sample k that is k - 1, so the kink there, the jump
     # (zero-order hold) or the change of slope (first-order hold: the input is
-    # continuous) through the last part [t_k, e_{c+1}]: W or Z of the last
-    # parts, whose lengths' weights are those of the first part, reversed (the
-    # lengths are symmetric about half a cell); the first parts' [Φ | W | Z];
-    # the last two as Chebyshev coefficients in the first part's ξ = ℓ / h_c
-    WZ = np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2)
-    kpart = table.bwd[2] if hold == 'foh' else table.bwd[1]                # (N, D1, n, m)
-    # the coefficients of every sample's data: the kink's part, and the first
-    # part's [Φ | W | Z] when that is fewer numbers (n + 2m <= D1) than its
-    # products with (x, a, σ) at the D1 orders, which are formed otherwise
-    firstC = table.coefficients(np.concatenate(table.fwd, axis=3))          # (N, D1, n, n+2m)
-    E1 = n * (n + 2 * m) if n + 2 * m <= D1 else 0
-    tab = np.concatenate([firstC.reshape(N, D1, -1)[:, :, :E1],
-                          table.coefficients(kpart, reverse=True).reshape(N, D1, n * m)],
-                         axis=2)
-    tabT = np.ascontiguousarray(tab.transpose(0, 2, 1))                     # (N, E, D1)
-    firstC = firstC.reshape(N, D1 * n, n + 2 * m)
-    march = PhaseMarch(table.fwd[0][:, -1])
+    # continuous), is a difference of consecutive samples
+    last = np.cumsum(np.bincount(g, minlength=P * N)) - 1
+    last[1:] = last[:-1]
+    last[0] = 0
+    np.maximum(last, 0, out=last)
+    kink = np.zeros((m, R, L))
+    kink[:, :, 1:] = np.diff(sigma if hold == 'foh' else u, axis=2)
+    # the table's data: whole cells' [W Z]; Chebyshev coefficients in the
+    # first part's ξ = ℓ / h_c of the kink's part [t_k, e_{c+1}] (W or Z of
+    # the last parts, whose lengths' weights are those of the first part,
+    # reversed) and of the first part's [Φ W Z], applied to (x(e_c), a, σ)
+    # for the state at the sample; the latter as entries when those are
+    # fewer numbers (n + q <= D1) than their products with (x, a, σ) at the
+    # D1 orders, which are formed otherwise
+    WZ = np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2)[:, :, :q]
+    kpart = table.bwd[2] if hold == 'foh' else table.bwd[1]                 # (N, D1, n, m)
+    first = table.coefficients(np.concatenate(table.fwd, axis=3)[..., :n + q])  # (N, D1, n, n+q)
+    kcoef = table.coefficients(kpart, reverse=True)
     # the first sample: its cell's last part carries x0 to the next cell,
     # entered as the forcing of cell g0 (all earlier cells force nothing)
-    Pb, Wb, Zb = table.last(j[:1], lens[j[:1]] - ell[:1])
+    Pb, Wb, Zb = table.last(j[:1], lens[j[:1]] * (1 - xi[:1]))
     x1 = Pb[0] @ x0 + Wb[0] @ u[:, :, 0] + Zb[0] @ sigma[:, :, 0]
     x = np.empty((n, R, L))
     x[:, :, 0] = x0
+    kernel = _kernel(n, L)
+    if kernel is not None:
+        kernel(np.ascontiguousarray(table.fwd[0][:, -1]), np.ascontiguousarray(WZ),
+               np.ascontiguousarray(first), np.ascontiguousarray(kcoef), edges, float(T),
+               table.offset, float(base), g, xi, t, np.ascontiguousarray(u), sigma, kink,
+               x1, x)
+        return (x if states else None), outputs(C, D, t, x, u)
+    E1 = n * (n + q) if n + q <= D1 else 0
+    tab = np.concatenate([first.reshape(N, D1, -1)[:, :, :E1], kcoef.reshape(N, D1, n * m)],
+                         axis=2)
+    tab = np.ascontiguousarray(tab.transpose(0, 2, 1))                      # (N, E, D1)
+    first = first.reshape(N, D1 * n, n + q)
+    march = PhaseMarch(table.fwd[0][:, -1])
     start = np.zeros((n, R))
-    per = max(1, _CHUNK_ENTRIES // (N * max(tab.shape[2], R * (n + 2 * m), R * D1 * n)))
+    # periods [p0, p1) at a time; inside, phases [j0, j1) at a time (the
+    # products per cell run over all the chunk's periods, on cache-sized blocks)
+    per = max(1, min(P, _CHUNK_ENTRIES // (N * R * (3 * n + q + m) + N * D1)))
+    per = -(-P // -(-P // per))                                 # equal chunks
+    E = tab.shape[1]
+    nph = max(1, min(N, _CELL_ENTRIES // (per * (R * (3 * n + q + m) + D1 + E))))
+    blocks = [slice(j0, min(N, j0 + nph)) for j0 in range(0, N, nph)]
     for p0 in range(0, P, per):
-        # the periods [p0, p1): their cells c0 .. c1 - 1 and samples k0 .. k1 - 1;
-        # every signal by phase: (N, rows, Pc R)
+        # the periods [p0, p1): cells c0 .. c1 - 1, samples in ks.  The cells'
+        # signals are formed in time order (Pc, N) and transposed once to the
+        # phase order (N, rows, Pc, R) of the products per cell; z = [x | a σ]
         p1 = min(P, p0 + per)
         Pc, c0, c1 = p1 - p0, p0 * N, p1 * N
         k0, k1 = np.searchsorted(g, [c0, c1])
-        k0 = max(k0, 1)
-        cells = np.arange(c0, c1)
-        tau = (base + cells // N) * T + table.offset + edges[cells % N]
-        kc = np.maximum(last[c0:c1], 0)
-        a = u[:, :, kc] + sigma[:, :, kc] * (tau - t[kc])                  # (m, R, cells)
-        sig = sigma[:, :, kc]
+        ks = slice(max(k0, 1), k1)
+        cs = g[ks] - c0                                     # the samples' cells
+        z = np.empty((N, n + q, Pc, R))
+        kc = last[c0:c1]
+        held = u[:, :, kc]
+        if hold == 'foh':
+            # the held input at the cells' starts τ: a = u_k + σ_k (τ - t_k)
+            tau = ((base + p0 + np.arange(Pc)) * T + table.offset)[:, None] + edges[:-1]
+            sk = sigma[:, :, kc]
+            held += sk * (tau.reshape(-1) - t[kc])
+            z[:, n + m:] = sk.reshape(m, R, Pc, N).transpose(3, 0, 2, 1)
+        z[:, n:n + m] = held.reshape(m, R, Pc, N).transpose(3, 0, 2, 1)
         if c0 <= g0:
-            a[:, :, :g0 + 1 - c0], sig[:, :, :g0 + 1 - c0] = 0.0, 0.0
-        ab = _by_phase(np.concatenate([a, sig]), N, Pc)                 # (N, 2m, Pc R)
-        f = np.matmul(WZ, ab)                                           # (N, n, Pc R)
-        # every (cell, period)'s data Σ_k T_k(ξ) tab_k, by phase: one product
-        # per cell over the periods (zero where the cell holds no sample);
-        # row j Pc + period
-        ks = np.arange(k0, k1)
-        gs = g[ks] - c0
-        row = j[ks] * Pc + gs // N
-        # rows are gathered, not scattered: every (cell, period) names its
-        # sample, or an appended zero row
-        which = np.full(N * Pc, len(ks))
-        which[row] = np.arange(len(ks))
-        Tk = np.concatenate([table.basis(ell[ks], j[ks]).T, np.zeros((1, D1))])
-        Tk = np.take(Tk, which, axis=0)
-        data = np.matmul(tabT, Tk.reshape(N, Pc, D1).transpose(0, 2, 1))   # (N, E, Pc)
-        if m and len(ks):
-            kink = sigma[:, :, ks] - sig[:, :, gs] if hold == 'foh' \
-                else u[:, :, ks] - a[:, :, gs]                               # (m, R, s)
-            Kp = np.concatenate([kink.transpose(2, 0, 1), np.zeros((1, m, R))])
-            Kp = np.take(Kp, which, axis=0).reshape(N, Pc, m, R)
-            fk = np.empty((N, n, Pc, R))
+            z[:g0 + 1, n:, 0] = 0.0
+        # T_d(2ξ - 1) of every cell (ξ = 0 without a sample) and the kinks
+        # (zero without a sample), by phase
+        sgrid = np.full(Pc * N, -1.0)
+        sgrid[cs] = 2 * xi[ks] - 1
+        sgrid = np.ascontiguousarray(sgrid.reshape(Pc, N).T)
+        kgrid = np.zeros((m, R, Pc * N))
+        kgrid[:, :, cs] = kink[:, :, ks]
+        kgrid = np.ascontiguousarray(kgrid.reshape(m, R, Pc, N).transpose(0, 3, 2, 1))
+        f = np.empty((N, n, Pc, R))
+        Tb = np.empty((N, D1, Pc))
+        for ph in blocks:
+            # forcing f_c = [W Z] (a, σ) + Σ_d T_d(ξ) K_d kink
+            _basis_by_phase(sgrid[ph], D1, out=Tb[ph])
+            if not m:
+                f[ph] = 0.0
+                continue
+            np.matmul(WZ[ph], z[ph, n:].reshape(-1, q, Pc * R),
+                      out=f[ph].reshape(-1, n, Pc * R))
+            data = np.matmul(tab[ph, E1:], Tb[ph])                          # (nph, n m, Pc)
             for i in range(n):
-                fk[:, i] = data[:, E1 + i * m, :, None] * Kp[:, :, 0]
-                for q in range(1, m):
-                    fk[:, i] += data[:, E1 + i * m + q, :, None] * Kp[:, :, q]
-            f += fk.reshape(N, n, Pc * R)
+                for r in range(m):
+                    f[ph, i] += data[:, i * m + r, :, None] * kgrid[r, ph]
         if c0 <= g0:
-            f[g0 - c0, :, :R] = x1
-        X, start = march(f, R, start)                                   # (N, n, Pc R)
-        if not len(ks):
+            f[:g0, :, 0] = 0.0
+            f[g0, :, 0] = x1
+        _, start = march(f.reshape(N, n, Pc * R), R, start,
+                         out=z[:, :n].reshape(N, n, Pc * R))
+        if not len(cs):
             continue
         # states at the samples from the first part [e_c, t_k] of their cell,
-        # applied to (x(e_c), a_c, σ_c)
-        z = np.concatenate([X, ab], axis=1)                             # (N, n+2m, Pc R)
-        xp = np.empty((N, Pc, n, R))
-        if E1:
-            z = z.reshape(N, n + 2 * m, Pc, R)
-            for i in range(n):
-                e0 = i * (n + 2 * m)
-                xp[:, :, i] = data[:, e0, :, None] * z[:, 0]
-                for e in range(1, n + 2 * m):
-                    xp[:, :, i] += data[:, e0 + e, :, None] * z[:, e]
-        else:
-            V = np.matmul(firstC, z).reshape(N, D1, n, Pc, R)
-            Tp = Tk.reshape(N, Pc, D1)
-            out = Tp[:, None, :, 0, None] * V[:, 0]
-            for d in range(1, D1):
-                out += Tp[:, None, :, d, None] * V[:, d]                  # (N, n, Pc, R)
-            xp[...] = out.transpose(0, 2, 1, 3)
-        x[:, :, k0:k1] = np.take(xp.reshape(N * Pc, n, R), row, axis=0).transpose(1, 2, 0)
+        # applied to (x(e_c), a, σ), (N, n, Pc, R); back in time order at the
+        # samples' cells
+        xp = np.empty((N, n, Pc, R))
+        for ph in blocks:
+            if E1:
+                data = np.matmul(tab[ph, :E1], Tb[ph])                      # (nph, n(n+q), Pc)
+                for i in range(n):
+                    e0 = i * (n + q)
+                    np.multiply(data[:, e0, :, None], z[ph, 0], out=xp[ph, i])
+                    for e in range(1, n + q):
+                        xp[ph, i] += data[:, e0 + e, :, None] * z[ph, e]
+            else:
+                V = np.matmul(first[ph], z[ph].reshape(-1, n + q, Pc * R))
+                V = V.reshape(-1, D1, n, Pc, R)
+                np.multiply(Tb[ph, 0, None, :, None], V[:, 0], out=xp[ph])
+                for d in range(1, D1):
+                    xp[ph] += Tb[ph, d, None, :, None] * V[:, d]
+        xt = np.ascontiguousarray(xp.transpose(1, 3, 2, 0)).reshape(n, R, Pc * N)
+        for i in range(n):
+            for r in range(R):
+                np.take(xt[i, r], cs, out=x[i, r, ks], mode='clip')
     return (x if states else None), outputs(C, D, t, x, u)
+
+
+def _kernel(n, L):
+    """The compiled cell march when enabled, installed and worthwhile (`cellkernel`), else None."""
+    if not (_get('timeresp.compiled') and L >= cellkernel.MIN_SAMPLES
+            and n <= cellkernel.MAX_STATES):
+        return None
+    return cellkernel.compiled_kernel()
+
+
+def _cells_of_samples(table, t):
+    """Period (counted from the period of t[0], as floats), cell j and fraction ξ
+    of the cell before every sample, and the number of the period of t[0]."""
+    edges, lens = table.edges, table.lens
+    N, T = len(lens), edges[-1]
+    shifted = t - table.offset
+    base = np.floor(shifted[0] / T)
+    w = lens[0]
+    if np.ptp(lens) <= 1e-13 * w and abs(N * w - T) <= 1e-13 * T:
+        # equal cells: r cells from the start of that period, ξ = r - ⌊r⌋ (exact)
+        r = shifted / w - base * N
+        cell = np.floor(r)
+        xi = r - cell
+        wraps = np.floor(cell / N)
+        j = (cell - wraps * N).astype(np.int64)
+        return wraps, j, xi, base
+    wraps = np.floor(shifted / T)
+    theta = shifted - wraps * T
+    j = _cell_of(edges, theta)
+    xi = np.clip((theta - edges[j]) / lens[j], 0.0, 1.0)
+    return wraps - base, j, xi, base
+
+
+def _basis_by_phase(s, K, out=None):
+    """``T_k(s)`` for k < K of an array s (N, P), shape (N, K, P)."""
+    if out is None:
+        out = np.empty((s.shape[0], K, s.shape[1]))
+    out[:, 0] = 1.0
+    if K > 1:
+        out[:, 1] = s
+    two_s = 2 * s
+    for k in range(2, K):
+        np.multiply(two_s, out[:, k - 1], out=out[:, k])
+        out[:, k] -= out[:, k - 2]
+    return out
 
 
 def outputs(C, D, t, x, u):
@@ -220,7 +292,14 @@ def outputs(C, D, t, x, u):
     for s0 in range(0, L, chunk):
         i = slice(s0, s0 + chunk)
         for M, v, first in ((C, x, True), (D, u, False)):
-            if M.is_constant:
+            if M.is_constant and 0 < M.shape[1] <= _FEW_COLUMNS:
+                # a few columns: a sum of scaled rows (a product would read v
+                # column by column)
+                Mc = M(t[0])
+                out = Mc[:, :1, None] * v[0, :, i]
+                for c in range(1, M.shape[1]):
+                    out += Mc[:, c:c + 1, None] * v[c, :, i]
+            elif M.is_constant:
                 out = np.tensordot(M(t[0]), v[:, :, i], axes=1)
             else:
                 out = _apply(M(t[i]), v[:, :, i])
@@ -253,9 +332,10 @@ class PhaseMarch:
     r at ``[c, :, p R + r]``: a loop over the b positions marches every
     block of every period from a zero start at once, a loop over the B
     blocks gives the block starts from a zero period start, and the period
-    starts follow ``s_{p+1} = Ψ s_p + z_p``.  It returns the states at the
-    start of every cell (same layout) and the state after the last period
-    (`start` and the result (n, R); default start 0).
+    starts follow ``s_{p+1} = Ψ s_p + z_p`` (`_period_starts`).  It returns
+    the states at the start of every cell (same layout; written into `out`
+    when given) and the state after the last period (`start` and the result
+    (n, R); default start 0).
 
     Examples
     --------
@@ -286,12 +366,12 @@ class PhaseMarch:
         for i in range(B):
             self.M[i + 1] = self.O[i, b] @ self.M[i]
 
-    def __call__(self, f, R, start=None):
+    def __call__(self, f, R, start=None, out=None):
         B, b, n, _ = self.Pb.shape
         O, M, Pb, Psi = self.O, self.M, self.Pb, self.M[-1]
         N, _, K = f.shape
         P = K // R
-        X = np.empty_like(f)
+        X = np.empty_like(f) if out is None else out
         per = max(1, _CHUNK_ENTRIES // max(1, 2 * N * n * R))
         s = np.zeros((n, R)) if start is None else start
         for p0 in range(0, P, per):
@@ -309,14 +389,44 @@ class PhaseMarch:
             Y[0] = 0.0
             for i in range(B):
                 Y[i + 1] = O[i, b] @ Y[i] + Z[i, b]
-            zend = Y[B].reshape(n, -1, R)
-            starts = np.empty((n, zend.shape[1], R))
-            for i in range(zend.shape[1]):
-                starts[:, i] = s
-                s = Psi @ s + zend[:, i]
+            starts, s = _period_starts(Psi, Y[B].reshape(n, -1, R), s)
             Sb = M[:B] @ starts.reshape(n, k) + Y[:B]                  # (B, n, k)
-            X[:, :, cols] = (O[:, :b] @ Sb[:, None] + Z[:, :b]).reshape(N, n, k)
+            Xc = X[:, :, cols].reshape(B, b, n, k)
+            np.matmul(O[:, :b], Sb[:, None], out=Xc)
+            Xc += Z[:, :b]
         return X, s
+
+
+def _period_starts(Psi, z, s):
+    """Starts ``s_p`` (n, P, R) of ``s_{p+1} = Ψ s_p + z_p`` (z (n, P, R)), and ``s_P``.
+
+    In blocks of q ≈ √P periods: the periods of every block from a zero
+    start at once (q steps), the block starts one after the other (P/q
+    steps), and ``s = Ψ^i s_block + local_i``.
+    """
+    n, P, R = z.shape
+    q = max(1, math.isqrt(P))
+    nb = -(-P // q)
+    zp = np.zeros((n, nb * q, R))
+    zp[:, :P] = z
+    zp = zp.reshape(n, nb, q, R)
+    local = np.empty((q + 1, n, nb, R))
+    local[0] = 0.0
+    powers = np.empty((q + 1, n, n))
+    powers[0] = np.eye(n)
+    for i in range(q):
+        local[i + 1] = np.tensordot(Psi, local[i], axes=1) + zp[:, :, i]
+        powers[i + 1] = Psi @ powers[i]
+    starts = np.empty((n, nb, R))
+    for c in range(nb):
+        starts[:, c] = s
+        s = powers[q] @ s + local[q, :, c]
+    # the state after period P (the padded periods would multiply by Ψ)
+    out = np.tensordot(powers[:q], starts, axes=([2], [0])) + local[:q]   # (q, n, nb, R)
+    out = out.transpose(1, 2, 0, 3).reshape(n, nb * q, R)
+    end = P - (nb - 1) * q                       # periods of the last block
+    last = powers[end] @ starts[:, -1] + local[end, :, -1]
+    return out[:, :P], last
 
 
 def _cell_of(edges, theta):

@@ -380,10 +380,15 @@ def _cell_layout(t, T, most):
         short = h < w
         if not np.any(short):
             return Ns, 0.0
-        # bin centres (i + 1/2) w / bins inside (s, s + h]: i0 <= i <= i1
-        s0 = np.mod(t[:-1][short], w) / w * bins
-        i0 = np.floor(s0 - 0.5).astype(np.int64) + 1
-        i1 = np.floor(s0 + h[short] / w * bins - 0.5).astype(np.int64)
+        # bin centres (i + 1/2) w / bins inside (s, s + h]: i0 <= i <= i1, from
+        # the steps' starts s in cells (their fractional parts, in bins)
+        s0 = t[:-1][short] / w
+        s0 -= np.floor(s0)
+        s0 *= bins
+        s0 -= 0.5
+        i0 = np.floor(s0).astype(np.int64) + 1
+        s0 += h[short] * (bins / w)
+        i1 = np.floor(s0).astype(np.int64)
         cover = np.bincount(i0, minlength=2 * bins + 2) \
             - np.bincount(i1 + 1, minlength=2 * bins + 2)
         cover = np.cumsum(cover)[:2 * bins]

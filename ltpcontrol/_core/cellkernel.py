@@ -1,0 +1,173 @@
+"""Compiled march over the cells of a phase table (optional: numba).
+
+`cellmarch.cell_march` marches the states of a record over the cells of a
+phase table with NumPy: every quantity of every cell is an array
+operation over the record.  For a few states each cell needs about a
+hundred multiplications, so the cost per sample is that of some eighty
+array passes, not of the arithmetic.  With numba installed (the ``fast``
+extra), long records of a few states take instead this scalar loop over
+the cells of the record, compiled once per environment (cached on disk):
+
+    for every cell c (phase j = c mod N) after the first sample's:
+        z = (x(e_c), a_c, σ_c),   a_c = u_k + σ_k (e_c - t_k)   (k the last sample before c)
+        if sample k lies in the cell (ξ = (t_k - e_c) / h_c):
+            x(t_k) = Σ_d T_d(2ξ - 1) F_{j,d} z
+            f      = Σ_d T_d(2ξ - 1) K_{j,d} kink_k
+        x(e_{c+1}) = Φ_j x(e_c) + [W_j Z_j] (a_c, σ_c) + f
+
+with the coefficients of `cell_march` (F those of the first part's
+[Φ W Z] in Chebyshev polynomials of ξ, K those of the kink's part).  The
+arithmetic is that of the NumPy march, in another order: the two agree to
+rounding.  Without numba, `march_cells` is this loop in Python, used by
+the tests on small records.
+
+The kernel is used when ``ltp.config.defaults['timeresp.compiled']`` is
+true (default), numba imports, the record has at least `MIN_SAMPLES`
+samples and the system at most `MAX_STATES` states (above that the
+NumPy march's matrix products are efficient).
+"""
+
+import numpy as np
+
+__all__ = []
+
+#: the compiled march is used for records of at least this many samples ...
+MIN_SAMPLES = 20_000
+#: ... of systems of at most this many states
+MAX_STATES = 8
+
+_COMPILED = None
+
+
+def compiled_kernel():
+    """The compiled `march_cells`, or None when numba cannot be imported.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.cellkernel import compiled_kernel
+    >>> kernel = compiled_kernel()
+    >>> kernel is None or callable(kernel)
+    True
+    """
+    global _COMPILED
+    if _COMPILED is None:
+        try:
+            import numba
+        except ImportError:
+            _COMPILED = False
+        else:
+            _COMPILED = numba.njit(cache=True, nogil=True)(march_cells)
+    return _COMPILED or None
+
+
+def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, sigma, kink, x1, x):
+    """States `x` (n, R, L) at the samples 1 .. L-1 from the cells' data (module notes).
+
+    Parameters
+    ----------
+    Phi : ndarray (N, n, n)
+        Whole cells' transitions.
+    WZ : ndarray (N, n, q)
+        Whole cells' W (and Z, first-order hold: q = 2m).
+    F : ndarray (N, D1, n, n + q)
+        Chebyshev coefficients of the first parts' [Φ W (Z)].
+    K : ndarray (N, D1, n, m)
+        Chebyshev coefficients of the kink's part.
+    edges : ndarray (N + 1,)
+    T, offset, base : float
+        Period, phase of the cells' origin, number of the period of t[0].
+    g : int64 ndarray (L,)
+        Cell of every sample (counted from the start of period `base`).
+    xi : ndarray (L,)
+        Fraction of its cell before every sample.
+    t : ndarray (L,)
+    u, sigma, kink : ndarray (m, R, L)
+        Inputs, slopes after the samples, kinks at the samples.
+    x1 : ndarray (n, R)
+        State at the start of the cell after the first sample's.
+    x : ndarray (n, R, L)
+        Output, written at samples 1 .. L-1.
+
+    Examples
+    --------
+    One state, ẋ = 0·x + u on two cells of one period (Φ = 1, W = h), a
+    constant input held: the state grows as t.
+
+    >>> from ltpcontrol._core.cellkernel import march_cells
+    >>> Phi, WZ = np.ones((2, 1, 1)), np.full((2, 1, 1), 0.5)
+    >>> F = np.zeros((2, 2, 1, 2)); F[:, 0, 0, 0] = 1.0        # Φ_f = 1
+    >>> F[:, 0, 0, 1], F[:, 1, 0, 1] = 0.25, 0.25             # W_f = ℓ = (1 + T_1) / 4
+    >>> K = np.zeros((2, 2, 1, 1))
+    >>> t = np.array([0.0, 0.8, 1.3]); g = np.array([0, 1, 2]); xi = np.array([0.0, 0.6, 0.6])
+    >>> u = np.ones((1, 1, 3)); zero = np.zeros((1, 1, 3))
+    >>> x = np.zeros((1, 1, 3))
+    >>> _ = march_cells(Phi, WZ, F, K, np.array([0.0, 0.5, 1.0]), 1.0, 0.0, 0.0, g, xi, t,
+    ...                 u, zero, zero, np.array([[0.5]]), x)
+    >>> x[0, 0]
+    array([0. , 0.8, 1.3])
+    """
+    N, n = Phi.shape[0], Phi.shape[1]
+    D1, nq = F.shape[1], F.shape[3]
+    q = nq - n
+    m, R, L = u.shape[0], u.shape[1], t.shape[0]
+    foh = q == 2 * m
+    # coefficients by (phase, row): F[j, i, d nq + e], K[j, i, d m + l]
+    Fr = np.ascontiguousarray(F.transpose(0, 2, 1, 3)).reshape(N, n, D1 * nq)
+    Kr = np.ascontiguousarray(K.transpose(0, 2, 1, 3)).reshape(N, n, D1 * m)
+    Td, z, xc, fk = np.empty(D1), np.empty(nq), np.empty(n), np.empty(n)
+    last_cell = g[L - 1]
+    for r in range(R):
+        for i in range(n):
+            xc[i] = x1[i, r]
+        k = 1
+        c = g[0] + 1
+        while c <= last_cell:
+            ph = c % N
+            # the held input at the cell's start, from the last sample k - 1
+            kp = k - 1
+            for i in range(n):
+                z[i] = xc[i]
+                fk[i] = 0.0
+            if foh:
+                tau = (base + c // N) * T + offset + edges[ph]
+                for l in range(m):
+                    s = sigma[l, r, kp]
+                    z[n + l] = u[l, r, kp] + s * (tau - t[kp])
+                    z[n + m + l] = s
+            else:
+                for l in range(m):
+                    z[n + l] = u[l, r, kp]
+            if k < L and g[k] == c:
+                # a sample in the cell: its state, and the kink's forcing
+                sx = 2.0 * xi[k] - 1.0
+                Td[0] = 1.0
+                if D1 > 1:
+                    Td[1] = sx
+                for d in range(2, D1):
+                    Td[d] = 2.0 * sx * Td[d - 1] - Td[d - 2]
+                for i in range(n):
+                    acc = 0.0
+                    for d in range(D1):
+                        sd = 0.0
+                        for e in range(nq):
+                            sd += Fr[ph, i, d * nq + e] * z[e]
+                        acc += Td[d] * sd
+                    x[i, r, k] = acc
+                for i in range(n):
+                    acc = 0.0
+                    for d in range(D1):
+                        sd = 0.0
+                        for l in range(m):
+                            sd += Kr[ph, i, d * m + l] * kink[l, r, k]
+                        acc += Td[d] * sd
+                    fk[i] = acc
+                k += 1
+            for i in range(n):
+                acc = fk[i]
+                for e in range(n):
+                    acc += Phi[ph, i, e] * z[e]
+                for l in range(q):
+                    acc += WZ[ph, i, l] * z[n + l]
+                xc[i] = acc
+            c += 1
+    return x

@@ -1,0 +1,115 @@
+"""The compiled march over the cells of a phase table equals the NumPy march.
+
+Tests of internals: they import private names (see the Developer notes).
+Without numba, the kernel's loop runs as Python (the same statements).
+"""
+
+import numpy as np
+import pytest
+
+import ltpcontrol as ltp
+import ltpcontrol._core.cellkernel as cellkernel
+import ltpcontrol._core.gridmarch as gridmarch
+
+
+def rel(a, b):
+    return float(np.abs(np.asarray(a) - np.asarray(b)).max() / np.abs(np.asarray(b)).max())
+
+
+def plant(n, m, seed):
+    """A stable random plant with a periodic A (one harmonic), period 1."""
+    rng = np.random.default_rng(seed)
+    c = 0.4 * rng.normal(size=(3, n, n)) + 0.4j * rng.normal(size=(3, n, n))
+    c[2] = c[0].conj()
+    c[1] = c[1].real - 1.5 * np.eye(n)
+    return ltp.ltpss(ltp.PeriodicMatrix(c, 1.0), rng.normal(size=(n, m)),
+                     rng.normal(size=(2, n)), rng.normal(size=(2, m)), period=1.0)
+
+
+def grid(seed):
+    """40 samples a period, jittered, then steps of about 2.5 samples (cells
+    without a sample)."""
+    rng = np.random.default_rng(seed)
+    dense = np.arange(600) / 40 + 0.013
+    dense[1:] += rng.uniform(-0.2, 0.2, 599) / 40
+    sparse = dense[-1] + np.cumsum(rng.uniform(2.3, 2.7, 200)) / 40
+    return np.concatenate([dense, sparse])
+
+
+class Spy:
+    """Counts the calls of a kernel."""
+
+    def __init__(self, kernel):
+        self.kernel, self.calls = kernel, 0
+
+    def __call__(self, *args):
+        self.calls += 1
+        return self.kernel(*args)
+
+
+@pytest.mark.parametrize("n, m, hold", [(2, 1, 'foh'), (2, 1, 'zoh'), (3, 2, 'foh')])
+@pytest.mark.parametrize("compiled", [False, True])
+def test_kernel_equals_the_numpy_march(monkeypatch, n, m, hold, compiled):
+    if compiled:
+        pytest.importorskip('numba')
+        kernel = cellkernel.compiled_kernel()
+    else:
+        kernel = cellkernel.march_cells
+    sys = plant(n, m, seed=n + m)
+    t = grid(n)
+    rng = np.random.default_rng(1)
+    U = rng.normal(size=(m, 2, len(t)))
+    X0 = rng.normal(size=(n, 2))
+    with ltp.config.defaults_context({'timeresp.compiled': False}):
+        ref = ltp.forced_response(sys, t, U, X0, input_hold=hold)
+    spy = Spy(kernel)
+    monkeypatch.setattr(cellkernel, 'MIN_SAMPLES', 0)
+    monkeypatch.setattr(cellkernel, 'compiled_kernel', lambda: spy)
+    resp = ltp.forced_response(sys, t, U, X0, input_hold=hold)
+    assert spy.calls == 1
+    assert rel(resp.states, ref.states) < 1e-13
+    assert rel(resp.outputs, ref.outputs) < 1e-13
+    # and the exact discretization, step by step
+    with monkeypatch.context() as mp:
+        for name in ('_table_steps', '_cell_table', '_repeat_length'):
+            mp.setattr(gridmarch, name, lambda *a: None)
+        direct = ltp.forced_response(sys, t, U, X0, input_hold=hold)
+    assert rel(resp.states, direct.states) < 1e-11
+
+
+def test_kernel_only_when_enabled_long_and_small(monkeypatch):
+    spy = Spy(cellkernel.march_cells)
+    monkeypatch.setattr(cellkernel, 'compiled_kernel', lambda: spy)
+    sys, t = plant(2, 1, seed=3), grid(2)
+    u = np.cos(3.0 * t)
+    monkeypatch.setattr(cellkernel, 'MIN_SAMPLES', len(t) + 1)      # too short
+    ltp.forced_response(sys, t, u)
+    monkeypatch.setattr(cellkernel, 'MIN_SAMPLES', 0)
+    with ltp.config.defaults_context({'timeresp.compiled': False}):  # disabled
+        ltp.forced_response(sys, t, u)
+    monkeypatch.setattr(cellkernel, 'MAX_STATES', 1)                # too many states
+    ltp.forced_response(sys, t, u)
+    assert spy.calls == 0
+    monkeypatch.setattr(cellkernel, 'MAX_STATES', 2)
+    ltp.forced_response(sys, t, u)
+    assert spy.calls == 1
+
+
+def test_without_numba_the_numpy_march_runs(monkeypatch):
+    import builtins
+    real_import = builtins.__import__
+
+    def no_numba(name, *args, **kwargs):
+        if name == 'numba':
+            raise ImportError('numba')
+        return real_import(name, *args, **kwargs)
+    monkeypatch.setattr(builtins, '__import__', no_numba)
+    monkeypatch.setattr(cellkernel, '_COMPILED', None)
+    monkeypatch.setattr(cellkernel, 'MIN_SAMPLES', 0)
+    assert cellkernel.compiled_kernel() is None
+    sys, t = plant(2, 1, seed=4), grid(3)
+    u = np.sin(2.0 * t)
+    resp = ltp.forced_response(sys, t, u)
+    with ltp.config.defaults_context({'timeresp.compiled': False}):
+        ref = ltp.forced_response(sys, t, u)
+    assert np.array_equal(resp.outputs, ref.outputs)
