@@ -54,14 +54,15 @@ import numpy as np
 from _common import row, timed
 
 import ltpcontrol as ltp
+import ltpcontrol._core.cellkernel as cellkernel
 import ltpcontrol._core.gridmarch as gridmarch
 from p6_limit import big_plant
 
 TOL = 1e-11
 FULL = dict(periods=100, samples=5000, window=600, pairs=9, long=(1000, 50000),
-            fine=12000, fine_long=24000, fine_mimo=8000)
+            fine=12000, fine_long=24000, fine_mimo=8000, fine_longer=192000)
 QUICK = dict(periods=10, samples=500, window=120, pairs=1, long=(40, 2000),
-             fine=1600, fine_long=2400, fine_mimo=1200)
+             fine=1600, fine_long=2400, fine_mimo=1200, fine_longer=3200)
 
 
 def _per_step(sys, t, u):
@@ -141,6 +142,11 @@ def run(quick=False, log=print, only=None):
     cases['P10i'] = ('Fourier', _jittered(fine_long, 400, 1.0, 6), 'aligned 400 long')
     cases['aligned 400 MIMO'] = ('20-state', np.arange(cfg['fine_mimo']) / 400, None)
     cases['P10j'] = ('20-state', _jittered(cfg['fine_mimo'], 400, 1.0, 7), 'aligned 400 MIMO')
+    longer = cfg['fine_longer']
+    cases['aligned 400 longer'] = ('Fourier', np.arange(longer) / 400, None)
+    cases['P10k'] = ('Fourier', _jittered(longer, 400, 1.0, 8), 'aligned 400 longer')
+    cases['P10l'] = ('Fourier', cases['P10k'][1], 'aligned 400 longer')
+    compiled = cellkernel.compiled_kernel() is not None and longer >= cellkernel.MIN_SAMPLES
 
     if only:
         keep = {n for n, c in cases.items() if n in only}
@@ -159,7 +165,13 @@ def run(quick=False, log=print, only=None):
     for name, (plant, t, _) in cases.items():
         sys = plants[plant]
         u = inputs(sys, t)
-        calls[name] = (lambda sys=sys, t=t, u=u: ltp.forced_response(sys, t, u))
+        # P10l: the NumPy march whether or not numba is installed
+        settings = {'timeresp.compiled': name != 'P10l'}
+
+        def call(sys=sys, t=t, u=u, settings=settings):
+            with ltp.config.defaults_context(settings):
+                return ltp.forced_response(sys, t, u)
+        calls[name] = call
         log(f"P10: {name}, {plant}, {len(t)} samples")
         resp = calls[name]()
         w = cfg['window']
@@ -191,7 +203,12 @@ def run(quick=False, log=print, only=None):
               'P10h': '400 steps/period, aligned but 5 samples dropped and 5 moved, '
                       'callable A',
               'P10i': f'400 steps/period, non-uniform, {fine_long // 400} periods',
-              'P10j': '400 steps/period, non-uniform, 20 states, 2 inputs, 2 outputs'}
+              'P10j': '400 steps/period, non-uniform, 20 states, 2 inputs, 2 outputs',
+              'P10k': f'400 steps/period, non-uniform, {longer // 400} periods, '
+                      + ('compiled march (numba)' if compiled else
+                         'NumPy march (numba not installed)'),
+              'P10l': f'400 steps/period, non-uniform, {longer // 400} periods, NumPy march '
+                      '(timeresp.compiled=False)'}
     rows = []
     for name, (plant, t, peer) in cases.items():
         if peer is None:
@@ -208,7 +225,7 @@ def run(quick=False, log=print, only=None):
             checks={'ours <= tol': errs[name] <= TOL, 'aligned <= tol': errs[peer] <= TOL},
             matched=ok, notes='error against the same discretization, step by step; '
                               'ratio: median over alternating pairs of runs',
-            extra=dict(window=cfg['window'])))
+            extra=dict(window=cfg['window'], compiled=compiled and name == 'P10k')))
     return rows
 
 

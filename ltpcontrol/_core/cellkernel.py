@@ -56,12 +56,20 @@ def compiled_kernel():
         except ImportError:
             _COMPILED = False
         else:
-            _COMPILED = numba.njit(cache=True, nogil=True)(march_cells)
+            # reassociated and fused sums (the loops over orders vectorise);
+            # no checks for division by zero (steps are positive)
+            _COMPILED = numba.njit(cache=True, nogil=True, error_model='numpy',
+                                   fastmath={'reassoc', 'contract'})(march_cells)
     return _COMPILED or None
 
 
-def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, sigma, kink, x1, x):
+def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, x1, x):
     """States `x` (n, R, L) at the samples 1 .. L-1 from the cells' data (module notes).
+
+    The input is held between samples: first order when ``WZ`` has 2m
+    columns (slopes ``σ_k = (u_{k+1} - u_k) / (t_{k+1} - t_k)``, zero after
+    the last sample; the kink at a sample is the change of slope), else
+    zero order (the kink is the jump ``u_k - u_{k-1}``).
 
     Parameters
     ----------
@@ -77,12 +85,12 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, sigma, kink,
     T, offset, base : float
         Period, phase of the cells' origin, number of the period of t[0].
     g : int64 ndarray (L,)
-        Cell of every sample (counted from the start of period `base`).
+        Cell of every sample (counted from the start of period `base`), one
+        sample a cell at most.
     xi : ndarray (L,)
         Fraction of its cell before every sample.
     t : ndarray (L,)
-    u, sigma, kink : ndarray (m, R, L)
-        Inputs, slopes after the samples, kinks at the samples.
+    u : ndarray (m, R, L)
     x1 : ndarray (n, R)
         State at the start of the cell after the first sample's.
     x : ndarray (n, R, L)
@@ -90,7 +98,7 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, sigma, kink,
 
     Examples
     --------
-    One state, ẋ = 0·x + u on two cells of one period (Φ = 1, W = h), a
+    One state, ẋ = u on two cells of one period (Φ = 1, W = h = 0.5), a
     constant input held: the state grows as t.
 
     >>> from ltpcontrol._core.cellkernel import march_cells
@@ -99,10 +107,9 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, sigma, kink,
     >>> F[:, 0, 0, 1], F[:, 1, 0, 1] = 0.25, 0.25             # W_f = ℓ = (1 + T_1) / 4
     >>> K = np.zeros((2, 2, 1, 1))
     >>> t = np.array([0.0, 0.8, 1.3]); g = np.array([0, 1, 2]); xi = np.array([0.0, 0.6, 0.6])
-    >>> u = np.ones((1, 1, 3)); zero = np.zeros((1, 1, 3))
     >>> x = np.zeros((1, 1, 3))
     >>> _ = march_cells(Phi, WZ, F, K, np.array([0.0, 0.5, 1.0]), 1.0, 0.0, 0.0, g, xi, t,
-    ...                 u, zero, zero, np.array([[0.5]]), x)
+    ...                 np.ones((1, 1, 3)), np.array([[0.5]]), x)
     >>> x[0, 0]
     array([0. , 0.8, 1.3])
     """
@@ -111,55 +118,74 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, sigma, kink,
     q = nq - n
     m, R, L = u.shape[0], u.shape[1], t.shape[0]
     foh = q == 2 * m
-    # coefficients by (phase, row): F[j, i, d nq + e], K[j, i, d m + l]
-    Fr = np.ascontiguousarray(F.transpose(0, 2, 1, 3)).reshape(N, n, D1 * nq)
-    Kr = np.ascontiguousarray(K.transpose(0, 2, 1, 3)).reshape(N, n, D1 * m)
-    Td, z, xc, fk = np.empty(D1), np.empty(nq), np.empty(n), np.empty(n)
+    # coefficients by phase and order, entries flat: F[j, d, i nq + e], K[j, d, i m + l]
+    Ff = F.reshape(N, D1, n * nq)
+    Kf = K.reshape(N, D1, n * m)
+    Td, z = np.empty(D1), np.empty(nq)
+    M, Mk = np.empty(n * nq), np.empty(n * m)
+    xc, fk = np.empty(n), np.empty(n)
+    slope, kink = np.zeros(m), np.empty(m)
     last_cell = g[L - 1]
     for r in range(R):
         for i in range(n):
             xc[i] = x1[i, r]
+        if foh:
+            for l in range(m):
+                slope[l] = (u[l, r, 1] - u[l, r, 0]) / (t[1] - t[0])
         k = 1
         c = g[0] + 1
+        ph, period = c % N, c // N                       # c = period N + ph
+        start = (base + period) * T + offset             # of the period
         while c <= last_cell:
-            ph = c % N
             # the held input at the cell's start, from the last sample k - 1
             kp = k - 1
             for i in range(n):
                 z[i] = xc[i]
                 fk[i] = 0.0
             if foh:
-                tau = (base + c // N) * T + offset + edges[ph]
+                tau = start + edges[ph]
                 for l in range(m):
-                    s = sigma[l, r, kp]
-                    z[n + l] = u[l, r, kp] + s * (tau - t[kp])
-                    z[n + m + l] = s
+                    z[n + l] = u[l, r, kp] + slope[l] * (tau - t[kp])
+                    z[n + m + l] = slope[l]
             else:
                 for l in range(m):
                     z[n + l] = u[l, r, kp]
             if k < L and g[k] == c:
-                # a sample in the cell: its state, and the kink's forcing
+                # a sample in the cell: the first part's [Φ W Z] and the kink's
+                # part at ξ (sums over the orders, entries in the inner loop),
+                # the state at the sample and the kink's forcing
+                for l in range(m):
+                    if foh:
+                        new = (u[l, r, k + 1] - u[l, r, k]) / (t[k + 1] - t[k]) \
+                            if k + 1 < L else 0.0
+                        kink[l] = new - slope[l]
+                        slope[l] = new
+                    else:
+                        kink[l] = u[l, r, k] - u[l, r, kp]
                 sx = 2.0 * xi[k] - 1.0
                 Td[0] = 1.0
                 if D1 > 1:
                     Td[1] = sx
                 for d in range(2, D1):
                     Td[d] = 2.0 * sx * Td[d - 1] - Td[d - 2]
+                for a in range(n * nq):
+                    M[a] = Ff[ph, 0, a]
+                for a in range(n * m):
+                    Mk[a] = Kf[ph, 0, a]
+                for d in range(1, D1):
+                    w = Td[d]
+                    for a in range(n * nq):
+                        M[a] += w * Ff[ph, d, a]
+                    for a in range(n * m):
+                        Mk[a] += w * Kf[ph, d, a]
                 for i in range(n):
                     acc = 0.0
-                    for d in range(D1):
-                        sd = 0.0
-                        for e in range(nq):
-                            sd += Fr[ph, i, d * nq + e] * z[e]
-                        acc += Td[d] * sd
+                    for e in range(nq):
+                        acc += M[i * nq + e] * z[e]
                     x[i, r, k] = acc
-                for i in range(n):
                     acc = 0.0
-                    for d in range(D1):
-                        sd = 0.0
-                        for l in range(m):
-                            sd += Kr[ph, i, d * m + l] * kink[l, r, k]
-                        acc += Td[d] * sd
+                    for l in range(m):
+                        acc += Mk[i * m + l] * kink[l]
                     fk[i] = acc
                 k += 1
             for i in range(n):
@@ -170,4 +196,8 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, sigma, kink,
                     acc += WZ[ph, i, l] * z[n + l]
                 xc[i] = acc
             c += 1
+            ph += 1
+            if ph == N:
+                ph, period = 0, period + 1
+                start = (base + period) * T + offset
     return x

@@ -95,28 +95,12 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     n, R = x0.shape
     m, L = u.shape[0], len(t)
     D1 = len(table.frac)
-    wraps, j, xi, base = _cells_of_samples(table, t)
-    g = wraps.astype(np.int64) * N + j
+    g, xi, base = _cells_of_samples(table, t)
     if np.any(np.diff(g) == 0):
         return None                     # two samples in one cell: not this table
-    # slopes of the held input on [t_k, t_{k+1}) (zero after the last sample);
-    # q rows of the held input in the cells' forcing: a (and σ, first-order hold)
-    sigma = np.zeros((m, R, L))
-    if hold == 'foh':
-        sigma[:, :, :-1] = np.diff(u, axis=2) / np.diff(t)
+    # the held input's q rows in the cells' forcing: a (and σ, first-order hold)
     q = 2 * m if hold == 'foh' else m
     g0, P = int(g[0]), int(g[-1]) // N + 1
-    # the last sample before every cell of the record (a sample at a cell's
-    # start is counted in the cell: its jump below makes up the difference);
-    # for the cell of sample k that is k - 1, so the kink there, the jump
-    # (zero-order hold) or the change of slope (first-order hold: the input is
-    # continuous), is a difference of consecutive samples
-    last = np.cumsum(np.bincount(g, minlength=P * N)) - 1
-    last[1:] = last[:-1]
-    last[0] = 0
-    np.maximum(last, 0, out=last)
-    kink = np.zeros((m, R, L))
-    kink[:, :, 1:] = np.diff(sigma if hold == 'foh' else u, axis=2)
     # the table's data: whole cells' [W Z]; Chebyshev coefficients in the
     # first part's ξ = ℓ / h_c of the kink's part [t_k, e_{c+1}] (W or Z of
     # the last parts, whose lengths' weights are those of the first part,
@@ -130,17 +114,34 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     kcoef = table.coefficients(kpart, reverse=True)
     # the first sample: its cell's last part carries x0 to the next cell,
     # entered as the forcing of cell g0 (all earlier cells force nothing)
-    Pb, Wb, Zb = table.last(j[:1], lens[j[:1]] * (1 - xi[:1]))
-    x1 = Pb[0] @ x0 + Wb[0] @ u[:, :, 0] + Zb[0] @ sigma[:, :, 0]
+    j0 = g[:1] % N
+    Pb, Wb, Zb = table.last(j0, lens[j0] * (1 - xi[:1]))
+    x1 = Pb[0] @ x0 + Wb[0] @ u[:, :, 0]
+    if hold == 'foh':
+        x1 += Zb[0] @ (u[:, :, 1] - u[:, :, 0]) / (t[1] - t[0])
     x = np.empty((n, R, L))
     x[:, :, 0] = x0
     kernel = _kernel(n, L)
     if kernel is not None:
         kernel(np.ascontiguousarray(table.fwd[0][:, -1]), np.ascontiguousarray(WZ),
                np.ascontiguousarray(first), np.ascontiguousarray(kcoef), edges, float(T),
-               table.offset, float(base), g, xi, t, np.ascontiguousarray(u), sigma, kink,
-               x1, x)
+               table.offset, float(base), g, xi, t, np.ascontiguousarray(u), x1, x)
         return (x if states else None), outputs(C, D, t, x, u)
+    # slopes of the held input on [t_k, t_{k+1}) (zero after the last sample)
+    sigma = np.zeros((m, R, L))
+    if hold == 'foh':
+        sigma[:, :, :-1] = np.diff(u, axis=2) / np.diff(t)
+    # the last sample before every cell of the record (a sample at a cell's
+    # start is counted in the cell: its jump below makes up the difference);
+    # for the cell of sample k that is k - 1, so the kink there, the jump
+    # (zero-order hold) or the change of slope (first-order hold: the input is
+    # continuous), is a difference of consecutive samples
+    last = np.cumsum(np.bincount(g, minlength=P * N)) - 1
+    last[1:] = last[:-1]
+    last[0] = 0
+    np.maximum(last, 0, out=last)
+    kink = np.zeros((m, R, L))
+    kink[:, :, 1:] = np.diff(sigma if hold == 'foh' else u, axis=2)
     E1 = n * (n + q) if n + q <= D1 else 0
     tab = np.concatenate([first.reshape(N, D1, -1)[:, :, :E1], kcoef.reshape(N, D1, n * m)],
                          axis=2)
@@ -239,8 +240,8 @@ def _kernel(n, L):
 
 
 def _cells_of_samples(table, t):
-    """Period (counted from the period of t[0], as floats), cell j and fraction ξ
-    of the cell before every sample, and the number of the period of t[0]."""
+    """Cell g of every sample (counted from the start of the period of t[0]),
+    the fraction ξ of the cell before it, and the number of that period."""
     edges, lens = table.edges, table.lens
     N, T = len(lens), edges[-1]
     shifted = t - table.offset
@@ -248,17 +249,18 @@ def _cells_of_samples(table, t):
     w = lens[0]
     if np.ptp(lens) <= 1e-13 * w and abs(N * w - T) <= 1e-13 * T:
         # equal cells: r cells from the start of that period, ξ = r - ⌊r⌋ (exact)
-        r = shifted / w - base * N
+        r = shifted
+        r /= w
+        r -= base * N
         cell = np.floor(r)
-        xi = r - cell
-        wraps = np.floor(cell / N)
-        j = (cell - wraps * N).astype(np.int64)
-        return wraps, j, xi, base
+        xi = r
+        xi -= cell
+        return cell.astype(np.int64), xi, base
     wraps = np.floor(shifted / T)
     theta = shifted - wraps * T
     j = _cell_of(edges, theta)
     xi = np.clip((theta - edges[j]) / lens[j], 0.0, 1.0)
-    return wraps - base, j, xi, base
+    return (wraps - base).astype(np.int64) * N + j, xi, base
 
 
 def _basis_by_phase(s, K, out=None):
@@ -287,26 +289,22 @@ def outputs(C, D, t, x, u):
     array([4., 2.])
     """
     (n, R, L), m, p = x.shape, u.shape[0], C.shape[0]
-    y = np.empty((p, R, L))
+    y = np.zeros((p, R, L))
     chunk = max(256, _CHUNK_ENTRIES // max(1, p * (n + m)))
     for s0 in range(0, L, chunk):
         i = slice(s0, s0 + chunk)
-        for M, v, first in ((C, x, True), (D, u, False)):
-            if M.is_constant and 0 < M.shape[1] <= _FEW_COLUMNS:
-                # a few columns: a sum of scaled rows (a product would read v
-                # column by column)
-                Mc = M(t[0])
-                out = Mc[:, :1, None] * v[0, :, i]
-                for c in range(1, M.shape[1]):
-                    out += Mc[:, c:c + 1, None] * v[c, :, i]
-            elif M.is_constant:
-                out = np.tensordot(M(t[0]), v[:, :, i], axes=1)
-            else:
-                out = _apply(M(t[i]), v[:, :, i])
-            if first:
-                y[:, :, i] = out
-            else:
-                y[:, :, i] += out
+        for M, v in ((C, x), (D, u)):
+            if not M.is_constant:
+                y[:, :, i] += _apply(M(t[i]), v[:, :, i])
+                continue
+            Mc = M(t[0])
+            if Mc.shape[1] > _FEW_COLUMNS:
+                y[:, :, i] += np.tensordot(Mc, v[:, :, i], axes=1)
+                continue
+            # a few columns: a sum of scaled rows (a product would read v
+            # column by column); zero columns skipped
+            for c in np.flatnonzero(np.any(Mc, axis=0)):
+                y[:, :, i] += Mc[:, c:c + 1, None] * v[c, :, i]
     return y
 
 

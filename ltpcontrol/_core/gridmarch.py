@@ -330,7 +330,7 @@ def _cell_table(A, B, h, T, rtol, t=None):
     bps = np.mod(np.concatenate([A.breakpoints, B.breakpoints]), T)
     Ns = -(-N0 // _PIECE_CELLS)
     offset = 0.0
-    layout = None if (t is None or bps.size) else _cell_layout(t, T, Ns)
+    layout = None if (t is None or bps.size) else _cell_layout(t, h, T, Ns)
     if layout is not None:
         Ns, offset = layout
     pieces = np.union1d(np.linspace(0, T, Ns + 1), bps)
@@ -360,40 +360,39 @@ def _cell_table(A, B, h, T, rtol, t=None):
     return CellTable(cells.edges, cells.lens, frac, fwd, bwd, offset)
 
 
-def _cell_layout(t, T, most):
+def _cell_layout(t, h, T, most):
     """``(pieces, offset)``: the fewest pieces of `_PIECE_CELLS` equal cells with one sample each.
 
     Cells of width w hold at most one sample each when every step shorter
     than w has a cell edge inside it: the offset of the edges (modulo w)
     must lie in the arc ``(t_k, t_{k+1}]`` of every such step.  The arcs are
-    intersected on 256 bins for piece counts from the mean step on; the
-    offset is the middle of the widest common run.  None when no count
-    below `most` works.
+    intersected on 256 bins for piece counts from the mean step on (a step
+    of at least w covers every bin: its arc is cut to w, and every bin must
+    be covered by all the steps); the offset is the middle of the widest
+    common run.  None when no count below `most` works.
     """
-    h = np.diff(t)
     bins = 256
+    hmin = float(h.min())
     first = max(1, math.ceil(T / (_PIECE_CELLS * float(np.mean(h)))))
     for Ns in sorted({min(most, int(first * 1.06 ** i)) for i in range(8)}):
         if Ns >= most:
             break
         w = T / (Ns * _PIECE_CELLS)
-        short = h < w
-        if not np.any(short):
+        if hmin >= w:
             return Ns, 0.0
         # bin centres (i + 1/2) w / bins inside (s, s + h]: i0 <= i <= i1, from
         # the steps' starts s in cells (their fractional parts, in bins)
-        s0 = t[:-1][short] / w
+        s0 = t[:-1] / w
         s0 -= np.floor(s0)
         s0 *= bins
         s0 -= 0.5
-        i0 = np.floor(s0).astype(np.int64) + 1
-        s0 += h[short] * (bins / w)
+        i0 = np.floor(s0).astype(np.int64)
+        s0 += np.minimum(h, w) * (bins / w)
         i1 = np.floor(s0).astype(np.int64)
-        cover = np.bincount(i0, minlength=2 * bins + 2) \
+        cover = np.bincount(i0 + 1, minlength=2 * bins + 2) \
             - np.bincount(i1 + 1, minlength=2 * bins + 2)
         cover = np.cumsum(cover)[:2 * bins]
-        count = cover[:bins] + cover[bins:]
-        ok = count == short.sum()
+        ok = cover[:bins] + cover[bins:] == len(h)
         if ok.sum() < 3:
             continue
         if ok.all():

@@ -168,7 +168,7 @@ def test_cell_layout_holds_one_sample_per_cell():
     jittered = np.arange(4000) / 400 + rng.uniform(-0.2, 0.2, 4000) / 400
     walk = np.cumsum(np.r_[0.0, rng.uniform(0.8, 1.2, 3000) / 50])
     for t, most in ((jittered, 84), (walk, 8)):
-        layout = gridmarch._cell_layout(t, 1.0, most)
+        layout = gridmarch._cell_layout(t, np.diff(t), 1.0, most)
         if layout is None:
             assert t is walk
             continue
