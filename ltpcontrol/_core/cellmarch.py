@@ -32,15 +32,17 @@ table's D + 1 lengths): as Chebyshev coefficients in ξ = ℓ / h_c, a
 sample's data are ``Σ_k T_k(2ξ - 1) data_k`` (the last part's, at
 ``1 - ξ``, take the signs ``(-1)^k``).
 
-Layout: the cells of the record are an N × P grid (phase × period), every
-signal stored as (phase, rows, periods × traces).  Every (cell, period)
-gets the Chebyshev polynomials of its sample (zero without one), so that
-the samples' data, the kinks' forcing and the states at the samples are
-batched products over the N phases, with all periods and traces at once;
-the samples are gathered from and into that grid by rows.  The march over
-the cells is blocked over the period (`PhaseMarch`).  No step's transition
-matrix is formed; the work is O(N P R n² + N n³) per march, and the
-record is taken in chunks of periods within a fixed budget.
+Layout: the cells of the record are an N × P grid (phase × period).  The
+cells' signals (the held input a, σ, the samples' T_k(2ξ - 1) and kinks;
+zero without a sample) are formed in time order and transposed once to
+(phase, rows, periods × traces); the products with the cells' data run by
+phase over all periods and traces, on blocks of phases that fit a cache;
+the states at the samples go back to time order with one transpose and a
+gather.  The march over the cells is blocked over the period
+(`PhaseMarch`).  No step's transition matrix is formed; the work is
+O(N P R n² + N n³) per march, and the record is taken in chunks of periods
+within a fixed budget.  Long records of a few states take instead the
+compiled loop of `cellkernel` when numba is installed.
 """
 
 import math
