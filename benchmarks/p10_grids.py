@@ -70,7 +70,7 @@ def _per_step(sys, t, u):
     names = ('_table_steps', '_cell_table', '_repeat_length')
     saved = {name: getattr(gridmarch, name) for name in names}
     for name in names:
-        setattr(gridmarch, name, lambda *a: None)
+        setattr(gridmarch, name, lambda *a, **k: None)
     try:
         return np.asarray(ltp.forced_response(sys, t, u).outputs)
     finally:

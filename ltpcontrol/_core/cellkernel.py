@@ -63,8 +63,8 @@ def compiled_kernel():
     return _COMPILED or None
 
 
-def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, x1, x):
-    """States `x` (n, R, L) at the samples 1 .. L-1 from the cells' data (module notes).
+def march_cells(Phi, WZ, F, K, edges, T, offset, base, w, g, xi, t, u, x1, x, Cc, Dc, y):
+    """States `x` and outputs `y` at the samples from the cells' data (module notes).
 
     The input is held between samples: first order when ``WZ`` has 2m
     columns (slopes ``σ_k = (u_{k+1} - u_k) / (t_{k+1} - t_k)``, zero after
@@ -84,9 +84,12 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, x1, x):
     edges : ndarray (N + 1,)
     T, offset, base : float
         Period, phase of the cells' origin, number of the period of t[0].
+    w : float
+        Width of equal cells: a sample's cell and fraction come from
+        ``r = (t - offset) / w - base N`` (cell ⌊r⌋, ξ = r - ⌊r⌋); 0: from
+        `g` and `xi`.
     g : int64 ndarray (L,)
-        Cell of every sample (counted from the start of period `base`), one
-        sample a cell at most.
+        Cell of every sample (counted from the start of period `base`).
     xi : ndarray (L,)
         Fraction of its cell before every sample.
     t : ndarray (L,)
@@ -94,7 +97,16 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, x1, x):
     x1 : ndarray (n, R)
         State at the start of the cell after the first sample's.
     x : ndarray (n, R, L)
-        Output, written at samples 1 .. L-1.
+        States, written at samples 1 .. L-1 (sample 0 holds x0).
+    Cc, Dc : ndarray (p, n), (p, m)
+        Constant output matrices, or Cc with no rows: `y` is not written.
+    y : ndarray (p, R, L)
+        Outputs ``Cc x + Dc u``.
+
+    Returns
+    -------
+    bool
+        False when two samples fall in one cell (`x` and `y` incomplete).
 
     Examples
     --------
@@ -106,17 +118,20 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, x1, x):
     >>> F = np.zeros((2, 2, 1, 2)); F[:, 0, 0, 0] = 1.0        # Φ_f = 1
     >>> F[:, 0, 0, 1], F[:, 1, 0, 1] = 0.25, 0.25             # W_f = ℓ = (1 + T_1) / 4
     >>> K = np.zeros((2, 2, 1, 1))
-    >>> t = np.array([0.0, 0.8, 1.3]); g = np.array([0, 1, 2]); xi = np.array([0.0, 0.6, 0.6])
-    >>> x = np.zeros((1, 1, 3))
-    >>> _ = march_cells(Phi, WZ, F, K, np.array([0.0, 0.5, 1.0]), 1.0, 0.0, 0.0, g, xi, t,
-    ...                 np.ones((1, 1, 3)), np.array([[0.5]]), x)
-    >>> x[0, 0]
-    array([0. , 0.8, 1.3])
+    >>> t = np.array([0.0, 0.8, 1.3])
+    >>> x, y = np.zeros((1, 1, 3)), np.zeros((1, 1, 3))
+    >>> march_cells(Phi, WZ, F, K, np.array([0.0, 0.5, 1.0]), 1.0, 0.0, 0.0, 0.5,
+    ...             np.array([0]), np.zeros(1), t, np.ones((1, 1, 3)), np.array([[0.5]]),
+    ...             x, np.array([[2.0]]), np.zeros((1, 1)), y)
+    True
+    >>> x[0, 0], y[0, 0]
+    (array([0. , 0.8, 1.3]), array([0. , 1.6, 2.6]))
     """
     N, n = Phi.shape[0], Phi.shape[1]
     D1, nq = F.shape[1], F.shape[3]
     q = nq - n
     m, R, L = u.shape[0], u.shape[1], t.shape[0]
+    p = Cc.shape[0]
     foh = q == 2 * m
     # coefficients by phase and order, entries flat: F[j, d, i nq + e], K[j, d, i m + l]
     Ff = F.reshape(N, D1, n * nq)
@@ -125,79 +140,114 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, g, xi, t, u, x1, x):
     M, Mk = np.empty(n * nq), np.empty(n * m)
     xc, fk = np.empty(n), np.empty(n)
     slope, kink = np.zeros(m), np.empty(m)
-    last_cell = g[L - 1]
+    shift = base * N
+    inv_w = 1.0 / w if w > 0.0 else 0.0
+    if w > 0.0:
+        r0 = (t[0] - offset) / w - shift
+        g0 = int(np.floor(r0))
+    else:
+        g0 = g[0]
     for r in range(R):
         for i in range(n):
             xc[i] = x1[i, r]
+        for o in range(p):
+            acc = 0.0
+            for i in range(n):
+                acc += Cc[o, i] * x[i, r, 0]
+            for l in range(m):
+                acc += Dc[o, l] * u[l, r, 0]
+            y[o, r, 0] = acc
         if foh:
             for l in range(m):
                 slope[l] = (u[l, r, 1] - u[l, r, 0]) / (t[1] - t[0])
-        k = 1
-        c = g[0] + 1
+        c = g0 + 1                                       # the cell after sample 0's
         ph, period = c % N, c // N                       # c = period N + ph
         start = (base + period) * T + offset             # of the period
-        while c <= last_cell:
-            # the held input at the cell's start, from the last sample k - 1
-            kp = k - 1
-            for i in range(n):
-                z[i] = xc[i]
-                fk[i] = 0.0
-            if foh:
-                tau = start + edges[ph]
-                for l in range(m):
-                    z[n + l] = u[l, r, kp] + slope[l] * (tau - t[kp])
-                    z[n + m + l] = slope[l]
+        for k in range(1, L):
+            # the sample's cell and fraction
+            if w > 0.0:
+                # (a product: a sample on an edge may land on either side,
+                # with ξ = 1 or 0, which are the same instant)
+                rk = (t[k] - offset) * inv_w - shift
+                gk = int(np.floor(rk))
+                xk = rk - gk
             else:
-                for l in range(m):
-                    z[n + l] = u[l, r, kp]
-            if k < L and g[k] == c:
-                # a sample in the cell: the first part's [Φ W Z] and the kink's
-                # part at ξ (sums over the orders, entries in the inner loop),
-                # the state at the sample and the kink's forcing
-                for l in range(m):
-                    if foh:
-                        new = (u[l, r, k + 1] - u[l, r, k]) / (t[k + 1] - t[k]) \
-                            if k + 1 < L else 0.0
-                        kink[l] = new - slope[l]
-                        slope[l] = new
-                    else:
-                        kink[l] = u[l, r, k] - u[l, r, kp]
-                sx = 2.0 * xi[k] - 1.0
-                Td[0] = 1.0
-                if D1 > 1:
-                    Td[1] = sx
-                for d in range(2, D1):
-                    Td[d] = 2.0 * sx * Td[d - 1] - Td[d - 2]
-                for a in range(n * nq):
-                    M[a] = Ff[ph, 0, a]
-                for a in range(n * m):
-                    Mk[a] = Kf[ph, 0, a]
-                for d in range(1, D1):
-                    w = Td[d]
-                    for a in range(n * nq):
-                        M[a] += w * Ff[ph, d, a]
-                    for a in range(n * m):
-                        Mk[a] += w * Kf[ph, d, a]
+                gk, xk = g[k], xi[k]
+            if gk < c:
+                return False                             # two samples in one cell
+            kp = k - 1
+            while True:
+                # the held input at the cell's start, from the last sample k - 1
                 for i in range(n):
-                    acc = 0.0
-                    for e in range(nq):
-                        acc += M[i * nq + e] * z[e]
-                    x[i, r, k] = acc
-                    acc = 0.0
+                    z[i] = xc[i]
+                    fk[i] = 0.0
+                if foh:
+                    tau = start + edges[ph]
                     for l in range(m):
-                        acc += Mk[i * m + l] * kink[l]
-                    fk[i] = acc
-                k += 1
-            for i in range(n):
-                acc = fk[i]
-                for e in range(n):
-                    acc += Phi[ph, i, e] * z[e]
-                for l in range(q):
-                    acc += WZ[ph, i, l] * z[n + l]
-                xc[i] = acc
-            c += 1
-            ph += 1
-            if ph == N:
-                ph, period = 0, period + 1
-                start = (base + period) * T + offset
-    return x
+                        z[n + l] = u[l, r, kp] + slope[l] * (tau - t[kp])
+                        z[n + m + l] = slope[l]
+                else:
+                    for l in range(m):
+                        z[n + l] = u[l, r, kp]
+                if c == gk:
+                    # the sample's cell: the first part's [Φ W Z] and the kink's
+                    # part at ξ (sums over the orders, entries in the inner
+                    # loop), the state and output at the sample, the kink's
+                    # forcing
+                    for l in range(m):
+                        if foh:
+                            new = (u[l, r, k + 1] - u[l, r, k]) / (t[k + 1] - t[k]) \
+                                if k + 1 < L else 0.0
+                            kink[l] = new - slope[l]
+                            slope[l] = new
+                        else:
+                            kink[l] = u[l, r, k] - u[l, r, kp]
+                    sx = 2.0 * xk - 1.0
+                    Td[0] = 1.0
+                    if D1 > 1:
+                        Td[1] = sx
+                    for d in range(2, D1):
+                        Td[d] = 2.0 * sx * Td[d - 1] - Td[d - 2]
+                    for a in range(n * nq):
+                        M[a] = Ff[ph, 0, a]
+                    for a in range(n * m):
+                        Mk[a] = Kf[ph, 0, a]
+                    for d in range(1, D1):
+                        wd = Td[d]
+                        for a in range(n * nq):
+                            M[a] += wd * Ff[ph, d, a]
+                        for a in range(n * m):
+                            Mk[a] += wd * Kf[ph, d, a]
+                    for i in range(n):
+                        acc = 0.0
+                        for e in range(nq):
+                            acc += M[i * nq + e] * z[e]
+                        x[i, r, k] = acc
+                        acc = 0.0
+                        for l in range(m):
+                            acc += Mk[i * m + l] * kink[l]
+                        fk[i] = acc
+                    for o in range(p):
+                        acc = 0.0
+                        for i in range(n):
+                            acc += Cc[o, i] * x[i, r, k]
+                        for l in range(m):
+                            acc += Dc[o, l] * u[l, r, k]
+                        y[o, r, k] = acc
+                if k + 1 < L or c < gk:
+                    # x(e_{c+1}) (not needed after the last sample)
+                    for i in range(n):
+                        acc = fk[i]
+                        for e in range(n):
+                            acc += Phi[ph, i, e] * z[e]
+                        for l in range(q):
+                            acc += WZ[ph, i, l] * z[n + l]
+                        xc[i] = acc
+                c += 1
+                ph += 1
+                if ph == N:
+                    ph, period = 0, period + 1
+                    start = (base + period) * T + offset
+                if c > gk:
+                    break
+    return True

@@ -97,12 +97,17 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     n, R = x0.shape
     m, L = u.shape[0], len(t)
     D1 = len(table.frac)
-    g, xi, base = _cells_of_samples(table, t)
-    if np.any(np.diff(g) == 0):
-        return None                     # two samples in one cell: not this table
+    kernel = _kernel(n, L)
+    w = _equal_width(table)
+    if kernel is not None and w:
+        # the compiled march locates the samples itself: the first one here
+        g, xi, base = _cells_of_samples(table, t[:1])
+    else:
+        g, xi, base = _cells_of_samples(table, t)
+        if np.any(np.diff(g) == 0):
+            return None                 # two samples in one cell: not this table
     # the held input's q rows in the cells' forcing: a (and σ, first-order hold)
     q = 2 * m if hold == 'foh' else m
-    g0, P = int(g[0]), int(g[-1]) // N + 1
     # the table's data: whole cells' [W Z]; Chebyshev coefficients in the
     # first part's ξ = ℓ / h_c of the kink's part [t_k, e_{c+1}] (W or Z of
     # the last parts, whose lengths' weights are those of the first part,
@@ -123,12 +128,20 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
         x1 += Zb[0] @ (u[:, :, 1] - u[:, :, 0]) / (t[1] - t[0])
     x = np.empty((n, R, L))
     x[:, :, 0] = x0
-    kernel = _kernel(n, L)
     if kernel is not None:
-        kernel(np.ascontiguousarray(table.fwd[0][:, -1]), np.ascontiguousarray(WZ),
-               np.ascontiguousarray(first), np.ascontiguousarray(kcoef), edges, float(T),
-               table.offset, float(base), g, xi, t, np.ascontiguousarray(u), x1, x)
-        return (x if states else None), outputs(C, D, t, x, u)
+        # constant output matrices: the outputs too
+        p = C.shape[0]
+        const = C.is_constant and D.is_constant
+        Cc, Dc = (C(t[0]), D(t[0])) if const else (np.zeros((0, n)), np.zeros((0, m)))
+        y = np.empty((p, R, L)) if const else np.empty((0, R, L))
+        if not kernel(np.ascontiguousarray(table.fwd[0][:, -1]), np.ascontiguousarray(WZ),
+                      np.ascontiguousarray(first), np.ascontiguousarray(kcoef), edges,
+                      float(T), table.offset, float(base), w, g, xi, t,
+                      np.ascontiguousarray(u), x1, x, np.ascontiguousarray(Cc, float),
+                      np.ascontiguousarray(Dc, float), y):
+            return None                 # two samples in one cell: not this table
+        return (x if states else None), (y if const else outputs(C, D, t, x, u))
+    g0, P = int(g[0]), int(g[-1]) // N + 1
     # slopes of the held input on [t_k, t_{k+1}) (zero after the last sample)
     sigma = np.zeros((m, R, L))
     if hold == 'foh':
@@ -241,6 +254,14 @@ def _kernel(n, L):
     return cellkernel.compiled_kernel()
 
 
+def _equal_width(table):
+    """The cells' width when they are equal (to rounding), else 0."""
+    lens, T = table.lens, table.edges[-1]
+    w = float(lens[0])
+    equal = np.ptp(lens) <= 1e-13 * w and abs(len(lens) * w - T) <= 1e-13 * T
+    return w if equal else 0.0
+
+
 def _cells_of_samples(table, t):
     """Cell g of every sample (counted from the start of the period of t[0]),
     the fraction ξ of the cell before it, and the number of that period."""
@@ -248,8 +269,8 @@ def _cells_of_samples(table, t):
     N, T = len(lens), edges[-1]
     shifted = t - table.offset
     base = np.floor(shifted[0] / T)
-    w = lens[0]
-    if np.ptp(lens) <= 1e-13 * w and abs(N * w - T) <= 1e-13 * T:
+    w = _equal_width(table)
+    if w:
         # equal cells: r cells from the start of that period, ξ = r - ⌊r⌋ (exact)
         r = shifted
         r /= w

@@ -72,6 +72,7 @@ _PIECE_CELLS = 8             # cells per piece on which A and B are interpolated
 _SAMPLES = (12, 20, 32)      # Chebyshev samples of A and B per piece, tried in turn
 # (degree D of the partial-cell interpolants, Magnus steps per sub-interval), by cost
 _LADDER = ((4, 1), (5, 1), (6, 1), (8, 1), (8, 2), (10, 2), (12, 4))
+_LAYOUT_STEPS = 16384        # steps of a long record from which cells are laid out first
 _PHASE_MAX = 1024            # most phases of the interpolated step data of a uniform grid
 
 
@@ -125,11 +126,15 @@ def _grid_march(A, B, C, D, t, u, x0, hold, rtol, states):
             if repeat is None:
                 # a grid whose phases never repeat: march over the cells of a
                 # phase table
-                cells = _cell_table(A, B, h, T, rtol, t)
-                marched = None if cells is None else cell_march(cells, C, D, t, u, x0,
-                                                                hold, states)
-                if marched is not None:
-                    return marched
+                # phase table, laid out from every k-th step of a long record
+                # first (again from all steps when two samples share a cell)
+                stride = -(-len(h) // _LAYOUT_STEPS)
+                for k in ((stride, 1) if stride > 1 else (1,)):
+                    cells = _cell_table(A, B, h, T, rtol, t, stride=k)
+                    marched = None if cells is None else cell_march(cells, C, D, t, u, x0,
+                                                                    hold, states)
+                    if marched is not None:
+                        return marched
                 if np.allclose(h, h[0], rtol=1e-10, atol=0):
                     # a uniform grid: the step data are smooth periodic functions
                     # of the phase
@@ -313,12 +318,13 @@ class _PhaseInterpolant:
         return X[:, :, :n], X[:, :, n:n + m], X[:, :, n + m:]
 
 
-def _cell_table(A, B, h, T, rtol, t=None):
+def _cell_table(A, B, h, T, rtol, t=None, stride=1):
     """The phase table of the steps `h` (module notes), or None when not exact enough.
 
     With the samples `t` of a plant without switching, the cells are the
     fewest (offset at will) that hold at most one sample each
-    (`_cell_layout`); otherwise they are shorter than the shortest step.
+    (`_cell_layout`, from every `stride`-th step); otherwise they are
+    shorter than the shortest step.
     """
     hmin = float(h.min())
     tol = max(_TABLE_TOL, 0.1 * rtol)
@@ -330,7 +336,8 @@ def _cell_table(A, B, h, T, rtol, t=None):
     bps = np.mod(np.concatenate([A.breakpoints, B.breakpoints]), T)
     Ns = -(-N0 // _PIECE_CELLS)
     offset = 0.0
-    layout = None if (t is None or bps.size) else _cell_layout(t, h, T, Ns)
+    layout = None if (t is None or bps.size) else \
+        _cell_layout(t[:-1:stride], h[::stride], T, Ns, (t[-1] - t[0]) / len(h))
     if layout is not None:
         Ns, offset = layout
     pieces = np.union1d(np.linspace(0, T, Ns + 1), bps)
@@ -360,20 +367,22 @@ def _cell_table(A, B, h, T, rtol, t=None):
     return CellTable(cells.edges, cells.lens, frac, fwd, bwd, offset)
 
 
-def _cell_layout(t, h, T, most):
+def _cell_layout(starts, h, T, most, mean=None):
     """``(pieces, offset)``: the fewest pieces of `_PIECE_CELLS` equal cells with one sample each.
 
     Cells of width w hold at most one sample each when every step shorter
     than w has a cell edge inside it: the offset of the edges (modulo w)
-    must lie in the arc ``(t_k, t_{k+1}]`` of every such step.  The arcs are
-    intersected on 256 bins for piece counts from the mean step on (a step
+    must lie in the arc ``(t_k, t_{k+1}]`` of every such step (`starts`
+    t_k, steps `h`).  The arcs are
+    intersected on 256 bins for piece counts from the `mean` step on (a step
     of at least w covers every bin: its arc is cut to w, and every bin must
     be covered by all the steps); the offset is the middle of the widest
     common run.  None when no count below `most` works.
     """
     bins = 256
     hmin = float(h.min())
-    first = max(1, math.ceil(T / (_PIECE_CELLS * float(np.mean(h)))))
+    mean = float(np.mean(h)) if mean is None else mean
+    first = max(1, math.ceil(T / (_PIECE_CELLS * mean) - 1e-9))
     for Ns in sorted({min(most, int(first * 1.06 ** i)) for i in range(8)}):
         if Ns >= most:
             break
@@ -382,7 +391,7 @@ def _cell_layout(t, h, T, most):
             return Ns, 0.0
         # bin centres (i + 1/2) w / bins inside (s, s + h]: i0 <= i <= i1, from
         # the steps' starts s in cells (their fractional parts, in bins)
-        s0 = t[:-1] / w
+        s0 = starts / w
         s0 -= np.floor(s0)
         s0 *= bins
         s0 -= 0.5

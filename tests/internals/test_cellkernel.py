@@ -47,15 +47,39 @@ class Spy:
         return self.kernel(*args)
 
 
-@pytest.mark.parametrize("n, m, hold", [(2, 1, 'foh'), (2, 1, 'zoh'), (3, 2, 'foh')])
+def periodic_output(n, m, seed):
+    """The plant of `plant` with a periodic C."""
+    sys = plant(n, m, seed)
+    c = np.zeros((3, 2, n), complex)
+    c[1] = sys.C(0.0)
+    c[0] = c[2] = 0.3
+    return ltp.ltpss(sys.A, sys.B, ltp.PeriodicMatrix(c, 1.0), sys.D, period=1.0)
+
+
+def switching(n, m, seed):
+    """A plant whose A switches at 0.3 and 0.8 of the period (cells split there)."""
+    rng = np.random.default_rng(seed)
+    A1, A2 = (ltp.PeriodicMatrix.constant(0.5 * rng.normal(size=(n, n)) - 1.5 * np.eye(n), 1.0)
+              for _ in range(2))
+    A = ltp.PeriodicMatrix.switching([A1, A2, A1], [0.0, 0.3, 0.8], 1.0)
+    return ltp.ltpss(A, rng.normal(size=(n, m)), rng.normal(size=(1, n)), 0, period=1.0)
+
+
+CASES = [(plant, 2, 1, 'foh'), (plant, 2, 1, 'zoh'), (plant, 3, 2, 'foh'),
+         (periodic_output, 2, 1, 'foh'), (switching, 2, 1, 'foh'), (switching, 3, 1, 'zoh')]
+
+
+@pytest.mark.parametrize("make, n, m, hold", CASES)
 @pytest.mark.parametrize("compiled", [False, True])
-def test_kernel_equals_the_numpy_march(monkeypatch, n, m, hold, compiled):
+def test_kernel_equals_the_numpy_march(monkeypatch, make, n, m, hold, compiled):
+    # equal cells located in the loop, or cells split at switching instants
+    # located before; constant outputs in the loop, or periodic ones after
     if compiled:
         pytest.importorskip('numba')
         kernel = cellkernel.compiled_kernel()
     else:
         kernel = cellkernel.march_cells
-    sys = plant(n, m, seed=n + m)
+    sys = make(n, m, seed=n + m)
     t = grid(n)
     rng = np.random.default_rng(1)
     U = rng.normal(size=(m, 2, len(t)))
@@ -72,9 +96,28 @@ def test_kernel_equals_the_numpy_march(monkeypatch, n, m, hold, compiled):
     # and the exact discretization, step by step
     with monkeypatch.context() as mp:
         for name in ('_table_steps', '_cell_table', '_repeat_length'):
-            mp.setattr(gridmarch, name, lambda *a: None)
+            mp.setattr(gridmarch, name, lambda *a, **k: None)
         direct = ltp.forced_response(sys, t, U, X0, input_hold=hold)
     assert rel(resp.states, direct.states) < 1e-11
+    assert rel(resp.outputs, direct.outputs) < 1e-11
+
+
+def test_two_samples_in_one_cell_are_refused(monkeypatch):
+    # the loop locates equal cells itself and reports a shared cell; the
+    # layout is then made from every step
+    monkeypatch.setattr(gridmarch, '_LAYOUT_STEPS', 100)
+    monkeypatch.setattr(cellkernel, 'MIN_SAMPLES', 0)
+    spy = Spy(cellkernel.march_cells)
+    monkeypatch.setattr(cellkernel, 'compiled_kernel', lambda: spy)
+    sys = plant(2, 1, seed=6)
+    t = grid(2)
+    t[7] = t[6] + 0.2 / 40                            # not in the subsample
+    u = np.cos(2.0 * t)
+    resp = ltp.forced_response(sys, t, u)
+    assert spy.calls == 2
+    with ltp.config.defaults_context({'timeresp.compiled': False}):
+        ref = ltp.forced_response(sys, t, u)
+    assert rel(resp.outputs, ref.outputs) < 1e-13
 
 
 def test_kernel_only_when_enabled_long_and_small(monkeypatch):

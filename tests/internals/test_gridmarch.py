@@ -19,9 +19,9 @@ def rel(a, b):
 def direct(monkeypatch, sys, t, u, **kw):
     """The same exact discretization with every step integrated on its own."""
     with monkeypatch.context() as mp:
-        mp.setattr(gridmarch, '_table_steps', lambda *a: None)
-        mp.setattr(gridmarch, '_cell_table', lambda *a: None)
-        mp.setattr(gridmarch, '_repeat_length', lambda *a: None)
+        mp.setattr(gridmarch, '_table_steps', lambda *a, **k: None)
+        mp.setattr(gridmarch, '_cell_table', lambda *a, **k: None)
+        mp.setattr(gridmarch, '_repeat_length', lambda *a, **k: None)
         return ltp.forced_response(sys, t, u, **kw)
 
 
@@ -168,7 +168,7 @@ def test_cell_layout_holds_one_sample_per_cell():
     jittered = np.arange(4000) / 400 + rng.uniform(-0.2, 0.2, 4000) / 400
     walk = np.cumsum(np.r_[0.0, rng.uniform(0.8, 1.2, 3000) / 50])
     for t, most in ((jittered, 84), (walk, 8)):
-        layout = gridmarch._cell_layout(t, np.diff(t), 1.0, most)
+        layout = gridmarch._cell_layout(t[:-1], np.diff(t), 1.0, most)
         if layout is None:
             assert t is walk
             continue
@@ -203,3 +203,28 @@ def test_cell_march_in_chunks_equals_the_per_step_march(monkeypatch, n, m, hold)
     ref = direct(monkeypatch, sys, t, U, X0=X0, input_hold=hold)
     assert rel(whole.states, ref.states) < 1e-11
     assert rel(whole.outputs, ref.outputs) < 1e-11
+
+
+def test_cells_laid_out_from_a_subsample_then_from_every_step(monkeypatch):
+    # a long record's cells are laid out from every k-th step first; a short
+    # step outside that subsample puts two samples in one cell, and the
+    # layout is made again from every step
+    sys = damped_mathieu()
+    T = sys.period
+    rng = np.random.default_rng(5)
+    t = T / 40 * (np.arange(1200) + rng.uniform(-0.05, 0.05, 1200))
+    t[7] = t[6] + 0.3 * T / 40                  # not a multiple of the stride
+    u = np.cos(1.3 * t)
+    monkeypatch.setattr(gridmarch, '_LAYOUT_STEPS', 100)
+    strides = []
+    table = gridmarch._cell_table
+
+    def spy(*args, stride=1, **kwargs):
+        strides.append(stride)
+        return table(*args, stride=stride, **kwargs)
+    monkeypatch.setattr(gridmarch, '_cell_table', spy)
+    resp = ltp.forced_response(sys, t, u)
+    assert strides == [12, 1]
+    monkeypatch.setattr(gridmarch, '_cell_table', table)
+    ref = direct(monkeypatch, sys, t, u)
+    assert rel(resp.states, ref.states) < 1e-12
