@@ -34,7 +34,7 @@ __all__ = []
 #: the compiled march is used for records of at least this many samples ...
 MIN_SAMPLES = 20_000
 #: ... of systems of at most this many states
-MAX_STATES = 8
+MAX_STATES = 12
 
 _COMPILED = None
 
