@@ -27,7 +27,7 @@ from control.exception import ControlArgument, ControlDimension
 from .ltpsys import LTPStateSpace
 from .periodic_matrix import PeriodicMatrix
 from .coerce import as_ltp
-from .validation import check_positive, commensurate, real_array
+from .validation import commensurate, real_array
 
 __all__ = ['clarke_matrix', 'park_matrix', 'frame_transform', 'park', 'clarke',
            'sequence_components']

@@ -32,7 +32,7 @@ from control.exception import ControlArgument
 from .coerce import as_ltp
 from .validation import check_positive_int
 from .tvsystem import DiscreteLTPSystem
-from .lifting_forms import lift_form, tv_time_lift  # noqa: F401  (re-exported)
+from .lifting_forms import lift_form
 
 __all__ = ['lift']
 

@@ -38,7 +38,7 @@ reduces it).
 import numpy as np
 import scipy.sparse as sps
 import control as ct
-from control.exception import ControlArgument, ControlDimension
+from control.exception import ControlArgument
 
 from .tvsystem import DiscreteLTPSystem, dltpss
 from .validation import check_positive, check_positive_int, real_array

@@ -200,7 +200,6 @@ class _BlockOperators:
 def _block_operators(Phi, E, F, C, D, b, states=True):
     """Operators of all N/b block phases at once (loops over k only)."""
     N, n, m = E.shape
-    p = C.shape[1]
     nb = N // b
     Phi, E, C, D = (a.reshape((nb, b) + a.shape[1:]) for a in (Phi, E, C, D))
     F = None if F is None else F.reshape((nb, b) + F.shape[1:])

@@ -23,7 +23,6 @@ At the sampling instants of output j, ``y_j[k]`` is the plant output at
 LTI equivalent is ``lift(model, method='time')``.
 """
 
-import math
 import numbers
 
 import numpy as np

@@ -17,7 +17,6 @@ system argument, which needs the system class, is checked by
 import numbers
 from fractions import Fraction
 
-import control as ct
 import numpy as np
 from control.exception import ControlArgument, ControlDimension
 
