@@ -29,7 +29,12 @@ callable of scalar time (the two forms a user writes):
 * **P10i** a long non-uniform record, 60 periods (24000 samples), against
   the aligned grid with as many samples;
 * **P10j** a 20-state, 2-input, 2-output plant (``big_plant``), non-uniform
-  400 steps per period, 8000 samples.
+  400 steps per period, 8000 samples;
+* **P10k/P10l** a long non-uniform record, 480 periods (192 000 samples),
+  against the aligned grid with as many samples: P10k with the default
+  settings (the compiled cell march when numba is installed: the ``fast``
+  extra; the row's label says which ran), P10l with the NumPy march
+  (``timeresp.compiled=False``).
 
 The input is a sum of two cosines, one trace.  Accuracy: every grid's
 outputs against the same exact discretization computed step by step
@@ -44,9 +49,10 @@ of load on a shared machine hits both sides of a pair alike.
 Where the time goes on the non-uniform rows: the cell table of a jittered
 grid (400 cells of a period, one sample each, Chebyshev-Lobatto lengths of
 degree 6) costs about as much as the aligned grid's 400 step integrations;
-the march then costs about 0.3-0.5 µs per sample for the 2-state plant
-against about 0.1 µs on the aligned grid, so the ratio grows slowly with
-the record (P10i); for 20 states the table is about two thirds of the call.
+the march then costs per sample about 0.1 µs compiled and 0.25-0.3 µs
+with NumPy, against about 0.06 µs on the aligned grid, so without numba
+the ratio grows with the record (P10i, P10l); for 20 states the table is
+about two thirds of the call.
 """
 
 import numpy as np
