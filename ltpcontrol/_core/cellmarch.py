@@ -201,10 +201,11 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
         kgrid[:, :, cs] = kink[:, :, ks]
         kgrid = np.ascontiguousarray(kgrid.reshape(m, R, Pc, N).transpose(0, 3, 2, 1))
         f = np.empty((N, n, Pc, R))
-        Tb = np.empty((N, D1, Pc))
+        Tk = np.empty((D1, N, Pc))                     # by order: contiguous rows
+        Tb = Tk.transpose(1, 0, 2)                      # (N, D1, Pc) for the products
         for ph in blocks:
             # forcing f_c = [W Z] (a, σ) + Σ_d T_d(ξ) K_d kink
-            _basis_by_phase(sgrid[ph], D1, out=Tb[ph])
+            _chebyshev_rows(sgrid[ph], D1, out=Tk[:, ph])
             if not m:
                 f[ph] = 0.0
                 continue
@@ -236,9 +237,9 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
             else:
                 V = np.matmul(first[ph], z[ph].reshape(-1, n + q, Pc * R))
                 V = V.reshape(-1, D1, n, Pc, R)
-                np.multiply(Tb[ph, 0, None, :, None], V[:, 0], out=xp[ph])
+                np.multiply(Tk[0, ph, None, :, None], V[:, 0], out=xp[ph])
                 for d in range(1, D1):
-                    xp[ph] += Tb[ph, d, None, :, None] * V[:, d]
+                    xp[ph] += Tk[d, ph, None, :, None] * V[:, d]
         xt = np.ascontiguousarray(xp.transpose(1, 3, 2, 0)).reshape(n, R, Pc * N)
         for i in range(n):
             for r in range(R):
@@ -286,17 +287,15 @@ def _cells_of_samples(table, t):
     return (wraps - base).astype(np.int64) * N + j, xi, base
 
 
-def _basis_by_phase(s, K, out=None):
-    """``T_k(s)`` for k < K of an array s (N, P), shape (N, K, P)."""
-    if out is None:
-        out = np.empty((s.shape[0], K, s.shape[1]))
-    out[:, 0] = 1.0
+def _chebyshev_rows(s, K, out):
+    """``out[k] = T_k(s)`` for k < K (s of any shape; out (K,) + s.shape)."""
+    out[0] = 1.0
     if K > 1:
-        out[:, 1] = s
+        out[1] = s
     two_s = 2 * s
     for k in range(2, K):
-        np.multiply(two_s, out[:, k - 1], out=out[:, k])
-        out[:, k] -= out[:, k - 2]
+        np.multiply(two_s, out[k - 1], out=out[k])
+        out[k] -= out[k - 2]
     return out
 
 
