@@ -27,6 +27,8 @@ samples and the system at most `MAX_STATES` states (above that the
 NumPy march's matrix products are efficient).
 """
 
+import warnings
+
 import numpy as np
 
 __all__ = []
@@ -58,9 +60,23 @@ def compiled_kernel():
         else:
             # reassociated and fused sums (the loops over orders vectorise);
             # no checks for division by zero (steps are positive)
-            _COMPILED = numba.njit(cache=True, nogil=True, error_model='numpy',
-                                   fastmath={'reassoc', 'contract'})(march_cells)
+            _COMPILED = _guarded(numba.njit(cache=True, nogil=True, error_model='numpy',
+                                            fastmath={'reassoc', 'contract'})(march_cells))
     return _COMPILED or None
+
+
+def _guarded(kernel):
+    """`kernel`, returning None (and disabled, with a warning) if numba fails to compile it."""
+    def call(*args):
+        global _COMPILED
+        try:
+            return kernel(*args)
+        except Exception as exc:            # numba could not compile the loop here
+            _COMPILED = False
+            warnings.warn(f"the compiled cell march is unavailable ({type(exc).__name__}: "
+                          f"{exc}); simulating with NumPy", UserWarning, stacklevel=2)
+            return None
+    return call
 
 
 def march_cells(Phi, WZ, F, K, edges, T, offset, base, w, g, xi, t, u, x1, x, Cc, Dc, y):

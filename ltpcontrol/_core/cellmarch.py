@@ -106,6 +106,7 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
         g, xi, base = _cells_of_samples(table, t)
         if np.any(np.diff(g) == 0):
             return None                 # two samples in one cell: not this table
+        w = 0.0
     # the held input's q rows in the cells' forcing: a (and σ, first-order hold)
     q = 2 * m if hold == 'foh' else m
     # the table's data: whole cells' [W Z]; Chebyshev coefficients in the
@@ -134,13 +135,20 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
         const = C.is_constant and D.is_constant
         Cc, Dc = (C(t[0]), D(t[0])) if const else (np.zeros((0, n)), np.zeros((0, m)))
         y = np.empty((p, R, L)) if const else np.empty((0, R, L))
-        if not kernel(np.ascontiguousarray(table.fwd[0][:, -1]), np.ascontiguousarray(WZ),
-                      np.ascontiguousarray(first), np.ascontiguousarray(kcoef), edges,
-                      float(T), table.offset, float(base), w, g, xi, t,
-                      np.ascontiguousarray(u), x1, x, np.ascontiguousarray(Cc, float),
-                      np.ascontiguousarray(Dc, float), y):
-            return None                 # two samples in one cell: not this table
-        return (x if states else None), (y if const else outputs(C, D, t, x, u))
+        ok = kernel(np.ascontiguousarray(table.fwd[0][:, -1]), np.ascontiguousarray(WZ),
+                    np.ascontiguousarray(first), np.ascontiguousarray(kcoef), edges,
+                    float(T), table.offset, float(base), w, g, xi, t,
+                    np.ascontiguousarray(u), x1, x, np.ascontiguousarray(Cc, float),
+                    np.ascontiguousarray(Dc, float), y)
+        if ok is not None:
+            if not ok:
+                return None             # two samples in one cell: not this table
+            return (x if states else None), (y if const else outputs(C, D, t, x, u))
+        # numba could not compile the loop: the NumPy march
+        if w:
+            g, xi, base = _cells_of_samples(table, t)
+            if np.any(np.diff(g) == 0):
+                return None
     g0, P = int(g[0]), int(g[-1]) // N + 1
     # slopes of the held input on [t_k, t_{k+1}) (zero after the last sample)
     sigma = np.zeros((m, R, L))

@@ -156,3 +156,19 @@ def test_without_numba_the_numpy_march_runs(monkeypatch):
     with ltp.config.defaults_context({'timeresp.compiled': False}):
         ref = ltp.forced_response(sys, t, u)
     assert np.array_equal(resp.outputs, ref.outputs)
+
+
+def test_a_kernel_numba_cannot_compile_falls_back_to_numpy(monkeypatch):
+    def broken(*args):
+        raise RuntimeError('no LLVM here')
+    monkeypatch.setattr(cellkernel, 'MIN_SAMPLES', 0)
+    monkeypatch.setattr(cellkernel, '_COMPILED', cellkernel._guarded(broken))
+    sys, t = plant(2, 1, seed=5), grid(2)
+    u = np.cos(1.5 * t)
+    with pytest.warns(UserWarning, match='simulating with NumPy'):
+        resp = ltp.forced_response(sys, t, u)
+    assert cellkernel._COMPILED is False
+    assert cellkernel.compiled_kernel() is None
+    with ltp.config.defaults_context({'timeresp.compiled': False}):
+        ref = ltp.forced_response(sys, t, u)
+    assert np.array_equal(resp.outputs, ref.outputs)
