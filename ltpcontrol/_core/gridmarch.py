@@ -135,7 +135,7 @@ def _grid_march(A, B, C, D, t, u, x0, hold, rtol, states):
                                                                     hold, states)
                     if marched is not None:
                         return marched
-                if np.allclose(h, h[0], rtol=1e-10, atol=0):
+                if _uniform(t, h):
                     # a uniform grid: the step data are smooth periodic functions
                     # of the phase
                     table = _phase_table(A, B, float(h[0]), T, rtol)
@@ -160,9 +160,28 @@ def _grid_march(A, B, C, D, t, u, x0, hold, rtol, states):
     return _chunked_march(steps, C, D, t, u, x0, hold, states)
 
 
+def _uniform(t, h):
+    """Whether the steps h of the grid t are equal, to 1e-10 and to the rounding of t.
+
+    The times of a long record carry rounding errors of ``eps |t|``: a step
+    computed as a difference of two of them is known to that absolute
+    accuracy only (``np.arange(L) / 400`` has steps that differ by 2e-10
+    relative beyond a million samples).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.gridmarch import _uniform
+    >>> t = np.arange(2_000_000) / 400
+    >>> _uniform(t, np.diff(t)), _uniform(t[:3] ** 2, np.diff(t[:3] ** 2))
+    (True, False)
+    """
+    atol = 8 * np.finfo(float).eps * max(abs(float(t[0])), abs(float(t[-1])))
+    return bool(np.all(np.abs(h - h[0]) <= 1e-10 * abs(h[0]) + atol))
+
+
 def _repeat_length(t, h, T):
     """``(q, p)`` when the grid is uniform and ``q h = p T`` (q <= a bound), else None."""
-    if not np.allclose(h, h[0], rtol=1e-10, atol=0):
+    if not _uniform(t, h):
         return None
     ratio = Fraction(float(h[0] / T)).limit_denominator(_MAX_REPEAT)
     q, p = ratio.denominator, ratio.numerator

@@ -228,3 +228,16 @@ def test_cells_laid_out_from_a_subsample_then_from_every_step(monkeypatch):
     monkeypatch.setattr(gridmarch, '_cell_table', table)
     ref = direct(monkeypatch, sys, t, u)
     assert rel(resp.states, ref.states) < 1e-12
+
+
+def test_long_aligned_record_is_uniform_despite_the_rounding_of_its_times():
+    # np.arange(L) / 400 beyond a million samples: steps that differ by 2e-10
+    # relative (the rounding of t ~ 4000), still the aligned grid
+    t = np.arange(1_600_000) / 400
+    h = np.diff(t)
+    assert np.ptp(h) / h[0] > 1e-10
+    assert gridmarch._repeat_length(t, h, 1.0) == (400, 1)
+    # a grid moved by more than that rounding is not uniform
+    t2 = t.copy()
+    t2[800_000] += 1e-9
+    assert gridmarch._repeat_length(t2, np.diff(t2), 1.0) is None
