@@ -149,11 +149,13 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, w, g, xi, t, u, x1, x, Cc
     m, R, L = u.shape[0], u.shape[1], t.shape[0]
     p = Cc.shape[0]
     foh = q == 2 * m
-    # coefficients by phase and order, entries flat: F[j, d, i nq + e], K[j, d, i m + l]
-    Ff = F.reshape(N, D1, n * nq)
-    Kf = K.reshape(N, D1, n * m)
+    # coefficients by phase and order, entries flat: [F[j, d, i nq + e] | K[j, d, i m + l]]
+    E = n * nq + n * m
+    FK = np.empty((N, D1, E))
+    FK[:, :, :n * nq] = F.reshape(N, D1, n * nq)
+    FK[:, :, n * nq:] = K.reshape(N, D1, n * m)
     Td, z = np.empty(D1), np.empty(nq)
-    M, Mk = np.empty(n * nq), np.empty(n * m)
+    M = np.empty(E)
     xc, fk = np.empty(n), np.empty(n)
     slope, kink = np.zeros(m), np.empty(m)
     shift = base * N
@@ -224,16 +226,12 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, w, g, xi, t, u, x1, x, Cc
                         Td[1] = sx
                     for d in range(2, D1):
                         Td[d] = 2.0 * sx * Td[d - 1] - Td[d - 2]
-                    for a in range(n * nq):
-                        M[a] = Ff[ph, 0, a]
-                    for a in range(n * m):
-                        Mk[a] = Kf[ph, 0, a]
+                    for a in range(E):
+                        M[a] = FK[ph, 0, a]
                     for d in range(1, D1):
                         wd = Td[d]
-                        for a in range(n * nq):
-                            M[a] += wd * Ff[ph, d, a]
-                        for a in range(n * m):
-                            Mk[a] += wd * Kf[ph, d, a]
+                        for a in range(E):
+                            M[a] += wd * FK[ph, d, a]
                     for i in range(n):
                         acc = 0.0
                         for e in range(nq):
@@ -241,7 +239,7 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, w, g, xi, t, u, x1, x, Cc
                         x[i, r, k] = acc
                         acc = 0.0
                         for l in range(m):
-                            acc += Mk[i * m + l] * kink[l]
+                            acc += M[n * nq + i * m + l] * kink[l]
                         fk[i] = acc
                     for o in range(p):
                         acc = 0.0
