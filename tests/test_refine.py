@@ -134,7 +134,7 @@ def test_monte_carlo_unbiased_and_efficient():
     std = 0.05 * np.abs(G) + 0.005
     _, crb = ltp.refine_ltp(true, ltp.HTFData(G, omega, true.period, std=std), maxiter=0,
                             return_info=True)
-    res = ltp.monte_carlo(_mc_draw, 120, seed=11, n_jobs=2,
+    res = ltp.monte_carlo(_mc_draw, 120, seed=11, n_jobs=1,
                           args=(G, omega, std, perturbed(true, 7, 0.05)))
     p = crb.x.size
     x, var_rep = res.samples[:, :p], res.samples[:, p:]
