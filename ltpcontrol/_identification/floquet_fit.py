@@ -111,6 +111,19 @@ def _apply_conj_map(J, H, size):
     return out.reshape(J.shape[0], -1)
 
 
+def _conj_combine(x, H, axis):
+    """`_apply_conj_map` along one `axis` (harmonics -H..H) of `x`: ``P_0``, then
+    ``P_h + P_{-h}`` and ``j (P_h - P_{-h})`` for h = 1..H, on the factor of a
+    Jacobian before it is expanded by identity matrices (the same values)."""
+    x = np.moveaxis(x, axis, 0)
+    out = np.empty(x.shape, complex)
+    out[0] = x[H]
+    pos, neg = x[H + 1:], x[H - 1::-1]
+    out[1::2] = pos + neg
+    out[2::2] = 1j * (pos - neg)
+    return np.moveaxis(out, 0, axis)
+
+
 def _zero_pad(x, pad):
     """``np.pad(x, pad)`` (zeros) for pads along the first axis only, without
     `numpy.pad`'s general machinery (the refit unpacks at every evaluation)."""
@@ -143,6 +156,7 @@ class _FloquetFit:
         self.cpad = ((Kd + H - 2 * K,) * 2, (0, 0), (0, 0))   # C_l = 0 for 2K < |l| <= Kd+H
         self.dpad = ((Kd - K,) * 2, (0, 0), (0, 0))           # D_n = 0 for K < |n| <= Kd
         self._last = None                 # (θ, A, Ω, then A, B, C, D, R, G) of the last response
+        self._jd = None                   # (lines, Jacobian of the D coefficients)
 
     def pack(self, sys):
         K, H = self.K, self.H
@@ -179,25 +193,32 @@ class _FloquetFit:
         M, m = omega.size, np.arange(-H, H + 1)
         CR = np.einsum('nmoi,wmij->nowmj', _cnm(Cc, Kd, H), R)    # C_{n-m} R_m
         X = np.einsum('wmij,mjq->wmiq', R, Bc)                     # R_m B_m, (w, m, i, q)
+        # J @ self.T, one series at a time (T is 0, 1 and ±j in blocks): the
+        # harmonics of a series are combined on the factor of its block, before
+        # the expansion by identity matrices (`_apply_conj_map` on the block)
+        nb, nc = self.nb, self.nc
+        J = np.empty((G.size, self.ncoef + (nx * nx if self.fit_a else 0)), complex)
         # rows (q, n, o, w) of G;  dG_n = Σ_m C_{n-m} R_m dB_m
         eu, ey = np.eye(nu), np.eye(ny)
-        JB = np.einsum('nowmi,qr->qnowmir', CR, eu)
+        J[:, :nb] = np.einsum('nowmi,qr->qnowmir', _conj_combine(CR, H, 3),
+                              eu).reshape(G.size, nb)
         # dG_n = Σ_l dC_l X_{n-l}, |n-l| <= H, |l| <= 2K
         L = Kd + H
         Xsel = np.zeros((2 * Kd + 1, 2 * L + 1, M, nx, nu), complex)
         for a, n in enumerate(range(-Kd, Kd + 1)):
             Xsel[a, n - m + L] = X.transpose(1, 0, 2, 3)
-        JC = np.einsum('oz,nlwiq->qnowlzi', ey, Xsel[:, L - 2 * K:L + 2 * K + 1])
-        # dG_n = dD_n, |n| <= K
-        JD = np.einsum('qr,na,oz,w->qnowazr', eu, np.eye(2 * Kd + 1, 2 * K + 1, K - Kd), ey,
-                       np.ones(M))
-        # J @ self.T, one series at a time (T is 0, 1 and ±j in blocks)
-        J = np.hstack([_apply_conj_map(Jx.reshape(G.size, -1), h, size)
-                       for Jx, (h, size) in zip((JB, JC, JD), self.series)])
+        J[:, nb:nb + nc] = np.einsum('oz,nlwiq->qnowlzi', ey, _conj_combine(
+            Xsel[:, L - 2 * K:L + 2 * K + 1], 2 * K, 1)).reshape(G.size, nc)
+        if len(self.series) == 3:
+            # dG_n = dD_n, |n| <= K: constant, made once for a number of lines
+            if self._jd is None or self._jd[0] != M:
+                JD = np.einsum('qr,na,oz,w->qnowazr', eu, np.eye(2 * Kd + 1, 2 * K + 1, K - Kd),
+                               ey, np.ones(M))
+                self._jd = (M, _apply_conj_map(JD.reshape(G.size, -1), K, ny * nu))
+            J[:, nb + nc:self.ncoef] = self._jd[1]
         if self.fit_a:
             # dR_m = R_m dA R_m:  dG_n = Σ_m C_{n-m} R_m dA R_m B_m
-            JA = np.einsum('nowmi,wmjq->qnowij', CR, X)
-            J = np.hstack([J, JA.reshape(G.size, nx * nx)])
+            J[:, self.ncoef:] = np.einsum('nowmi,wmjq->qnowij', CR, X).reshape(G.size, nx * nx)
         return G, J
 
 
