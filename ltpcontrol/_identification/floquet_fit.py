@@ -336,7 +336,9 @@ def _projected_svd(J, r):
     if not np.all(np.isfinite(J)):
         return None, None, None
     m, p = J.shape
-    R = scipy.linalg.qr(np.column_stack([J, r]), mode='r', check_finite=False)[0]
+    Jr = np.empty((m, p + 1), order='F')         # LAPACK's layout: no copy in `qr`
+    Jr[:, :p], Jr[:, p] = J, r
+    R = scipy.linalg.qr(Jr, mode='r', overwrite_a=True, check_finite=False)[0]
     tall = m >= int(p * 11 / 6)
     Ur, s, Vt = _robust_svd(R[:p, :p] if tall else R[:, :p])
     if Ur is None:
