@@ -329,23 +329,42 @@ def _projected_svd(J, r):
     The factor has ``m`` rows, zero below the triangle: when LAPACK's SVD
     would factor a matrix of its shape by a QR first (``m >= 11 p / 6``; that
     QR leaves the triangle as it is), the SVD is taken of the ``p x p``
-    triangle alone, the same result bit for bit at a fraction of the work.
+    triangle alone, the same result bit for bit at a fraction of the work,
+    and only that triangle is copied out of LAPACK's factor.
     ``(None, None, None)`` when `J` is not finite or the SVD fails
     (`_robust_svd`).
     """
     if not np.all(np.isfinite(J)):
         return None, None, None
     m, p = J.shape
-    Jr = np.empty((m, p + 1), order='F')         # LAPACK's layout: no copy in `qr`
+    Jr = np.empty((m, p + 1), order='F')         # LAPACK's layout: no copy in geqrf
     Jr[:, :p], Jr[:, p] = J, r
-    R = scipy.linalg.qr(Jr, mode='r', overwrite_a=True, check_finite=False)[0]
-    tall = m >= int(p * 11 / 6)
-    Ur, s, Vt = _robust_svd(R[:p, :p] if tall else R[:, :p])
+    qr = _householder_qr(Jr)
+    if m < int(p * 11 / 6):                   # LAPACK takes the factor as it is
+        R = np.triu(qr)
+        Ur, s, Vt = _robust_svd(R[:, :p])
+        if Ur is None:
+            return None, None, None
+        return Ur.T @ R[:, p], s, Vt
+    Ur, s, Vt = _robust_svd(np.triu(qr[:p, :p]))
     if Ur is None:
         return None, None, None
-    if tall:                                  # U = [U_R; 0], as the SVD of R[:, :p] has it
-        Ur = np.concatenate([Ur, np.zeros((m - p, Ur.shape[1]))])
-    return Ur.T @ R[:, p], s, Vt
+    Qtr = np.zeros(m)
+    Qtr[:p + 1] = qr[:p + 1, p]               # the last column of R: Q^T r
+    Ur = np.concatenate([Ur, np.zeros((m - p, Ur.shape[1]))])   # U = [U_R; 0]
+    return Ur.T @ Qtr, s, Vt
+
+
+def _householder_qr(a):
+    """LAPACK's ``geqrf`` of the Fortran-ordered `a` in place (R in its upper
+    triangle, the reflectors below), with the optimal workspace, as
+    `scipy.linalg.qr` calls it; without the copy of the whole triangle."""
+    geqrf, = scipy.linalg.get_lapack_funcs(('geqrf',), (a,))
+    lwork = geqrf(a, lwork=-1, overwrite_a=True)[2][0].real.astype(np.int_)
+    qr, _, _, info = geqrf(a, lwork=lwork, overwrite_a=True)
+    if info < 0:
+        raise ValueError(f"illegal value in {-info}th argument of internal geqrf")
+    return qr
 
 
 def _robust_svd(J):
