@@ -282,7 +282,11 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
         colnorm = np.linalg.norm(J, axis=0)
         colnorm = np.maximum(colnorm, 1e-8 * max(colnorm.max(), np.finfo(float).tiny))
         # one SVD per iteration: the damped step -V diag(s/(s²+μ)) U^T r for any μ
-        Utr, sv, Vt = _projected_svd(J / colnorm, r)
+        # (the scaled Jacobian written beside r in LAPACK's layout)
+        Jr = np.empty((J.shape[0], J.shape[1] + 1), order='F')
+        np.divide(J, colnorm, out=Jr[:, :-1])
+        Jr[:, -1] = r
+        Utr, sv, Vt = _stacked_projected_svd(Jr)
         if Utr is None:
             break                                 # a Jacobian the SVD cannot take: stop
         sv = np.where(sv > max(J.shape) * np.finfo(float).eps * sv[0], sv, 0.0)
@@ -334,11 +338,17 @@ def _projected_svd(J, r):
     ``(None, None, None)`` when `J` is not finite or the SVD fails
     (`_robust_svd`).
     """
-    if not np.all(np.isfinite(J)):
+    Jr = np.empty((J.shape[0], J.shape[1] + 1), order='F')   # LAPACK's layout
+    Jr[:, :-1], Jr[:, -1] = J, r
+    return _stacked_projected_svd(Jr)
+
+
+def _stacked_projected_svd(Jr):
+    """`_projected_svd` of ``J, r`` given as ``Jr = [J r]`` in Fortran order
+    (overwritten by the QR), so that LAPACK takes it without a copy."""
+    if not np.all(np.isfinite(Jr[:, :-1])):
         return None, None, None
-    m, p = J.shape
-    Jr = np.empty((m, p + 1), order='F')         # LAPACK's layout: no copy in geqrf
-    Jr[:, :p], Jr[:, p] = J, r
+    m, p = Jr.shape[0], Jr.shape[1] - 1
     qr = _householder_qr(Jr)
     if m < int(p * 11 / 6):                   # LAPACK takes the factor as it is
         R = np.triu(qr)
@@ -351,8 +361,9 @@ def _projected_svd(J, r):
         return None, None, None
     Qtr = np.zeros(m)
     Qtr[:p + 1] = qr[:p + 1, p]               # the last column of R: Q^T r
-    Ur = np.concatenate([Ur, np.zeros((m - p, Ur.shape[1]))])   # U = [U_R; 0]
-    return Ur.T @ Qtr, s, Vt
+    U = np.zeros((m, Ur.shape[1]))           # U = [U_R; 0]
+    U[:p] = Ur
+    return U.T @ Qtr, s, Vt
 
 
 def _householder_qr(a):
