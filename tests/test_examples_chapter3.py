@@ -21,7 +21,7 @@ SMALL_DESIGN = {**hop.DESIGN, 'duration': 8.0, 'gap': 4.0}
 
 @pytest.fixture(scope='module')
 def hopper_result():
-    return hop.identify(design=SMALL_DESIGN)
+    return hop.identify(design=SMALL_DESIGN, n_jobs=1)
 
 
 def test_hopper_parametric_fit(hopper_result):
@@ -68,7 +68,7 @@ def test_delay_output_shift():
 @pytest.mark.slow
 def test_delay_table():
     # the thesis's 30 s chirps: the single-harmonic estimates need the long records
-    estimates, switching = delays.delay_experiments(hop.DESIGN)
+    estimates, switching = delays.delay_experiments(hop.DESIGN, n_jobs=1)
     fit = delays.magnitude_fit(estimates, switching)
     assert abs(fit.params[0] / 200 - 1) < 0.01 and abs(fit.params[1] / 2 - 1) < 0.05
     reference = hop.model_htf(fit.params, switching, 3)

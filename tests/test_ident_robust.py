@@ -49,13 +49,15 @@ def test_random_plants():
 
 
 def test_negative_multipliers_give_a_model_and_a_warning():
-    """Two distinct negative real multipliers: no real Floquet form of period T."""
+    """Two distinct negative real multipliers: no real Floquet form of period T.
+    60 lines show it as the 120 of the other tests do (relative residual 0.084
+    and 0.087, the same warnings), at half the cost of the refit."""
     plant = random_ltp(8, 3, 2, allow_negative=True)
     mu = ltp.floquet_multipliers(plant)
     assert np.sum((np.abs(mu.imag) < 1e-9) & (mu.real < 0)) == 2
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter('always')
-        model = ltp.identify_ltp(lifted_data(plant, 2, LINES, DT), T, 3, 2)
+        model = ltp.identify_ltp(lifted_data(plant, 2, design_lines(T, 60), DT), T, 3, 2)
     assert any('misses the data' in str(w.message) for w in caught)
     assert model.nstates == 3
 

@@ -9,6 +9,7 @@ suite passes.
 """
 
 import ast
+import functools
 import pathlib
 import re
 import subprocess
@@ -22,13 +23,29 @@ from tools.import_graph import (LAYERS, PACKAGE, TOP, cycles, layer_index, packa
 ROOT = PACKAGE.parent
 
 
+@functools.cache
+def graph():
+    """The package's import graph, built once for the tests of this module."""
+    return package_graph()
+
+
+@functools.cache
+def parsed(path):
+    """The syntax tree of a package module, parsed once for the tests of this module."""
+    return ast.parse(path.read_text())
+
+
+def _tree(source):
+    return source if isinstance(source, ast.AST) else ast.parse(source)
+
+
 def test_package_respects_layers():
-    errors = violations(package_graph())
+    errors = violations(graph())
     assert not errors, "\n".join(errors)
 
 
 def test_import_graph_has_no_cycle():
-    found = cycles(package_graph())
+    found = cycles(graph())
     assert not found, "import cycles: " + "; ".join(" <-> ".join(c) for c in found)
 
 
@@ -68,7 +85,8 @@ def private_names(source, package='ltpcontrol'):
         return [p for p in parts if p.startswith('_') and not p.startswith('__')]
 
     found, aliases = set(), set()
-    for node in ast.walk(ast.parse(source)):
+    tree = ast.parse(source)
+    for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             for alias in node.names:
                 parts = alias.name.split('.')
@@ -83,7 +101,7 @@ def private_names(source, package='ltpcontrol'):
             for alias in node.names:
                 if private(parts + [alias.name]):
                     found.add(f"{node.module}.{alias.name}")
-    for node in ast.walk(ast.parse(source)):
+    for node in ast.walk(tree):
         if isinstance(node, ast.Attribute):
             chain, value = [node.attr], node.value
             while isinstance(value, ast.Attribute):
@@ -122,7 +140,8 @@ SYSTEM_KEYWORDS = {'name', 'inputs', 'outputs', 'states', 'params'}
 
 
 def hidden_options(source):
-    """Documented parameters of public functions taking ``**kwargs`` missing from the signature.
+    """Documented parameters of public functions taking ``**kwargs`` missing from the signature
+    (`source`: text or syntax tree).
 
     Such an option is read out of ``**kwargs`` (``kwargs.pop``) instead of
     being a keyword parameter.  Overloaded call forms (``*args``, as
@@ -130,7 +149,7 @@ def hidden_options(source):
     are exempt; ``__init__`` is checked against its class's docstring.
     """
     found = []
-    tree = ast.parse(source)
+    tree = _tree(source)
     scopes = [(None, tree.body)] + [(node, node.body) for node in ast.walk(tree)
                                     if isinstance(node, ast.ClassDef)]
     for cls, body in scopes:
@@ -157,7 +176,7 @@ def hidden_options(source):
 
 @pytest.mark.parametrize('module', sorted(package_paths()))
 def test_documented_options_are_parameters(module):
-    found = hidden_options(package_paths()[module].read_text())
+    found = hidden_options(parsed(package_paths()[module]))
     assert not found, f"{module}: make these keyword-only parameters: {found}"
 
 
@@ -173,7 +192,7 @@ def test_hidden_option_is_found():
 def test_library_does_not_patch_with_unittest():
     users = [key for key, path in package_paths().items()
              if {'unittest'} & {alias.name.split('.')[0] for node in
-                                ast.walk(ast.parse(path.read_text()))
+                                ast.walk(parsed(path))
                                 if isinstance(node, (ast.Import, ast.ImportFrom))
                                 for alias in ([ast.alias(node.module or '')]
                                               if isinstance(node, ast.ImportFrom)
@@ -182,16 +201,17 @@ def test_library_does_not_patch_with_unittest():
 
 
 def private_periodic_matrix_access(source):
-    """Private `PeriodicMatrix` members (``_new``, ``_coeffs``, ...) used in `source`."""
+    """Private `PeriodicMatrix` members (``_new``, ``_coeffs``, ...) used in `source`
+    (text or syntax tree)."""
     private = {'_new', '_init', '_coeffs', '_func', '_pieces', '_times', '_combine'}
-    return sorted({node.attr for node in ast.walk(ast.parse(source))
+    return sorted({node.attr for node in ast.walk(_tree(source))
                    if isinstance(node, ast.Attribute) and node.attr in private})
 
 
 def test_periodic_matrix_is_used_through_public_methods():
     users = {key: found for key, path in package_paths().items()
              if key != '_core.periodic_matrix'
-             and (found := private_periodic_matrix_access(path.read_text()))}
+             and (found := private_periodic_matrix_access(parsed(path)))}
     assert users == {}
 
 

@@ -6,8 +6,6 @@ in the LTI limit, finite differences for the Jacobian, and a Monte-Carlo
 study of the estimator's bias and covariance against its Cramér-Rao bound.
 """
 
-import importlib.util
-import pathlib
 import warnings
 
 import control as ct
@@ -18,6 +16,7 @@ from hypothesis import given, settings, strategies as st
 from control.exception import ControlArgument, ControlDimension
 
 import ltpcontrol as ltp
+from example_scripts import import_script
 from systems import real_fourier_basis
 
 
@@ -134,7 +133,7 @@ def test_monte_carlo_unbiased_and_efficient():
     std = 0.05 * np.abs(G) + 0.005
     _, crb = ltp.refine_ltp(true, ltp.HTFData(G, omega, true.period, std=std), maxiter=0,
                             return_info=True)
-    res = ltp.monte_carlo(_mc_draw, 120, seed=11, n_jobs=2,
+    res = ltp.monte_carlo(_mc_draw, 120, seed=11, n_jobs=1,
                           args=(G, omega, std, perturbed(true, 7, 0.05)))
     p = crb.x.size
     x, var_rep = res.samples[:, :p], res.samples[:, p:]
@@ -251,10 +250,7 @@ def test_modal_pivot_form_is_a_state_transformation(seed, nx, ny, nu, pair):
 @pytest.mark.slow
 def test_noise_study_refinement_lowers_subspace_error():
     # the gallery study's plant and data (SNR 12.5, per-experiment noise), 8 draws
-    path = pathlib.Path(__file__).parents[1] / 'examples' / 'plot_noise_study.py'
-    spec = importlib.util.spec_from_file_location('plot_noise_study', path)
-    study = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(study)
+    study = import_script('plot_noise_study')     # examples/ on the path, for its imports
     res = ltp.monte_carlo(study.draw, 8, seed=2017, n_jobs=1)
     sub, ml = res.samples[:, 0], res.samples[:, 1]
     assert np.all(sub < 0.02)                       # the subspace model forms

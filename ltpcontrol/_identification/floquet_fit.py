@@ -111,6 +111,19 @@ def _apply_conj_map(J, H, size):
     return out.reshape(J.shape[0], -1)
 
 
+def _conj_combine(x, H, axis):
+    """`_apply_conj_map` along one `axis` (harmonics -H..H) of `x`: ``P_0``, then
+    ``P_h + P_{-h}`` and ``j (P_h - P_{-h})`` for h = 1..H, on the factor of a
+    Jacobian before it is expanded by identity matrices (the same values)."""
+    x = np.moveaxis(x, axis, 0)
+    out = np.empty(x.shape, complex)
+    out[0] = x[H]
+    pos, neg = x[H + 1:], x[H - 1::-1]
+    out[1::2] = pos + neg
+    out[2::2] = 1j * (pos - neg)
+    return np.moveaxis(out, 0, axis)
+
+
 def _zero_pad(x, pad):
     """``np.pad(x, pad)`` (zeros) for pads along the first axis only, without
     `numpy.pad`'s general machinery (the refit unpacks at every evaluation)."""
@@ -143,6 +156,7 @@ class _FloquetFit:
         self.cpad = ((Kd + H - 2 * K,) * 2, (0, 0), (0, 0))   # C_l = 0 for 2K < |l| <= Kd+H
         self.dpad = ((Kd - K,) * 2, (0, 0), (0, 0))           # D_n = 0 for K < |n| <= Kd
         self._last = None                 # (θ, A, Ω, then A, B, C, D, R, G) of the last response
+        self._jd = None                   # (lines, Jacobian of the D coefficients)
 
     def pack(self, sys):
         K, H = self.K, self.H
@@ -179,25 +193,32 @@ class _FloquetFit:
         M, m = omega.size, np.arange(-H, H + 1)
         CR = np.einsum('nmoi,wmij->nowmj', _cnm(Cc, Kd, H), R)    # C_{n-m} R_m
         X = np.einsum('wmij,mjq->wmiq', R, Bc)                     # R_m B_m, (w, m, i, q)
+        # J @ self.T, one series at a time (T is 0, 1 and ±j in blocks): the
+        # harmonics of a series are combined on the factor of its block, before
+        # the expansion by identity matrices (`_apply_conj_map` on the block)
+        nb, nc = self.nb, self.nc
+        J = np.empty((G.size, self.ncoef + (nx * nx if self.fit_a else 0)), complex)
         # rows (q, n, o, w) of G;  dG_n = Σ_m C_{n-m} R_m dB_m
         eu, ey = np.eye(nu), np.eye(ny)
-        JB = np.einsum('nowmi,qr->qnowmir', CR, eu)
+        J[:, :nb] = np.einsum('nowmi,qr->qnowmir', _conj_combine(CR, H, 3),
+                              eu).reshape(G.size, nb)
         # dG_n = Σ_l dC_l X_{n-l}, |n-l| <= H, |l| <= 2K
         L = Kd + H
         Xsel = np.zeros((2 * Kd + 1, 2 * L + 1, M, nx, nu), complex)
         for a, n in enumerate(range(-Kd, Kd + 1)):
             Xsel[a, n - m + L] = X.transpose(1, 0, 2, 3)
-        JC = np.einsum('oz,nlwiq->qnowlzi', ey, Xsel[:, L - 2 * K:L + 2 * K + 1])
-        # dG_n = dD_n, |n| <= K
-        JD = np.einsum('qr,na,oz,w->qnowazr', eu, np.eye(2 * Kd + 1, 2 * K + 1, K - Kd), ey,
-                       np.ones(M))
-        # J @ self.T, one series at a time (T is 0, 1 and ±j in blocks)
-        J = np.hstack([_apply_conj_map(Jx.reshape(G.size, -1), h, size)
-                       for Jx, (h, size) in zip((JB, JC, JD), self.series)])
+        J[:, nb:nb + nc] = np.einsum('oz,nlwiq->qnowlzi', ey, _conj_combine(
+            Xsel[:, L - 2 * K:L + 2 * K + 1], 2 * K, 1)).reshape(G.size, nc)
+        if len(self.series) == 3:
+            # dG_n = dD_n, |n| <= K: constant, made once for a number of lines
+            if self._jd is None or self._jd[0] != M:
+                JD = np.einsum('qr,na,oz,w->qnowazr', eu, np.eye(2 * Kd + 1, 2 * K + 1, K - Kd),
+                               ey, np.ones(M))
+                self._jd = (M, _apply_conj_map(JD.reshape(G.size, -1), K, ny * nu))
+            J[:, nb + nc:self.ncoef] = self._jd[1]
         if self.fit_a:
             # dR_m = R_m dA R_m:  dG_n = Σ_m C_{n-m} R_m dA R_m B_m
-            JA = np.einsum('nowmi,wmjq->qnowij', CR, X)
-            J = np.hstack([J, JA.reshape(G.size, nx * nx)])
+            J[:, self.ncoef:] = np.einsum('nowmi,wmjq->qnowij', CR, X).reshape(G.size, nx * nx)
         return G, J
 
 
@@ -261,7 +282,11 @@ def fit_floquet(sys, Gc, omega, K, *, harmonics=None, estimate_d=True, fit_a=Tru
         colnorm = np.linalg.norm(J, axis=0)
         colnorm = np.maximum(colnorm, 1e-8 * max(colnorm.max(), np.finfo(float).tiny))
         # one SVD per iteration: the damped step -V diag(s/(s²+μ)) U^T r for any μ
-        Utr, sv, Vt = _projected_svd(J / colnorm, r)
+        # (the scaled Jacobian written beside r in LAPACK's layout)
+        Jr = np.empty((J.shape[0], J.shape[1] + 1), order='F')
+        np.divide(J, colnorm, out=Jr[:, :-1])
+        Jr[:, -1] = r
+        Utr, sv, Vt = _stacked_projected_svd(Jr)
         if Utr is None:
             break                                 # a Jacobian the SVD cannot take: stop
         sv = np.where(sv > max(J.shape) * np.finfo(float).eps * sv[0], sv, 0.0)
@@ -305,17 +330,52 @@ def _projected_svd(J, r):
     Jacobian to ``(p+1) x p`` with ``Q^T r`` beside it, whose SVD has the
     singular values and right vectors of `J` (``U = Q U_R``); that is about
     half the work of the SVD of `J` with its ``m x p`` left vectors.
+    The factor has ``m`` rows, zero below the triangle: when LAPACK's SVD
+    would factor a matrix of its shape by a QR first (``m >= 11 p / 6``; that
+    QR leaves the triangle as it is), the SVD is taken of the ``p x p``
+    triangle alone, the same result bit for bit at a fraction of the work,
+    and only that triangle is copied out of LAPACK's factor.
     ``(None, None, None)`` when `J` is not finite or the SVD fails
     (`_robust_svd`).
     """
-    if not np.all(np.isfinite(J)):
+    Jr = np.empty((J.shape[0], J.shape[1] + 1), order='F')   # LAPACK's layout
+    Jr[:, :-1], Jr[:, -1] = J, r
+    return _stacked_projected_svd(Jr)
+
+
+def _stacked_projected_svd(Jr):
+    """`_projected_svd` of ``J, r`` given as ``Jr = [J r]`` in Fortran order
+    (overwritten by the QR), so that LAPACK takes it without a copy."""
+    if not np.all(np.isfinite(Jr[:, :-1])):
         return None, None, None
-    p = J.shape[1]
-    R = scipy.linalg.qr(np.column_stack([J, r]), mode='r', check_finite=False)[0]
-    Ur, s, Vt = _robust_svd(R[:, :p])
+    m, p = Jr.shape[0], Jr.shape[1] - 1
+    qr = _householder_qr(Jr)
+    if m < int(p * 11 / 6):                   # LAPACK takes the factor as it is
+        R = np.triu(qr)
+        Ur, s, Vt = _robust_svd(R[:, :p])
+        if Ur is None:
+            return None, None, None
+        return Ur.T @ R[:, p], s, Vt
+    Ur, s, Vt = _robust_svd(np.triu(qr[:p, :p]))
     if Ur is None:
         return None, None, None
-    return Ur.T @ R[:, p], s, Vt
+    Qtr = np.zeros(m)
+    Qtr[:p + 1] = qr[:p + 1, p]               # the last column of R: Q^T r
+    U = np.zeros((m, Ur.shape[1]))           # U = [U_R; 0]
+    U[:p] = Ur
+    return U.T @ Qtr, s, Vt
+
+
+def _householder_qr(a):
+    """LAPACK's ``geqrf`` of the Fortran-ordered `a` in place (R in its upper
+    triangle, the reflectors below), with the optimal workspace, as
+    `scipy.linalg.qr` calls it; without the copy of the whole triangle."""
+    geqrf, = scipy.linalg.get_lapack_funcs(('geqrf',), (a,))
+    lwork = geqrf(a, lwork=-1, overwrite_a=True)[2][0].real.astype(np.int_)
+    qr, _, _, info = geqrf(a, lwork=lwork, overwrite_a=True)
+    if info < 0:
+        raise ValueError(f"illegal value in {-info}th argument of internal geqrf")
+    return qr
 
 
 def _robust_svd(J):
