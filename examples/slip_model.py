@@ -227,11 +227,19 @@ def flight_state(t, y0, z0, vy0, vz0, d_h, d_v, g):
     return y, z, vy, vz
 
 
+#: Descent times already computed, by their arguments (at most `_DESCENT_CACHE_SIZE`).
+#: A leg fit predicts the same strides again and again with other leg
+#: parameters, and the descent does not depend on the leg.
+_DESCENT_CACHE = {}
+_DESCENT_CACHE_SIZE = 64
+
+
 def descent_time(z0, z_td, d_v, g):
     """Time to fall from apex height `z0` to touchdown height `z_td`.
 
     Solves ``z(t) = z_td`` of (2.6) with zero initial vertical velocity by
-    Newton's method (``z`` is monotone on the descent).
+    Newton's method (``z`` is monotone on the descent).  The result for the
+    same arguments is computed once (see `_DESCENT_CACHE`).
 
     Examples
     --------
@@ -239,6 +247,18 @@ def descent_time(z0, z_td, d_v, g):
     1.0
     """
     z0, z_td = np.broadcast_arrays(np.asarray(z0, float), np.asarray(z_td, float))
+    if np.ndim(d_v) or np.ndim(g):
+        return _descent_time(z0, z_td, d_v, g)
+    key = (z0.shape, z0.tobytes(), z_td.tobytes(), float(d_v), float(g))
+    if key not in _DESCENT_CACHE:
+        if len(_DESCENT_CACHE) >= _DESCENT_CACHE_SIZE:
+            del _DESCENT_CACHE[next(iter(_DESCENT_CACHE))]      # the oldest entry
+        _DESCENT_CACHE[key] = _descent_time(z0, z_td, d_v, g)
+    return _DESCENT_CACHE[key].copy()
+
+
+def _descent_time(z0, z_td, d_v, g):
+    """`descent_time` of broadcast arrays, computed."""
     drop = z0 - z_td
     t = np.sqrt(2 * np.maximum(drop, 0) / g)
     for _ in range(30):
