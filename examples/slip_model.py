@@ -326,14 +326,16 @@ class _Stance(NamedTuple):
     state: Callable
 
 
-def _newton_root(fun, lo, hi, iterations=40):
+def _newton_root(fun, lo, hi, iterations=40, f_hi=None):
     """Vectorised safeguarded Newton for the root of ``fun`` in ``[lo, hi]``.
 
     ``fun(t)`` returns the value and the derivative; the value must change
     sign over the bracket.  Steps leaving the bracket fall back to bisection.
+    `f_hi` is the value at `hi` when the caller has it already.
     """
     f_lo = fun(lo)[0]
-    active = np.sign(f_lo) != np.sign(fun(hi)[0])
+    active = np.sign(f_lo) != np.sign(fun(hi)[0] if f_hi is None else f_hi)
+    inactive = ~active
     t = 0.5 * (lo + hi)
     for _ in range(iterations):
         f, df = fun(t)
@@ -345,7 +347,7 @@ def _newton_root(fun, lo, hi, iterations=40):
         t_new = np.where(inside, step, 0.5 * (lo + hi))
         done = np.abs(t_new - t) <= 1e-12
         t = t_new
-        if np.all(done | ~active):
+        if (done | inactive).all():
             break
     return np.where(active, t, np.nan)
 
@@ -416,8 +418,9 @@ def _aas_evaluator(theta0, p, kappa, c, rhod0, p_td=None):
         rhodd = amp_dd * decay * np.cos(arg + two_phi2)
         return kappa * (1 - rho) - c * rhod, neg_kappa * rhod - c * rhodd
 
-    lifts = (force(t_top)[0] < 0) & (rhod0 < 0) & (xi < 1)
-    t_lo = np.where(lifts, _newton_root(force, t_b, t_top), np.nan)
+    f_top = force(t_top)[0]
+    lifts = (f_top < 0) & (rhod0 < 0) & (xi < 1)
+    t_lo = np.where(lifts, _newton_root(force, t_b, t_top, f_hi=f_top), np.nan)
     if p_td is not None:
         # p grows from p_td at touchdown to 2 p - p_td at liftoff
         rate[...] = np.nan_to_num(2 * (p - p_td) / np.where(lifts, t_lo, 1.0))
