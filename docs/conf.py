@@ -92,6 +92,29 @@ if os.environ.get('LTP_DOCS_ONLINE') != '1':
 # unless LTP_DOCS_FULL=1 asks for the full runs.
 if os.environ.get('LTP_DOCS_FULL') != '1':
     os.environ['LTP_EXAMPLES_QUICK'] = '1'
+
+
+def _gallery_skips_example_pngs():
+    """Figures saved into the examples folder are not drawn during the build.
+
+    The gallery scripts save their figures as PNG files beside themselves
+    for readers who run them; the gallery draws every figure itself (its
+    image scraper) and the build never uses those files.  Skipping them
+    leaves the pages as they are and saves one drawing per saved figure.
+    """
+    from matplotlib.figure import Figure
+    examples = os.path.abspath(os.path.join('..', 'examples'))
+    savefig = Figure.savefig
+
+    def gallery_savefig(self, fname, *args, **kwargs):
+        if (isinstance(fname, (str, os.PathLike))
+                and os.path.dirname(os.path.abspath(fname)) == examples):
+            return None
+        return savefig(self, fname, *args, **kwargs)
+    Figure.savefig = gallery_savefig
+
+
+_gallery_skips_example_pngs()
 sphinx_gallery_conf = {
     'examples_dirs': '../examples',
     'gallery_dirs': 'auto_examples',

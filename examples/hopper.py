@@ -23,6 +23,26 @@ HOPPER_PARAMS = {'g': 9.81, 'k': 200.0, 'c': 2.0, 'm': 1.0, 'x0': 0.2}
 #: Forcing period in seconds (``f0(t) = cos 2πt``).
 PERIOD = 1.0
 
+#: Simulated experiments already at hand in this process, by their arguments (see
+#: `cached_experiment`).
+_EXPERIMENTS = {}
+
+
+def cached_experiment(key, simulate):
+    """``simulate()``, computed once per process for the same hashable `key`
+    (every time when `key` is None).
+
+    The examples that simulate the same experiment (the undelayed chirps of
+    the delay study and of the HTF identification) run in one documentation
+    build; the same result objects are returned again, so callers must not
+    modify them.
+    """
+    if key is None:
+        return simulate()
+    if key not in _EXPERIMENTS:
+        _EXPERIMENTS[key] = simulate()
+    return _EXPERIMENTS[key]
+
 
 def _vector_field(damped):
     def updfcn(t, x, u, p):
@@ -69,9 +89,17 @@ def hopper_plant(**params):
                        target='lossy', name='lossless', jacobian=_state_matrix(False),
                        input_jacobian=_input_matrix),
     ]
-    return ltp.HybridPlant(modes, lambda t, x, u, p: [x[0]], states=['x', 'v'],
-                           inputs=['u'], outputs=['x'], params={**HOPPER_PARAMS, **params},
-                           name='hopper')
+    plant = ltp.HybridPlant(modes, lambda t, x, u, p: [x[0]], states=['x', 'v'],
+                            inputs=['u'], outputs=['x'], params={**HOPPER_PARAMS, **params},
+                            name='hopper')
+    plant._hopper_params = tuple(sorted(plant.params.items()))
+    return plant
+
+
+def plant_key(plant):
+    """Hashable parameters of a plant made by `hopper_plant` (None for other plants)."""
+    key = getattr(plant, '_hopper_params', None)
+    return key if key is not None and plant.params == dict(key) else None
 
 
 def hopper_orbit(plant=None, x0=(0.15, 0.0), mode0='lossy', **kwargs):

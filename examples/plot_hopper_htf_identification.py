@@ -53,7 +53,8 @@ import numpy as np  # noqa: E402
 from joblib import Parallel, delayed  # noqa: E402
 
 import ltpcontrol as ltp  # noqa: E402
-from hopper import HOPPER_PARAMS, PERIOD, hopper_ltp, hopper_orbit, hopper_plant  # noqa: E402
+from hopper import (HOPPER_PARAMS, PERIOD, cached_experiment, hopper_ltp,  # noqa: E402
+                    hopper_orbit, hopper_plant, plant_key)
 
 QUICK = os.environ.get('LTP_EXAMPLES_QUICK', '0') == '1'
 
@@ -146,6 +147,18 @@ def chirp_experiment(plant, cycle, design=DESIGN, input_delay=0.0, n_jobs=N_JOBS
     y : ndarray
         Output deviation ``ξ1`` on ``exc.time``.
     """
+    # the same experiment on the same hopper is simulated once per process
+    params = plant_key(plant)
+    key = None if params is None else (
+        'chirp', params, np.asarray(cycle[0], float).tobytes(), cycle[1],
+        np.asarray(cycle[2], float).tobytes(), tuple(sorted(design.items())),
+        float(input_delay), DT, tuple(sorted(SOLVER.items())))
+    return cached_experiment(key, lambda: _chirp_experiment(plant, cycle, design,
+                                                            input_delay, n_jobs))
+
+
+def _chirp_experiment(plant, cycle, design, input_delay, n_jobs):
+    """`chirp_experiment`, simulated."""
     x0, mode0, xbar = cycle
     exc = ltp.chirp_replicas(PERIOD, dt=DT, **design)
     chirps = [chirp_function(design, r) for r in range(len(exc.segments))]

@@ -19,6 +19,7 @@ gravity (2.24), and the four springs of Table 2.5 (vertical experiments).
 """
 
 from dataclasses import dataclass, replace
+from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
@@ -299,6 +300,13 @@ def _crossing(values, start, rising):
     return start + i + v[i] / (v[i] - v[i + 1])
 
 
+@lru_cache(maxsize=16)
+def _butterworth(order, cutoff, fs):
+    """Second-order sections of the Butterworth low-pass, designed once per
+    ``(order, cutoff, fs)`` (the records share a handful of sampling rates)."""
+    return butter(order, cutoff, fs=fs, output="sos")
+
+
 def process_record(record, rho0, cutoff=50.0, order=5):
     """Filter, differentiate and extract transitions (Section 2.3.2).
 
@@ -327,7 +335,7 @@ def process_record(record, rho0, cutoff=50.0, order=5):
     """
     t = record.t
     fs = 1 / np.mean(np.diff(t))
-    sos = butter(order, cutoff, fs=fs, output="sos")
+    sos = _butterworth(order, cutoff, fs).copy()
     y, z = sosfiltfilt(sos, record.y), sosfiltfilt(sos, record.z)
     vy, vz = np.gradient(y, t), np.gradient(z, t)
     idx = np.arange(t.size)

@@ -169,7 +169,8 @@ def prediction_errors(data, params, method, vy0=None, index=None):
         _relative(b[:, 1:3], np.column_stack([pred.bottom.y, pred.bottom.z]))])  # (2.32)
 
 
-def fit_leg(data, params, method, vy0=None, index=None, start=None, max_nfev=60):
+def fit_leg(data, params, method, vy0=None, index=None, start=None, max_nfev=60,
+            return_errors=False):
     """Fit leg stiffness and damping on the cost (2.33).
 
     ``C = sqrt(C_ap^2 + C_av^2 + C_at^2 + C_bp^2)`` with each ``C`` the mean
@@ -189,6 +190,8 @@ def fit_leg(data, params, method, vy0=None, index=None, start=None, max_nfev=60)
     max_nfev : int, optional
         Evaluation budget of the optimiser.  The cost is a mean of norms,
         so it has kinks; loose tolerances (1e-6) stop the zig-zag near them.
+    return_errors : bool, optional
+        Also return the errors of :func:`prediction_errors` at the fit.
 
     Returns
     -------
@@ -196,6 +199,9 @@ def fit_leg(data, params, method, vy0=None, index=None, start=None, max_nfev=60)
         ``d`` is 0 for lossless methods.
     cost : float
         Final value of ``C``.
+    errors : ndarray, shape (n, 4)
+        With `return_errors`: the errors of the fitted ``k, d`` (None if the
+        optimiser did not evaluate its result).
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
@@ -203,10 +209,13 @@ def fit_leg(data, params, method, vy0=None, index=None, start=None, max_nfev=60)
     start = np.array(start if start is not None else (params.k, params.d)) / scale
     lossless = method in _LOSSLESS
 
+    evaluated = {}      # the errors at every point the optimiser asked for
+
     def residuals(x):
         # the four mean errors whose norm is C of (2.33)
         p = params.replace(k=x[0] * scale[0], d=0.0 if lossless else x[1] * scale[1])
         err = prediction_errors(data, p, method, vy0, index)
+        evaluated[x.tobytes()] = err
         return np.mean(np.where(np.isnan(err), _FAILED, err), axis=0)
 
     x0 = start[:1] if lossless else start
@@ -217,6 +226,10 @@ def fit_leg(data, params, method, vy0=None, index=None, start=None, max_nfev=60)
                         x_scale=1.0, ftol=1e-6, xtol=1e-6, max_nfev=max_nfev)
     k = sol.x[0] * scale[0]
     d = 0.0 if lossless else sol.x[1] * scale[1]
+    if return_errors:
+        # the optimiser's result is a point it evaluated: the errors there, as
+        # `prediction_errors` gives them for the fitted k, d
+        return k, d, float(np.sqrt(2 * sol.cost)), evaluated.get(sol.x.tobytes())
     return k, d, float(np.sqrt(2 * sol.cost))
 
 
@@ -253,11 +266,12 @@ def cross_validate(data, params, method, folds=30, vy0=None, seed=0, fold_nfev=8
     stride_test = np.full((n, 4), np.nan)
     for held in np.array_split(order, folds):
         kept = np.setdiff1d(order, held)
-        k, d, _ = fit_leg(data, params, method, vy0, kept, start=(k_all, d_all),
-                          max_nfev=fold_nfev)
+        k, d, _, e_train = fit_leg(data, params, method, vy0, kept, start=(k_all, d_all),
+                                   max_nfev=fold_nfev, return_errors=True)
         fitted = params.replace(k=k, d=d)
         e_test = prediction_errors(data, fitted, method, vy0, held)
-        e_train = prediction_errors(data, fitted, method, vy0, kept)
+        if e_train is None:
+            e_train = prediction_errors(data, fitted, method, vy0, kept)
         stride_test[held] = e_test
         test.append(np.nanmean(e_test[:, :3], axis=0))
         train.append(np.nanmean(e_train[:, :3], axis=0))

@@ -227,11 +227,19 @@ def flight_state(t, y0, z0, vy0, vz0, d_h, d_v, g):
     return y, z, vy, vz
 
 
+#: Descent times already computed, by their arguments (at most `_DESCENT_CACHE_SIZE`).
+#: A leg fit predicts the same strides again and again with other leg
+#: parameters, and the descent does not depend on the leg.
+_DESCENT_CACHE = {}
+_DESCENT_CACHE_SIZE = 64
+
+
 def descent_time(z0, z_td, d_v, g):
     """Time to fall from apex height `z0` to touchdown height `z_td`.
 
     Solves ``z(t) = z_td`` of (2.6) with zero initial vertical velocity by
-    Newton's method (``z`` is monotone on the descent).
+    Newton's method (``z`` is monotone on the descent).  The result for the
+    same arguments is computed once (see `_DESCENT_CACHE`).
 
     Examples
     --------
@@ -239,6 +247,18 @@ def descent_time(z0, z_td, d_v, g):
     1.0
     """
     z0, z_td = np.broadcast_arrays(np.asarray(z0, float), np.asarray(z_td, float))
+    if np.ndim(d_v) or np.ndim(g):
+        return _descent_time(z0, z_td, d_v, g)
+    key = (z0.shape, z0.tobytes(), z_td.tobytes(), float(d_v), float(g))
+    if key not in _DESCENT_CACHE:
+        if len(_DESCENT_CACHE) >= _DESCENT_CACHE_SIZE:
+            del _DESCENT_CACHE[next(iter(_DESCENT_CACHE))]      # the oldest entry
+        _DESCENT_CACHE[key] = _descent_time(z0, z_td, d_v, g)
+    return _DESCENT_CACHE[key].copy()
+
+
+def _descent_time(z0, z_td, d_v, g):
+    """`descent_time` of broadcast arrays, computed."""
     drop = z0 - z_td
     t = np.sqrt(2 * np.maximum(drop, 0) / g)
     for _ in range(30):
@@ -306,14 +326,16 @@ class _Stance(NamedTuple):
     state: Callable
 
 
-def _newton_root(fun, lo, hi, iterations=40):
+def _newton_root(fun, lo, hi, iterations=40, f_hi=None):
     """Vectorised safeguarded Newton for the root of ``fun`` in ``[lo, hi]``.
 
     ``fun(t)`` returns the value and the derivative; the value must change
     sign over the bracket.  Steps leaving the bracket fall back to bisection.
+    `f_hi` is the value at `hi` when the caller has it already.
     """
     f_lo = fun(lo)[0]
-    active = np.sign(f_lo) != np.sign(fun(hi)[0])
+    active = np.sign(f_lo) != np.sign(fun(hi)[0] if f_hi is None else f_hi)
+    inactive = ~active
     t = 0.5 * (lo + hi)
     for _ in range(iterations):
         f, df = fun(t)
@@ -325,7 +347,7 @@ def _newton_root(fun, lo, hi, iterations=40):
         t_new = np.where(inside, step, 0.5 * (lo + hi))
         done = np.abs(t_new - t) <= 1e-12
         t = t_new
-        if np.all(done | ~active):
+        if (done | inactive).all():
             break
     return np.where(active, t, np.nan)
 
@@ -396,8 +418,9 @@ def _aas_evaluator(theta0, p, kappa, c, rhod0, p_td=None):
         rhodd = amp_dd * decay * np.cos(arg + two_phi2)
         return kappa * (1 - rho) - c * rhod, neg_kappa * rhod - c * rhodd
 
-    lifts = (force(t_top)[0] < 0) & (rhod0 < 0) & (xi < 1)
-    t_lo = np.where(lifts, _newton_root(force, t_b, t_top), np.nan)
+    f_top = force(t_top)[0]
+    lifts = (f_top < 0) & (rhod0 < 0) & (xi < 1)
+    t_lo = np.where(lifts, _newton_root(force, t_b, t_top, f_hi=f_top), np.nan)
     if p_td is not None:
         # p grows from p_td at touchdown to 2 p - p_td at liftoff
         rate[...] = np.nan_to_num(2 * (p - p_td) / np.where(lifts, t_lo, 1.0))

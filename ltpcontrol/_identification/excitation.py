@@ -271,11 +271,23 @@ def _periodic_design(omega, period, dt, nperiods, settle, nexp, phases, amplitud
     delays = np.arange(nexp) * period / nexp
     # broadcast views made once: a variable-step simulator calls `single` per step
     delay_col, omega3, phases3 = delays[:, None], omega[:, None, None], phases[:, None, None]
+    omega2, phases2 = omega[:, None], phases[:, None]
 
     def single(t, shift=0.0):
         t = np.atleast_1d(np.asarray(t, dtype=float))
         # u_r(t) = Σ_l a cos(ω_l (t - τ_r) + φ_l + shift), accumulated line by
         # line so that memory stays (experiments x samples)
+        if t.size == 1:
+            # one instant (what a variable-step simulator asks for): the same
+            # operations on (lines, experiments), the lines added in sequence
+            # as below, without the broadcasting and cumsum overhead
+            terms = np.cos(omega2 * (t[0] - delays) + phases2 + shift)
+            if nexp == 1:
+                total = 0.0
+                for term in terms.ravel().tolist():
+                    total += term
+                return np.array([[amplitude * total]])
+            return amplitude * terms.cumsum(axis=0)[-1][:, None]
         shifted = t[None, :] - delay_col
         if shifted.size <= _BATCH:
             # few samples (a variable-step simulator asks for one at a time):
