@@ -439,9 +439,10 @@ class CellTable:
                            length / self.lens[j])
 
 
-def _chebyshev_basis(s, K):
-    """``T_k(s)`` for k < K at the points s of [-1, 1], shape (K, S)."""
-    out = np.empty((K, len(s)))
+def _chebyshev_basis(s, K, out=None):
+    """``T_k(s)`` for k < K at the points s of [-1, 1] (any shape), shape (K,) + s.shape."""
+    if out is None:
+        out = np.empty((K,) + np.shape(s))
     out[0] = 1.0
     if K > 1:
         out[1] = s

@@ -51,6 +51,7 @@ import numpy as np
 
 from ..config import _get
 from . import cellkernel
+from .celldata import _chebyshev_basis
 
 __all__ = []
 
@@ -213,7 +214,7 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
         Tb = Tk.transpose(1, 0, 2)                      # (N, D1, Pc) for the products
         for ph in blocks:
             # forcing f_c = [W Z] (a, σ) + Σ_d T_d(ξ) K_d kink
-            _chebyshev_rows(sgrid[ph], D1, out=Tk[:, ph])
+            _chebyshev_basis(sgrid[ph], D1, out=Tk[:, ph])
             if not m:
                 f[ph] = 0.0
                 continue
@@ -293,18 +294,6 @@ def _cells_of_samples(table, t):
     j = _cell_of(edges, theta)
     xi = np.clip((theta - edges[j]) / lens[j], 0.0, 1.0)
     return (wraps - base).astype(np.int64) * N + j, xi, base
-
-
-def _chebyshev_rows(s, K, out):
-    """``out[k] = T_k(s)`` for k < K (s of any shape; out (K,) + s.shape)."""
-    out[0] = 1.0
-    if K > 1:
-        out[1] = s
-    two_s = 2 * s
-    for k in range(2, K):
-        np.multiply(two_s, out[k - 1], out=out[k])
-        out[k] -= out[k - 2]
-    return out
 
 
 def outputs(C, D, t, x, u):
