@@ -295,20 +295,23 @@ class HybridPlant:
 
     def state_jacobian(self, t, x, u, params=None, *, mode=0):
         """``∂f_i/∂x``: the mode's `jacobian` or central differences."""
-        i = self._mode(mode)
-        params = self.params if params is None else params
-        jac = self.modes[i].jacobian
-        if jac is not None:
-            return _matrix(jac(t, x, u, params), (self.nstates, self.nstates), 'jacobian')
-        return central_jacobian(lambda z: self.dynamics(t, z, u, params, mode=i), x)
+        return self._jacobian('jacobian', t, x, u, params, mode)
 
     def input_jacobian(self, t, x, u, params=None, *, mode=0):
         """``∂f_i/∂u``: the mode's `input_jacobian` or central differences."""
+        return self._jacobian('input_jacobian', t, x, u, params, mode)
+
+    def _jacobian(self, name, t, x, u, params, mode):
+        """The mode's Jacobian `name` (in x or in u), or its central differences."""
         i = self._mode(mode)
         params = self.params if params is None else params
-        jac = self.modes[i].input_jacobian
+        jac = getattr(self.modes[i], name)
+        wrt_x = name == 'jacobian'
         if jac is not None:
-            return _matrix(jac(t, x, u, params), (self.nstates, self.ninputs), 'input_jacobian')
+            cols = self.nstates if wrt_x else self.ninputs
+            return _matrix(jac(t, x, u, params), (self.nstates, cols), name)
+        if wrt_x:
+            return central_jacobian(lambda z: self.dynamics(t, z, u, params, mode=i), x)
         return central_jacobian(lambda v: self.dynamics(t, x, v, params, mode=i), u)
 
 
