@@ -93,63 +93,79 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     >>> bool(np.allclose(y[0, 0], 1 - np.exp(-t), rtol=0, atol=1e-13))
     True
     """
-    edges, T, lens = table.edges, table.edges[-1], table.lens
-    N = len(lens)
-    n, R = x0.shape
-    m, L = u.shape[0], len(t)
-    D1 = len(table.frac)
-    kernel = _kernel(n, L)
-    w = _equal_width(table)
-    if kernel is not None and w:
-        # the compiled march locates the samples itself: the first one here
-        g, xi, base = _cells_of_samples(table, t[:1])
-    else:
-        g, xi, base = _cells_of_samples(table, t)
-        if np.any(np.diff(g) == 0):
-            return None                 # two samples in one cell: not this table
-        w = 0.0
+    N, n, R, m = len(table.lens), x0.shape[0], x0.shape[1], u.shape[0]
     # the held input's q rows in the cells' forcing: a (and σ, first-order hold)
     q = 2 * m if hold == 'foh' else m
     # the table's data: whole cells' [W Z]; Chebyshev coefficients in the
     # first part's ξ = ℓ / h_c of the kink's part [t_k, e_{c+1}] (W or Z of
     # the last parts, whose lengths' weights are those of the first part,
     # reversed) and of the first part's [Φ W Z], applied to (x(e_c), a, σ)
-    # for the state at the sample; the latter as entries when those are
-    # fewer numbers (n + q <= D1) than their products with (x, a, σ) at the
-    # D1 orders, which are formed otherwise
+    # for the state at the sample
     WZ = np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2)[:, :, :q]
     kpart = table.bwd[2] if hold == 'foh' else table.bwd[1]                 # (N, D1, n, m)
     first = table.coefficients(np.concatenate(table.fwd, axis=3)[..., :n + q])  # (N, D1, n, n+q)
     kcoef = table.coefficients(kpart, reverse=True)
     # the first sample: its cell's last part carries x0 to the next cell,
-    # entered as the forcing of cell g0 (all earlier cells force nothing)
-    j0 = g[:1] % N
-    Pb, Wb, Zb = table.last(j0, lens[j0] * (1 - xi[:1]))
+    # entered as the forcing of the cell after it (earlier cells force nothing)
+    g0, xi0, base = _cells_of_samples(table, t[:1])
+    j0 = g0 % N
+    Pb, Wb, Zb = table.last(j0, table.lens[j0] * (1 - xi0))
     x1 = Pb[0] @ x0 + Wb[0] @ u[:, :, 0]
     if hold == 'foh':
         x1 += Zb[0] @ (u[:, :, 1] - u[:, :, 0]) / (t[1] - t[0])
-    x = np.empty((n, R, L))
+    x = np.empty((n, R, len(t)))
     x[:, :, 0] = x0
+    kernel = _kernel(n, len(t))
     if kernel is not None:
-        # constant output matrices: the outputs too
-        p = C.shape[0]
-        const = C.is_constant and D.is_constant
-        Cc, Dc = (C(t[0]), D(t[0])) if const else (np.zeros((0, n)), np.zeros((0, m)))
-        y = np.empty((p, R, L)) if const else np.empty((0, R, L))
-        ok = kernel(np.ascontiguousarray(table.fwd[0][:, -1]), np.ascontiguousarray(WZ),
-                    np.ascontiguousarray(first), np.ascontiguousarray(kcoef), edges,
-                    float(T), table.offset, float(base), w, g, xi, t,
-                    np.ascontiguousarray(u), x1, x, np.ascontiguousarray(Cc, float),
-                    np.ascontiguousarray(Dc, float), y)
-        if ok is not None:
-            if not ok:
-                return None             # two samples in one cell: not this table
-            return (x if states else None), (y if const else outputs(C, D, t, x, u))
-        # numba could not compile the loop: the NumPy march
-        if w:
-            g, xi, base = _cells_of_samples(table, t)
-            if np.any(np.diff(g) == 0):
-                return None
+        marched = _compiled_march(kernel, table, WZ, first, kcoef, C, D, t, u, x1, x, base)
+        if marched is not _UNAVAILABLE:
+            return marched if marched is None else ((x if states else None), marched)
+    # the NumPy march
+    g, xi, base = _cells_of_samples(table, t)
+    if np.any(np.diff(g) == 0):
+        return None                     # two samples in one cell: not this table
+    _numpy_march(table, WZ, first, kcoef, t, u, x1, x, g, xi, base, hold)
+    return (x if states else None), outputs(C, D, t, x, u)
+
+
+#: the compiled march could not run (numba failed): the NumPy march takes over
+_UNAVAILABLE = object()
+
+
+def _compiled_march(kernel, table, WZ, first, kcoef, C, D, t, u, x1, x, base):
+    """States (into `x`) and outputs by the compiled loop (`cellkernel`).
+
+    Returns the outputs, None when two samples share a cell, or
+    `_UNAVAILABLE` when the loop could not be compiled.
+    """
+    (n, R, L), m = x.shape, u.shape[0]
+    # equal cells: the loop locates the samples itself; else they are located here
+    w = _equal_width(table)
+    if w:
+        g, xi = np.zeros(1, np.int64), np.zeros(1)
+    else:
+        g, xi, _ = _cells_of_samples(table, t)
+    # constant output matrices: the outputs in the loop too
+    const = C.is_constant and D.is_constant
+    Cc, Dc = (C(t[0]), D(t[0])) if const else (np.zeros((0, n)), np.zeros((0, m)))
+    y = np.empty((len(Cc), R, L))
+    ok = kernel(np.ascontiguousarray(table.fwd[0][:, -1]), np.ascontiguousarray(WZ),
+                np.ascontiguousarray(first), np.ascontiguousarray(kcoef), table.edges,
+                float(table.edges[-1]), table.offset, float(base), w, g, xi, t,
+                np.ascontiguousarray(u), x1, x, np.ascontiguousarray(Cc, float),
+                np.ascontiguousarray(Dc, float), y)
+    if ok is None:
+        return _UNAVAILABLE
+    if not ok:
+        return None                     # two samples in one cell: not this table
+    return y if const else outputs(C, D, t, x, u)
+
+
+def _numpy_march(table, WZ, first, kcoef, t, u, x1, x, g, xi, base, hold):
+    """States at the samples 1 .. L-1 (into `x`) by the NumPy march (module notes)."""
+    edges, T = table.edges, table.edges[-1]
+    (n, R, L), m = x.shape, u.shape[0]
+    N, D1, q = WZ.shape[0], first.shape[1], WZ.shape[2]
     g0, P = int(g[0]), int(g[-1]) // N + 1
     # slopes of the held input on [t_k, t_{k+1}) (zero after the last sample)
     sigma = np.zeros((m, R, L))
@@ -166,6 +182,9 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     np.maximum(last, 0, out=last)
     kink = np.zeros((m, R, L))
     kink[:, :, 1:] = np.diff(sigma if hold == 'foh' else u, axis=2)
+    # the first part's data applied to (x, a, σ) as entries when those are
+    # fewer numbers (n + q <= D1) than their products with (x, a, σ) at the
+    # D1 orders, which are formed otherwise
     E1 = n * (n + q) if n + q <= D1 else 0
     tab = np.concatenate([first.reshape(N, D1, -1)[:, :, :E1], kcoef.reshape(N, D1, n * m)],
                          axis=2)
@@ -177,8 +196,7 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     # products per cell run over all the chunk's periods, on cache-sized blocks)
     per = max(1, min(P, _CHUNK_ENTRIES // (N * R * (3 * n + q + m) + N * D1)))
     per = -(-P // -(-P // per))                                 # equal chunks
-    E = tab.shape[1]
-    nph = max(1, min(N, _CELL_ENTRIES // (per * (R * (3 * n + q + m) + D1 + E))))
+    nph = max(1, min(N, _CELL_ENTRIES // (per * (R * (3 * n + q + m) + D1 + tab.shape[1]))))
     blocks = [slice(j0, min(N, j0 + nph)) for j0 in range(0, N, nph)]
     for p0 in range(0, P, per):
         # the periods [p0, p1): cells c0 .. c1 - 1, samples in ks.  The cells'
@@ -200,7 +218,7 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
             z[:, n + m:] = sk.reshape(m, R, Pc, N).transpose(3, 0, 2, 1)
         z[:, n:n + m] = held.reshape(m, R, Pc, N).transpose(3, 0, 2, 1)
         if c0 <= g0:
-            z[:g0 + 1, n:, 0] = 0.0
+            z[:g0 + 1, n:, 0] = 0.0                 # up to sample 0's cell: no input
         # T_d(2ξ - 1) of every cell (ξ = 0 without a sample) and the kinks
         # (zero without a sample), by phase
         sgrid = np.full(Pc * N, -1.0)
@@ -214,18 +232,15 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
         Tb = Tk.transpose(1, 0, 2)                      # (N, D1, Pc) for the products
         for ph in blocks:
             # forcing f_c = [W Z] (a, σ) + Σ_d T_d(ξ) K_d kink
+            nb = ph.stop - ph.start
             _chebyshev_basis(sgrid[ph], D1, out=Tk[:, ph])
-            if not m:
-                f[ph] = 0.0
-                continue
-            np.matmul(WZ[ph], z[ph, n:].reshape(-1, q, Pc * R),
-                      out=f[ph].reshape(-1, n, Pc * R))
+            np.matmul(WZ[ph], z[ph, n:].reshape(nb, q, Pc * R),
+                      out=f[ph].reshape(nb, n, Pc * R))
             data = np.matmul(tab[ph, E1:], Tb[ph])                          # (nph, n m, Pc)
             for i in range(n):
                 for r in range(m):
                     f[ph, i] += data[:, i * m + r, :, None] * kgrid[r, ph]
         if c0 <= g0:
-            f[:g0, :, 0] = 0.0
             f[g0, :, 0] = x1
         _, start = march(f.reshape(N, n, Pc * R), R, start,
                          out=z[:, :n].reshape(N, n, Pc * R))
@@ -244,7 +259,7 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
                     for e in range(1, n + q):
                         xp[ph, i] += data[:, e0 + e, :, None] * z[ph, e]
             else:
-                V = np.matmul(first[ph], z[ph].reshape(-1, n + q, Pc * R))
+                V = np.matmul(first[ph], z[ph].reshape(ph.stop - ph.start, n + q, Pc * R))
                 V = V.reshape(-1, D1, n, Pc, R)
                 np.multiply(Tk[0, ph, None, :, None], V[:, 0], out=xp[ph])
                 for d in range(1, D1):
@@ -253,7 +268,6 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
         for i in range(n):
             for r in range(R):
                 np.take(xt[i, r], cs, out=x[i, r, ks], mode='clip')
-    return (x if states else None), outputs(C, D, t, x, u)
 
 
 def _kernel(n, L):
@@ -325,13 +339,6 @@ def outputs(C, D, t, x, u):
             for c in np.flatnonzero(np.any(Mc, axis=0)):
                 y[:, :, i] += Mc[:, c:c + 1, None] * v[c, :, i]
     return y
-
-
-def _by_phase(z, N, P):
-    """Signal (rows, R, P N) of the cells in time order as (N, rows, P R)."""
-    rows, R, _ = z.shape
-    return np.ascontiguousarray(z.reshape(rows, R, P, N).transpose(3, 0, 2, 1)) \
-        .reshape(N, rows, P * R)
 
 
 def _apply(M, v):

@@ -125,7 +125,6 @@ def _grid_march(A, B, C, D, t, u, x0, hold, rtol, states):
         if count > 2 * math.ceil(T / h.min()) or (repeat is not None and repeat[1] > 1):
             if repeat is None:
                 # a grid whose phases never repeat: march over the cells of a
-                # phase table
                 # phase table, laid out from every k-th step of a long record
                 # first (again from all steps when two samples share a cell)
                 stride = -(-len(h) // _LAYOUT_STEPS)
@@ -391,12 +390,12 @@ def _cell_layout(starts, h, T, most, mean=None):
 
     Cells of width w hold at most one sample each when every step shorter
     than w has a cell edge inside it: the offset of the edges (modulo w)
-    must lie in the arc ``(t_k, t_{k+1}]`` of every such step (`starts`
-    t_k, steps `h`).  The arcs are
-    intersected on 256 bins for piece counts from the `mean` step on (a step
-    of at least w covers every bin: its arc is cut to w, and every bin must
-    be covered by all the steps); the offset is the middle of the widest
-    common run.  None when no count below `most` works.
+    must lie in the arc ``(t_k, t_{k+1}]`` of every such step (`starts` t_k,
+    steps `h`).  The arcs are intersected on 256 bins for piece counts from
+    the `mean` step on (a step of at least w covers every bin: its arc is
+    cut to w, and every bin must be covered by all the steps); the offset is
+    the middle of the widest common run.  None when no count below `most`
+    works.
     """
     bins = 256
     hmin = float(h.min())
