@@ -103,23 +103,37 @@ def _refine(X0, sweep, passes=2):
     restore full accuracy.  Returns the samples with ``X[0] = X[-1]``.
     """
     scale = max(1.0, np.abs(X0).max())
-    for attempt in range(passes + 1):
-        Xs, factors = sweep(X0)
-        res = Xs[0] - X0
-        if attempt == passes or np.abs(res).max() <= 1e-13 * scale:
+    Xs, factors = sweep(X0)
+    res = Xs[0] - X0
+    for _ in range(passes):
+        if np.abs(res).max() <= 1e-13 * scale:
             break
         mono = np.eye(X0.shape[0])
         for f in factors:
             mono = f @ mono
         if not np.all(np.isfinite(mono)) or np.max(np.abs(la.eigvals(mono))) >= 1:
             break
-        delta = la.solve_discrete_lyapunov(mono.T, res)
-        X0 = X0 + 0.5 * (delta + delta.T)
+        # a far from normal closed loop (a nearly uncontrollable plant) makes
+        # the Stein equation's Kronecker form numerically singular: the step
+        # is kept only when it lowers the residual
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter('ignore', la.LinAlgWarning)
+                delta = la.solve_discrete_lyapunov(mono.T, res)
+        except np.linalg.LinAlgError:
+            break
+        X1 = X0 + 0.5 * (delta + delta.T)
+        Xs1, factors1 = sweep(X1)
+        res1 = Xs1[0] - X1
+        if not np.abs(res1).max() < np.abs(res).max():
+            break
+        X0, Xs, factors, res = X1, Xs1, factors1, res1
     err = np.abs(res).max() / scale
     if not np.isfinite(err) or err > _RESIDUAL_WARN:
         warnings.warn(f"the periodic Riccati solution has a periodicity residual of "
                       f"{err:.1e}: the problem is ill-conditioned (closed-loop "
-                      "multipliers close to the unit circle or a badly scaled plant)",
+                      "multipliers close to the unit circle, a nearly uncontrollable "
+                      "mode or a badly scaled plant)",
                       UserWarning, stacklevel=3)
     Xs[0] = X0
     return Xs, factors
