@@ -14,7 +14,7 @@ they are python-control's `stability_margins` gain and phase margins.
 """
 
 import numpy as np
-from control.exception import ControlArgument, ControlDimension
+from control.exception import ControlDimension
 
 from .._core.lifting import lift
 from .._core.coerce import as_ltp

@@ -202,7 +202,7 @@ def _hankel(sys, nsteps):
         P = cyclic_lyap(A, B @ np.swapaxes(B, 1, 2), check=False)
         Q = cyclic_lyap(A, np.swapaxes(C, 1, 2) @ C, adjoint=True, check=False)
         return float(np.sqrt(max(_lam_max(P, Q).max(), 0.0)))
-    A, T = sys.A, sys.period
+    A = sys.A
     Qf, Qa = gram_weight(sys.B), gram_weight(sys.C, True)
     grid = step_grid(A, [sys.B, sys.C], nsteps)
     Phi, W, V, _ = step_integrals(A, grid[:-1], np.diff(grid), Qf=Qf, Qa=Qa)

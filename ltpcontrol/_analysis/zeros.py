@@ -151,7 +151,7 @@ def _bandwidth(M):
 
 def _harmonic_zeros(sys, K):
     """Finite pencil eigenvalues of truncation K in the central strip."""
-    n, m = sys.nstates, sys.ninputs
+    n = sys.nstates
     w = sys.omega_p
     T = [_toeplitz(M.fourier(2 * K), K) for M in (sys.A, sys.B, sys.C, sys.D)]
     F = T[0] - np.kron(np.diag(1j * w * np.arange(-K, K + 1)), np.eye(n))

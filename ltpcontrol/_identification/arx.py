@@ -21,7 +21,7 @@ estimator-based (LQG) controller.
 from dataclasses import dataclass
 
 import numpy as np
-from control.exception import ControlArgument, ControlDimension
+from control.exception import ControlDimension
 
 from .._core.ltpsys import LTPStateSpace
 from .records import as_records, common_grid, refuse_ambiguous

@@ -36,7 +36,7 @@ import scipy.linalg
 import scipy.optimize
 import scipy.sparse as sp
 import scipy.stats
-from control.exception import ControlArgument, ControlDimension
+from control.exception import ControlDimension
 from tqdm.auto import tqdm
 
 from .._frequency.htf import HTFData

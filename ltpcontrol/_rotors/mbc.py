@@ -21,7 +21,6 @@ with ``𝒯̇`` holding ``Ω T'`` and ``Ω² T'' + Ω̇ T'`` (Bir 2008; Hansen 2
 """
 
 import numbers
-import re
 import warnings
 
 import numpy as np

@@ -385,10 +385,9 @@ def _operating_speed(lines, out, path, overflow):
     desc = [r[4] for r in out['states']]
     n2 = sum(1 for r in out['states'] if r[3] == 2)
     half = n2 // 2
-    found = False
     for i in range(half):
         if 'DOF_GeAz' in desc[i]:
-            omega, domega, found = xdop[i], xdop[i + half], True
+            omega, domega = xdop[i], xdop[i + half]
             break
     for i in range(half):
         if 'DOF_DrTr' in desc[i]:
