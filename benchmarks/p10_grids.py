@@ -152,7 +152,7 @@ def run(quick=False, log=print, only=None):
     cases['aligned 400 longer'] = ('Fourier', np.arange(longer) / 400, None)
     cases['P10k'] = ('Fourier', _jittered(longer, 400, 1.0, 8), 'aligned 400 longer')
     cases['P10l'] = ('Fourier', cases['P10k'][1], 'aligned 400 longer')
-    compiled = cellkernel.compiled_kernel() is not None and longer >= cellkernel.MIN_SAMPLES
+    compiled = cellkernel.available() and longer >= cellkernel.MIN_SAMPLES
 
     if only:
         keep = {n for n, c in cases.items() if n in only}

@@ -25,11 +25,11 @@
     Relative tolerance of the rational period ratio ``T_1/T_2 = p/q``.
 ``timeresp.compiled`` : bool, default True
     `forced_response` on long grids whose phases never repeat (at least
-    20 000 samples, at most 12 states) marches with a compiled kernel when
+    20 000 samples, at most 16 states) marches with a compiled kernel when
     numba is installed (``pip install ltpcontrol[fast]``).  The kernel is
-    compiled at its first use and cached on disk (a few seconds, once per
-    environment).  False: always the NumPy march (same results to
-    rounding).
+    compiled at its first use for the system's sizes and cached on disk (a
+    few seconds, once per environment and sizes).  False: always the NumPy
+    march (same results to rounding).
 
 Examples
 --------

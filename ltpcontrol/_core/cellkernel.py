@@ -18,8 +18,9 @@ the cells of the record, compiled once per environment (cached on disk):
 with the coefficients of `cell_march` (F those of the first part's
 [Φ W Z] in Chebyshev polynomials of ξ, K those of the kink's part).  The
 arithmetic is that of the NumPy march, in another order: the two agree to
-rounding.  Without numba, `march_cells` is this loop in Python, used by
-the tests on small records.
+rounding.  `march_kernel` makes the loop for given sizes (constants of
+the compiled code); without numba it runs as Python, used by the tests on
+small records.
 
 The kernel is used when ``ltp.config.defaults['timeresp.compiled']`` is
 true (default), numba imports, the record has at least `MIN_SAMPLES`
@@ -27,6 +28,7 @@ samples and the system at most `MAX_STATES` states (above that the
 NumPy march's matrix products are efficient).
 """
 
+import importlib.util
 import warnings
 
 import numpy as np
@@ -36,37 +38,58 @@ __all__ = []
 #: the compiled march is used for records of at least this many samples ...
 MIN_SAMPLES = 20_000
 #: ... of systems of at most this many states
-MAX_STATES = 12
+MAX_STATES = 16
 
-_COMPILED = None
+#: compiled loops by sizes; False once numba failed to import or compile
+_COMPILED = {}
 
 
-def compiled_kernel():
-    """The compiled `march_cells`, or None when numba cannot be imported.
+def compiled_kernel(n, m, q, D1, p):
+    """The compiled loop for these sizes (`march_kernel`), or None without numba.
+
+    The sizes are compile-time constants of the loop (its small loops
+    unroll), so every combination is compiled once per environment and
+    cached on disk.
 
     Examples
     --------
     >>> from ltpcontrol._core.cellkernel import compiled_kernel
-    >>> kernel = compiled_kernel()
+    >>> kernel = compiled_kernel(2, 1, 2, 7, 1)
     >>> kernel is None or callable(kernel)
     True
     """
     global _COMPILED
-    if _COMPILED is None:
+    if _COMPILED is False:
+        return None
+    sizes = (int(n), int(m), int(q), int(D1), int(p))
+    if sizes not in _COMPILED:
         try:
             import numba
         except ImportError:
             _COMPILED = False
-        else:
-            # reassociated and fused sums (the loops over orders vectorise);
-            # no checks for division by zero (steps are positive)
-            _COMPILED = _guarded(numba.njit(cache=True, nogil=True, error_model='numpy',
-                                            fastmath={'reassoc', 'contract'})(march_cells))
-    return _COMPILED or None
+            return None
+        # reassociated and fused sums (the loops over orders vectorise);
+        # no checks for division by zero (steps are positive)
+        _COMPILED[sizes] = _guarded(numba.njit(
+            cache=True, nogil=True, error_model='numpy',
+            fastmath={'reassoc', 'contract'})(march_kernel(*sizes)))
+    return _COMPILED[sizes]
+
+
+def available():
+    """Whether the compiled loop can be used (numba imports and compiled so far).
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.cellkernel import available
+    >>> isinstance(available(), bool)
+    True
+    """
+    return _COMPILED is not False and importlib.util.find_spec('numba') is not None
 
 
 def _guarded(kernel):
-    """`kernel`, returning None (and disabled, with a warning) if numba fails to compile it."""
+    """`kernel`, returning None (and every loop disabled, with a warning) if numba fails to compile it."""
     def call(*args):
         global _COMPILED
         try:
@@ -79,57 +102,18 @@ def _guarded(kernel):
     return call
 
 
-def march_cells(Phi, WZ, F, K, edges, T, offset, base, w, g, xi, t, u, x1, x, Cc, Dc, y):
-    """States `x` and outputs `y` at the samples from the cells' data (module notes).
-
-    The input is held between samples: first order when ``WZ`` has 2m
-    columns (slopes ``σ_k = (u_{k+1} - u_k) / (t_{k+1} - t_k)``, zero after
-    the last sample; the kink at a sample is the change of slope), else
-    zero order (the kink is the jump ``u_k - u_{k-1}``).
-
-    Parameters
-    ----------
-    Phi : ndarray (N, n, n)
-        Whole cells' transitions.
-    WZ : ndarray (N, n, q)
-        Whole cells' W (and Z, first-order hold: q = 2m).
-    F : ndarray (N, D1, n, n + q)
-        Chebyshev coefficients of the first parts' [Φ W (Z)].
-    K : ndarray (N, D1, n, m)
-        Chebyshev coefficients of the kink's part.
-    edges : ndarray (N + 1,)
-    T, offset, base : float
-        Period, phase of the cells' origin, number of the period of t[0].
-    w : float
-        Width of equal cells: a sample's cell and fraction come from
-        ``r = (t - offset) / w - base N`` (cell ⌊r⌋, ξ = r - ⌊r⌋); 0: from
-        `g` and `xi`.
-    g : int64 ndarray (L,)
-        Cell of every sample (counted from the start of period `base`).
-    xi : ndarray (L,)
-        Fraction of its cell before every sample.
-    t : ndarray (L,)
-    u : ndarray (m, R, L)
-    x1 : ndarray (n, R)
-        State at the start of the cell after the first sample's.
-    x : ndarray (n, R, L)
-        States, written at samples 1 .. L-1 (sample 0 holds x0).
-    Cc, Dc : ndarray (p, n), (p, m)
-        Constant output matrices, or Cc with no rows: `y` is not written.
-    y : ndarray (p, R, L)
-        Outputs ``Cc x + Dc u``.
-
-    Returns
-    -------
-    bool
-        False when two samples fall in one cell (`x` and `y` incomplete).
+def march_kernel(n, m, q, D1, p):
+    """`march_cells` for n states, m inputs, q = m (zero-order hold) or 2m
+    (first-order hold) forcing columns, D1 Chebyshev orders and p output rows
+    (0: outputs not written), the sizes fixed (a closure), as Python.
 
     Examples
     --------
     One state, ẋ = u on two cells of one period (Φ = 1, W = h = 0.5), a
     constant input held: the state grows as t.
 
-    >>> from ltpcontrol._core.cellkernel import march_cells
+    >>> from ltpcontrol._core.cellkernel import march_kernel
+    >>> march_cells = march_kernel(1, 1, 1, 2, 1)
     >>> Phi, WZ = np.ones((2, 1, 1)), np.full((2, 1, 1), 0.5)
     >>> F = np.zeros((2, 2, 1, 2)); F[:, 0, 0, 0] = 1.0        # Φ_f = 1
     >>> F[:, 0, 0, 1], F[:, 1, 0, 1] = 0.25, 0.25             # W_f = ℓ = (1 + T_1) / 4
@@ -143,125 +127,171 @@ def march_cells(Phi, WZ, F, K, edges, T, offset, base, w, g, xi, t, u, x1, x, Cc
     >>> x[0, 0], y[0, 0]
     (array([0. , 0.8, 1.3]), array([0. , 1.6, 2.6]))
     """
-    N, n = Phi.shape[0], Phi.shape[1]
-    D1, nq = F.shape[1], F.shape[3]
-    q = nq - n
-    m, R, L = u.shape[0], u.shape[1], t.shape[0]
-    p = Cc.shape[0]
+    nq = n + q
     foh = q == 2 * m
-    # coefficients by phase and order, entries flat: [F[j, d, i nq + e] | K[j, d, i m + l]]
+    # coefficient entries: [F[j, d, i nq + e] | K[j, d, i m + l]]
     E = n * nq + n * m
-    FK = np.empty((N, D1, E))
-    FK[:, :, :n * nq] = F.reshape(N, D1, n * nq)
-    FK[:, :, n * nq:] = K.reshape(N, D1, n * m)
-    Td, z = np.empty(D1), np.empty(nq)
-    M = np.empty(E)
-    xc, fk = np.empty(n), np.empty(n)
-    slope, kink = np.zeros(m), np.empty(m)
-    shift = base * N
-    inv_w = 1.0 / w if w > 0.0 else 0.0
-    if w > 0.0:
-        r0 = (t[0] - offset) / w - shift
-        g0 = int(np.floor(r0))
-    else:
-        g0 = g[0]
-    for r in range(R):
-        for i in range(n):
-            xc[i] = x1[i, r]
-        for o in range(p):
-            acc = 0.0
+
+    def march_cells(Phi, WZ, F, K, edges, T, offset, base, w, g, xi, t, u, x1, x, Cc, Dc, y):
+        """States `x` and outputs `y` at the samples from the cells' data (module notes).
+
+        The input is held between samples: first order when ``WZ`` has 2m
+        columns (slopes ``σ_k = (u_{k+1} - u_k) / (t_{k+1} - t_k)``, zero after
+        the last sample; the kink at a sample is the change of slope), else
+        zero order (the kink is the jump ``u_k - u_{k-1}``).
+
+        Parameters
+        ----------
+        Phi : ndarray (N, n, n)
+            Whole cells' transitions.
+        WZ : ndarray (N, n, q)
+            Whole cells' W (and Z, first-order hold: q = 2m).
+        F : ndarray (N, D1, n, n + q)
+            Chebyshev coefficients of the first parts' [Φ W (Z)].
+        K : ndarray (N, D1, n, m)
+            Chebyshev coefficients of the kink's part.
+        edges : ndarray (N + 1,)
+        T, offset, base : float
+            Period, phase of the cells' origin, number of the period of t[0].
+        w : float
+            Width of equal cells: a sample's cell and fraction come from
+            ``r = (t - offset) / w - base N`` (cell ⌊r⌋, ξ = r - ⌊r⌋); 0: from
+            `g` and `xi`.
+        g : int64 ndarray (L,)
+            Cell of every sample (counted from the start of period `base`).
+        xi : ndarray (L,)
+            Fraction of its cell before every sample.
+        t : ndarray (L,)
+        u : ndarray (m, R, L)
+        x1 : ndarray (n, R)
+            State at the start of the cell after the first sample's.
+        x : ndarray (n, R, L)
+            States, written at samples 1 .. L-1 (sample 0 holds x0).
+        Cc, Dc : ndarray (p, n), (p, m)
+            Constant output matrices, or Cc with no rows: `y` is not written.
+        y : ndarray (p, R, L)
+            Outputs ``Cc x + Dc u``.
+
+        Returns
+        -------
+        bool
+            False when two samples fall in one cell (`x` and `y` incomplete).
+        """
+        N, R, L = Phi.shape[0], u.shape[1], t.shape[0]
+        # coefficients by phase and order, entries flat
+        FK = np.empty((N, D1, E))
+        FK[:, :, :n * nq] = F.reshape(N, D1, n * nq)
+        FK[:, :, n * nq:] = K.reshape(N, D1, n * m)
+        Td, z = np.empty(D1), np.empty(nq)
+        M = np.empty(E)
+        xc, fk = np.empty(n), np.empty(n)
+        slope, kink = np.zeros(m), np.empty(m)
+        shift = base * N
+        inv_w = 1.0 / w if w > 0.0 else 0.0
+        if w > 0.0:
+            r0 = (t[0] - offset) / w - shift
+            g0 = int(np.floor(r0))
+        else:
+            g0 = g[0]
+        for r in range(R):
             for i in range(n):
-                acc += Cc[o, i] * x[i, r, 0]
-            for l in range(m):
-                acc += Dc[o, l] * u[l, r, 0]
-            y[o, r, 0] = acc
-        if foh:
-            for l in range(m):
-                slope[l] = (u[l, r, 1] - u[l, r, 0]) / (t[1] - t[0])
-        c = g0 + 1                                       # the cell after sample 0's
-        ph, period = c % N, c // N                       # c = period N + ph
-        start = (base + period) * T + offset             # of the period
-        for k in range(1, L):
-            # the sample's cell and fraction
-            if w > 0.0:
-                # (a product: a sample on an edge may land on either side,
-                # with ξ = 1 or 0, which are the same instant)
-                rk = (t[k] - offset) * inv_w - shift
-                gk = int(np.floor(rk))
-                xk = rk - gk
-            else:
-                gk, xk = g[k], xi[k]
-            if gk < c:
-                return False                             # two samples in one cell
-            kp = k - 1
-            while True:
-                # the held input at the cell's start, from the last sample k - 1
+                xc[i] = x1[i, r]
+            for o in range(p):
+                acc = 0.0
                 for i in range(n):
-                    z[i] = xc[i]
-                    fk[i] = 0.0
-                if foh:
-                    tau = start + edges[ph]
-                    for l in range(m):
-                        z[n + l] = u[l, r, kp] + slope[l] * (tau - t[kp])
-                        z[n + m + l] = slope[l]
+                    acc += Cc[o, i] * x[i, r, 0]
+                for l in range(m):
+                    acc += Dc[o, l] * u[l, r, 0]
+                y[o, r, 0] = acc
+            if foh:
+                for l in range(m):
+                    slope[l] = (u[l, r, 1] - u[l, r, 0]) / (t[1] - t[0])
+            c = g0 + 1                                       # the cell after sample 0's
+            ph, period = c % N, c // N                       # c = period N + ph
+            start = (base + period) * T + offset             # of the period
+            for k in range(1, L):
+                # the sample's cell and fraction
+                if w > 0.0:
+                    # (a product: a sample on an edge may land on either side,
+                    # with ξ = 1 or 0, which are the same instant)
+                    rk = (t[k] - offset) * inv_w - shift
+                    gk = int(np.floor(rk))
+                    xk = rk - gk
                 else:
-                    for l in range(m):
-                        z[n + l] = u[l, r, kp]
-                if c == gk:
-                    # the sample's cell: the first part's [Φ W Z] and the kink's
-                    # part at ξ (sums over the orders, entries in the inner
-                    # loop), the state and output at the sample, the kink's
-                    # forcing
-                    for l in range(m):
-                        if foh:
-                            new = (u[l, r, k + 1] - u[l, r, k]) / (t[k + 1] - t[k]) \
-                                if k + 1 < L else 0.0
-                            kink[l] = new - slope[l]
-                            slope[l] = new
-                        else:
-                            kink[l] = u[l, r, k] - u[l, r, kp]
-                    sx = 2.0 * xk - 1.0
-                    Td[0] = 1.0
-                    if D1 > 1:
-                        Td[1] = sx
-                    for d in range(2, D1):
-                        Td[d] = 2.0 * sx * Td[d - 1] - Td[d - 2]
-                    for a in range(E):
-                        M[a] = FK[ph, 0, a]
-                    for d in range(1, D1):
-                        wd = Td[d]
+                    gk, xk = g[k], xi[k]
+                if gk < c:
+                    return False                             # two samples in one cell
+                kp = k - 1
+                while True:
+                    # the held input at the cell's start, from the last sample k - 1
+                    for i in range(n):
+                        z[i] = xc[i]
+                        fk[i] = 0.0
+                    if foh:
+                        tau = start + edges[ph]
+                        for l in range(m):
+                            z[n + l] = u[l, r, kp] + slope[l] * (tau - t[kp])
+                            z[n + m + l] = slope[l]
+                    else:
+                        for l in range(m):
+                            z[n + l] = u[l, r, kp]
+                    if c == gk:
+                        # the sample's cell: the first part's [Φ W Z] and the kink's
+                        # part at ξ (sums over the orders, entries in the inner
+                        # loop), the state and output at the sample, the kink's
+                        # forcing
+                        for l in range(m):
+                            if foh:
+                                new = (u[l, r, k + 1] - u[l, r, k]) / (t[k + 1] - t[k]) \
+                                    if k + 1 < L else 0.0
+                                kink[l] = new - slope[l]
+                                slope[l] = new
+                            else:
+                                kink[l] = u[l, r, k] - u[l, r, kp]
+                        sx = 2.0 * xk - 1.0
+                        Td[0] = 1.0
+                        if D1 > 1:
+                            Td[1] = sx
+                        for d in range(2, D1):
+                            Td[d] = 2.0 * sx * Td[d - 1] - Td[d - 2]
                         for a in range(E):
-                            M[a] += wd * FK[ph, d, a]
-                    for i in range(n):
-                        acc = 0.0
-                        for e in range(nq):
-                            acc += M[i * nq + e] * z[e]
-                        x[i, r, k] = acc
-                        acc = 0.0
-                        for l in range(m):
-                            acc += M[n * nq + i * m + l] * kink[l]
-                        fk[i] = acc
-                    for o in range(p):
-                        acc = 0.0
+                            M[a] = FK[ph, 0, a]
+                        for d in range(1, D1):
+                            wd = Td[d]
+                            for a in range(E):
+                                M[a] += wd * FK[ph, d, a]
                         for i in range(n):
-                            acc += Cc[o, i] * x[i, r, k]
-                        for l in range(m):
-                            acc += Dc[o, l] * u[l, r, k]
-                        y[o, r, k] = acc
-                if k + 1 < L or c < gk:
-                    # x(e_{c+1}) (not needed after the last sample)
-                    for i in range(n):
-                        acc = fk[i]
-                        for e in range(n):
-                            acc += Phi[ph, i, e] * z[e]
-                        for l in range(q):
-                            acc += WZ[ph, i, l] * z[n + l]
-                        xc[i] = acc
-                c += 1
-                ph += 1
-                if ph == N:
-                    ph, period = 0, period + 1
-                    start = (base + period) * T + offset
-                if c > gk:
-                    break
-    return True
+                            acc = 0.0
+                            for e in range(nq):
+                                acc += M[i * nq + e] * z[e]
+                            x[i, r, k] = acc
+                            acc = 0.0
+                            for l in range(m):
+                                acc += M[n * nq + i * m + l] * kink[l]
+                            fk[i] = acc
+                        for o in range(p):
+                            acc = 0.0
+                            for i in range(n):
+                                acc += Cc[o, i] * x[i, r, k]
+                            for l in range(m):
+                                acc += Dc[o, l] * u[l, r, k]
+                            y[o, r, k] = acc
+                    if k + 1 < L or c < gk:
+                        # x(e_{c+1}) (not needed after the last sample)
+                        for i in range(n):
+                            acc = fk[i]
+                            for e in range(n):
+                                acc += Phi[ph, i, e] * z[e]
+                            for l in range(q):
+                                acc += WZ[ph, i, l] * z[n + l]
+                            xc[i] = acc
+                    c += 1
+                    ph += 1
+                    if ph == N:
+                        ph, period = 0, period + 1
+                        start = (base + period) * T + offset
+                    if c > gk:
+                        break
+        return True
+
+    return march_cells

@@ -115,7 +115,7 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
         x1 += Zb[0] @ (u[:, :, 1] - u[:, :, 0]) / (t[1] - t[0])
     x = np.empty((n, R, len(t)))
     x[:, :, 0] = x0
-    kernel = _kernel(n, len(t))
+    kernel = _kernel(n, m, q, first.shape[1], C, D, len(t))
     if kernel is not None:
         marched = _compiled_march(kernel, table, WZ, first, kcoef, C, D, t, u, x1, x, base)
         if marched is not _UNAVAILABLE:
@@ -270,12 +270,14 @@ def _numpy_march(table, WZ, first, kcoef, t, u, x1, x, g, xi, base, hold):
                 np.take(xt[i, r], cs, out=x[i, r, ks], mode='clip')
 
 
-def _kernel(n, L):
+def _kernel(n, m, q, D1, C, D, L):
     """The compiled cell march when enabled, installed and worthwhile (`cellkernel`), else None."""
     if not (_get('timeresp.compiled') and L >= cellkernel.MIN_SAMPLES
             and n <= cellkernel.MAX_STATES):
         return None
-    return cellkernel.compiled_kernel()
+    # outputs in the loop for constant output matrices only
+    p = C.shape[0] if C.is_constant and D.is_constant else 0
+    return cellkernel.compiled_kernel(n, m, q, D1, p)
 
 
 def _equal_width(table):

@@ -37,14 +37,19 @@ def grid(seed):
 
 
 class Spy:
-    """Counts the calls of a kernel."""
+    """Stands for `compiled_kernel`: the loops of `make` (default: the
+    Python form) for any sizes, their calls counted."""
 
-    def __init__(self, kernel):
-        self.kernel, self.calls = kernel, 0
+    def __init__(self, make=cellkernel.march_kernel):
+        self.make, self.calls = make, 0
 
-    def __call__(self, *args):
-        self.calls += 1
-        return self.kernel(*args)
+    def __call__(self, *sizes):
+        loop = self.make(*sizes)
+
+        def counted(*args):
+            self.calls += 1
+            return loop(*args)
+        return counted
 
 
 def periodic_output(n, m, seed):
@@ -76,9 +81,9 @@ def test_kernel_equals_the_numpy_march(monkeypatch, make, n, m, hold, compiled):
     # located before; constant outputs in the loop, or periodic ones after
     if compiled:
         pytest.importorskip('numba')
-        kernel = cellkernel.compiled_kernel()
+        spy = Spy(cellkernel.compiled_kernel)
     else:
-        kernel = cellkernel.march_cells
+        spy = Spy()
     sys = make(n, m, seed=n + m)
     t = grid(n)
     rng = np.random.default_rng(1)
@@ -86,9 +91,8 @@ def test_kernel_equals_the_numpy_march(monkeypatch, make, n, m, hold, compiled):
     X0 = rng.normal(size=(n, 2))
     with ltp.config.defaults_context({'timeresp.compiled': False}):
         ref = ltp.forced_response(sys, t, U, X0, input_hold=hold)
-    spy = Spy(kernel)
     monkeypatch.setattr(cellkernel, 'MIN_SAMPLES', 0)
-    monkeypatch.setattr(cellkernel, 'compiled_kernel', lambda: spy)
+    monkeypatch.setattr(cellkernel, 'compiled_kernel', spy)
     resp = ltp.forced_response(sys, t, U, X0, input_hold=hold)
     assert spy.calls == 1
     assert rel(resp.states, ref.states) < 1e-13
@@ -107,8 +111,8 @@ def test_two_samples_in_one_cell_are_refused(monkeypatch):
     # layout is then made from every step
     monkeypatch.setattr(gridmarch, '_LAYOUT_STEPS', 100)
     monkeypatch.setattr(cellkernel, 'MIN_SAMPLES', 0)
-    spy = Spy(cellkernel.march_cells)
-    monkeypatch.setattr(cellkernel, 'compiled_kernel', lambda: spy)
+    spy = Spy()
+    monkeypatch.setattr(cellkernel, 'compiled_kernel', spy)
     sys = plant(2, 1, seed=6)
     t = grid(2)
     t[7] = t[6] + 0.2 / 40                            # not in the subsample
@@ -121,8 +125,8 @@ def test_two_samples_in_one_cell_are_refused(monkeypatch):
 
 
 def test_kernel_only_when_enabled_long_and_small(monkeypatch):
-    spy = Spy(cellkernel.march_cells)
-    monkeypatch.setattr(cellkernel, 'compiled_kernel', lambda: spy)
+    spy = Spy()
+    monkeypatch.setattr(cellkernel, 'compiled_kernel', spy)
     sys, t = plant(2, 1, seed=3), grid(2)
     u = np.cos(3.0 * t)
     monkeypatch.setattr(cellkernel, 'MIN_SAMPLES', len(t) + 1)      # too short
@@ -147,9 +151,11 @@ def test_without_numba_the_numpy_march_runs(monkeypatch):
             raise ImportError('numba')
         return real_import(name, *args, **kwargs)
     monkeypatch.setattr(builtins, '__import__', no_numba)
-    monkeypatch.setattr(cellkernel, '_COMPILED', None)
+    monkeypatch.setattr(cellkernel, '_COMPILED', {})
     monkeypatch.setattr(cellkernel, 'MIN_SAMPLES', 0)
-    assert cellkernel.compiled_kernel() is None
+    monkeypatch.setattr(cellkernel.importlib.util, 'find_spec', lambda name: None)
+    assert not cellkernel.available()
+    assert cellkernel.compiled_kernel(2, 1, 2, 7, 1) is None
     sys, t = plant(2, 1, seed=4), grid(3)
     u = np.sin(2.0 * t)
     resp = ltp.forced_response(sys, t, u)
@@ -161,14 +167,24 @@ def test_without_numba_the_numpy_march_runs(monkeypatch):
 def test_a_kernel_numba_cannot_compile_falls_back_to_numpy(monkeypatch):
     def broken(*args):
         raise RuntimeError('no LLVM here')
+
+    class Broken(dict):
+        """A loop for any sizes, which fails as numba's compilation would."""
+
+        def __contains__(self, sizes):
+            return True
+
+        def __getitem__(self, sizes):
+            return cellkernel._guarded(broken)
     monkeypatch.setattr(cellkernel, 'MIN_SAMPLES', 0)
-    monkeypatch.setattr(cellkernel, '_COMPILED', cellkernel._guarded(broken))
+    monkeypatch.setattr(cellkernel, '_COMPILED', Broken())
     sys, t = plant(2, 1, seed=5), grid(2)
     u = np.cos(1.5 * t)
     with pytest.warns(UserWarning, match='simulating with NumPy'):
         resp = ltp.forced_response(sys, t, u)
     assert cellkernel._COMPILED is False
-    assert cellkernel.compiled_kernel() is None
+    assert cellkernel.compiled_kernel(2, 1, 2, 7, 1) is None
+    assert not cellkernel.available()
     with ltp.config.defaults_context({'timeresp.compiled': False}):
         ref = ltp.forced_response(sys, t, u)
     assert np.array_equal(resp.outputs, ref.outputs)
