@@ -55,7 +55,7 @@ from .celldata import _chebyshev_basis
 
 __all__ = []
 
-_CHUNK_ENTRIES = 2 ** 21       # entries of a chunk's arrays
+_CHUNK_ENTRIES = 2 ** 18       # entries of a chunk's arrays (fresh memory pages cost)
 _FEW_COLUMNS = 8              # constant output matrices with fewer columns: rows summed
 _CELL_ENTRIES = 2 ** 19        # entries of a block of phases of the cell march (cache-sized)
 
@@ -122,7 +122,7 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
             return marched if marched is None else ((x if states else None), marched)
     # the NumPy march
     g, xi, base = _cells_of_samples(table, t)
-    if np.any(np.diff(g) == 0):
+    if np.any(g[1:] == g[:-1]):
         return None                     # two samples in one cell: not this table
     _numpy_march(table, WZ, first, kcoef, t, u, x1, x, g, xi, base, hold)
     return (x if states else None), outputs(C, D, t, x, u)
@@ -167,21 +167,6 @@ def _numpy_march(table, WZ, first, kcoef, t, u, x1, x, g, xi, base, hold):
     (n, R, L), m = x.shape, u.shape[0]
     N, D1, q = WZ.shape[0], first.shape[1], WZ.shape[2]
     g0, P = int(g[0]), int(g[-1]) // N + 1
-    # slopes of the held input on [t_k, t_{k+1}) (zero after the last sample)
-    sigma = np.zeros((m, R, L))
-    if hold == 'foh':
-        sigma[:, :, :-1] = np.diff(u, axis=2) / np.diff(t)
-    # the last sample before every cell of the record (a sample at a cell's
-    # start is counted in the cell: its jump below makes up the difference);
-    # for the cell of sample k that is k - 1, so the kink there, the jump
-    # (zero-order hold) or the change of slope (first-order hold: the input is
-    # continuous), is a difference of consecutive samples
-    last = np.cumsum(np.bincount(g, minlength=P * N)) - 1
-    last[1:] = last[:-1]
-    last[0] = 0
-    np.maximum(last, 0, out=last)
-    kink = np.zeros((m, R, L))
-    kink[:, :, 1:] = np.diff(sigma if hold == 'foh' else u, axis=2)
     # the first part's data applied to (x, a, σ) as entries when those are
     # fewer numbers (n + q <= D1) than their products with (x, a, σ) at the
     # D1 orders, which are formed otherwise
@@ -207,14 +192,33 @@ def _numpy_march(table, WZ, first, kcoef, t, u, x1, x, g, xi, base, hold):
         k0, k1 = np.searchsorted(g, [c0, c1])
         ks = slice(max(k0, 1), k1)
         cs = g[ks] - c0                                     # the samples' cells
+        # the samples s0 = ks.start - 1 .. k1 - 1 (the one before the chunk's
+        # cells on): the slopes of the held input on [t_k, t_{k+1}) (zero
+        # after the last sample) and the kinks at ks, the jumps (zero-order
+        # hold) or the changes of slope (first order: the input is continuous)
+        s0 = ks.start - 1
+        us, ts = u[:, :, s0:k1], t[s0:k1]
+        sigma = np.zeros_like(us)
+        if hold == 'foh':
+            e = min(k1 + 1, L)
+            np.divide(np.diff(u[:, :, s0:e], axis=2), np.diff(t[s0:e]),
+                      out=sigma[:, :, :e - s0 - 1])
+        kink = np.diff(sigma if hold == 'foh' else us, axis=2)
+        # the last sample before every cell, counted from s0 (a sample at a
+        # cell's start is counted in the cell: its kink makes up the
+        # difference; cells up to sample 0's take no input, below)
+        kc = np.empty(Pc * N, np.int64)
+        kc[0] = 0
+        np.cumsum(np.bincount(cs, minlength=Pc * N)[:-1], out=kc[1:])
         z = np.empty((N, n + q, Pc, R))
-        kc = last[c0:c1]
-        held = u[:, :, kc]
+        held = us[:, :, kc]
         if hold == 'foh':
             # the held input at the cells' starts τ: a = u_k + σ_k (τ - t_k)
             tau = ((base + p0 + np.arange(Pc)) * T + table.offset)[:, None] + edges[:-1]
+            tau = tau.reshape(-1)
+            tau -= ts[kc]
             sk = sigma[:, :, kc]
-            held += sk * (tau.reshape(-1) - t[kc])
+            held += sk * tau
             z[:, n + m:] = sk.reshape(m, R, Pc, N).transpose(3, 0, 2, 1)
         z[:, n:n + m] = held.reshape(m, R, Pc, N).transpose(3, 0, 2, 1)
         if c0 <= g0:
@@ -225,7 +229,7 @@ def _numpy_march(table, WZ, first, kcoef, t, u, x1, x, g, xi, base, hold):
         sgrid[cs] = 2 * xi[ks] - 1
         sgrid = np.ascontiguousarray(sgrid.reshape(Pc, N).T)
         kgrid = np.zeros((m, R, Pc * N))
-        kgrid[:, :, cs] = kink[:, :, ks]
+        kgrid[:, :, cs] = kink
         kgrid = np.ascontiguousarray(kgrid.reshape(m, R, Pc, N).transpose(0, 3, 2, 1))
         f = np.empty((N, n, Pc, R))
         Tk = np.empty((D1, N, Pc))                     # by order: contiguous rows

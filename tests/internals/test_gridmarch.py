@@ -180,11 +180,14 @@ def test_cell_layout_holds_one_sample_per_cell():
             assert N == 400
 
 
-@pytest.mark.parametrize("n, m, hold", [(2, 1, 'foh'), (2, 1, 'zoh'), (6, 2, 'foh')])
-def test_cell_march_in_chunks_equals_the_per_step_march(monkeypatch, n, m, hold):
+@pytest.mark.parametrize("n, m, hold, gap", [(2, 1, 'foh', False), (2, 1, 'zoh', False),
+                                             (6, 2, 'foh', False), (2, 1, 'foh', True),
+                                             (2, 1, 'zoh', True)])
+def test_cell_march_in_chunks_equals_the_per_step_march(monkeypatch, n, m, hold, gap):
     # both ways to the samples' states (entries of the first parts, or their
     # products with the states: n + 2m below or above the table's D + 1),
-    # two traces, periods taken one chunk at a time or all at once
+    # two traces, periods taken one chunk at a time or all at once; with a
+    # gap of three periods without samples (chunks holding none)
     import ltpcontrol._core.cellmarch as cellmarch
     rng = np.random.default_rng(n + m)
     c = 0.4 * rng.normal(size=(3, n, n)) + 0.4j * rng.normal(size=(3, n, n))
@@ -194,6 +197,8 @@ def test_cell_march_in_chunks_equals_the_per_step_march(monkeypatch, n, m, hold)
                     rng.normal(size=(1, n)), 0, period=1.0)
     t = np.arange(1201) / 40 + 0.1
     t[1:-1] += rng.uniform(-0.2, 0.2, 1199) / 40
+    if gap:
+        t = np.delete(t, np.arange(400, 521))
     U = rng.normal(size=(m, 2, len(t)))
     X0 = rng.normal(size=(n, 2))
     whole = ltp.forced_response(sys, t, U, X0, input_hold=hold)
