@@ -413,18 +413,30 @@ class CellTable:
         xi = np.clip(length / self.lens[j], 0.0, 1.0)
         return _chebyshev_basis(2 * xi - 1, len(self.frac))
 
-    def coefficients(self, values, reverse=False):
+    def coefficients(self, values, reverse=False, out=None):
         """Chebyshev coefficients in ξ of a table (N, D + 1, ...) at the lengths.
 
         With `reverse` those of the table read at ``1 - ξ`` (the last parts'
-        data at the first part's length: ``T_k(-s) = (-1)^k T_k(s)``).
+        data at the first part's length: ``T_k(-s) = (-1)^k T_k(s)``).  With
+        `out` (same shape, any strides) they are written there; a large
+        table order by order, with no temporary of its size.
         """
         N, D1 = values.shape[:2]
-        flat = np.ascontiguousarray(values).reshape(N, D1, -1)
-        out = np.matmul(self._to_coeffs, flat)                               # (N, D+1, ...)
+        M = self._to_coeffs
         if reverse:
-            out *= ((-1.0) ** np.arange(D1))[:, None]
-        return out.reshape(values.shape)
+            M = M * ((-1.0) ** np.arange(D1))[:, None]
+        if out is not None and values.size > _CHUNK_ENTRIES:
+            for k in range(D1):
+                np.multiply(values[:, 0], M[k, 0], out=out[:, k])
+                for i in range(1, D1):
+                    out[:, k] += M[k, i] * values[:, i]
+            return out
+        flat = np.ascontiguousarray(values).reshape(N, D1, -1)
+        coeffs = np.matmul(M, flat).reshape(values.shape)                     # (N, D+1, ...)
+        if out is None:
+            return coeffs
+        out[...] = coeffs
+        return out
 
     def first(self, j, length, parts=(0, 1, 2)):
         """(Φ, W, Z) (or the `parts` asked for) of ``[e_j, e_j + length]``."""

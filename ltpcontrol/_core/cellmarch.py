@@ -57,6 +57,7 @@ __all__ = []
 
 _CHUNK_ENTRIES = 2 ** 18       # entries of a chunk's arrays (fresh memory pages cost)
 _FEW_COLUMNS = 8              # constant output matrices with fewer columns: rows summed
+_FEW_HARMONICS = 16           # Fourier output matrices with at most these harmonics: by harmonic
 _CELL_ENTRIES = 2 ** 19        # entries of a block of phases of the cell march (cache-sized)
 
 
@@ -103,7 +104,11 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     # for the state at the sample
     WZ = np.concatenate([table.fwd[1][:, -1], table.fwd[2][:, -1]], axis=2)[:, :, :q]
     kpart = table.bwd[2] if hold == 'foh' else table.bwd[1]                 # (N, D1, n, m)
-    first = table.coefficients(np.concatenate(table.fwd, axis=3)[..., :n + q])  # (N, D1, n, n+q)
+    D1 = len(table.frac)
+    first = np.empty((N, D1, n, n + q))
+    for part, cols in enumerate((slice(0, n), slice(n, n + m), slice(n + m, n + q))):
+        if cols.stop > cols.start:
+            table.coefficients(table.fwd[part], out=first[..., cols])
     kcoef = table.coefficients(kpart, reverse=True)
     # the first sample: its cell's last part carries x0 to the next cell,
     # entered as the forcing of the cell after it (earlier cells force nothing)
@@ -333,6 +338,15 @@ def outputs(C, D, t, x, u):
     for s0 in range(0, L, chunk):
         i = slice(s0, s0 + chunk)
         for M, v in ((C, x), (D, u)):
+            if not M.is_constant and (M.nharmonics or _FEW_HARMONICS + 1) <= _FEW_HARMONICS:
+                # a Fourier series: M(t) v = M_0 v + 2 Re Σ_k e^{jkωt} (M_k v)
+                K = M.nharmonics
+                Mk = M.fourier(K)
+                y[:, :, i] += np.tensordot(Mk[K].real, v[:, :, i], axes=1)
+                for k in range(1, K + 1):
+                    w = np.exp(1j * k * M.omega_p * t[i])
+                    y[:, :, i] += 2 * (np.tensordot(Mk[K + k], v[:, :, i], axes=1) * w).real
+                continue
             if not M.is_constant:
                 y[:, :, i] += _apply(M(t[i]), v[:, :, i])
                 continue

@@ -56,12 +56,16 @@ from .celldata import (_ENTRYWISE_STATES, CellSamples, CellTable, _entries_produ
                        interpolate, lobatto)
 from .cellmarch import cell_march
 from .march import periodic_march
+from .memory import available_memory
 from .threads import small_blas
 from .transition import step_transitions
 
 __all__ = []
 
-_CHUNK_STEPS = 4000          # steps of step data held at a time
+_CHUNK_STEPS = 4000          # steps of step data held at a time ...
+_CHUNK_BYTES = 2 ** 26       # ... with at most this many bytes in one array of them
+_TABLE_SHARE = 0.5           # most of the available memory a cell table may take
+_TABLE_COPIES = 4            # arrays of a cell table's size alive while it is made and used
 _FEW_TRACES = 16             # up to this many traces: march state by state
 _SEQ_BLOCK = 32              # block length of that march
 _MAX_CELLS = 2 ** 15         # cells of the phase table
@@ -199,12 +203,14 @@ def _chunked_march(steps, C, D, t, u, x0, hold, states):
     """March chunk after chunk of step data, each chunk as one 'period'."""
     L = len(t)
     n, R = x0.shape
-    p = C.shape[0]
+    p, d = C.shape[0], n + 2 * u.shape[0]
     x = np.empty((n, R, L)) if states else None
     y = np.empty((p, R, L))
     xs = x0
-    for s0 in range(0, L, _CHUNK_STEPS):
-        s1 = min(L, s0 + _CHUNK_STEPS)
+    # chunks whose step data (and augmented matrices d x d) stay within _CHUNK_BYTES
+    chunk = max(20, min(_CHUNK_STEPS, _CHUNK_BYTES // (8 * d * d)))
+    for s0 in range(0, L, chunk):
+        s1 = min(L, s0 + chunk)
         S = s1 - s0
         k1 = min(s1, L - 1)                    # step data exist for samples < L - 1
         Phi, G0, G1 = steps(s0, k1)
@@ -381,6 +387,13 @@ def _cell_table(A, B, h, T, rtol, t=None, stride=1):
     else:
         return None
     frac, nsub = config
+    # the table's parts at the D + 1 lengths of every cell, (n, n + 2m) each:
+    # for large models on fine grids more than the memory holds (the step by
+    # step march then runs in chunks of bounded size)
+    need = _TABLE_COPIES * 8.0 * len(cells.lens) * len(frac) * cells.n * (cells.n + 2 * cells.m)
+    avail = available_memory()
+    if avail is not None and need > _TABLE_SHARE * avail:
+        return None
     fwd, bwd = _partial_table(cells, frac, nsub)
     return CellTable(cells.edges, cells.lens, frac, fwd, bwd, offset)
 
@@ -592,8 +605,12 @@ def _partial_table(cells, frac, nsub, which=None):
         product(col(bwd[i], Ph), S[k], bwd[i + 1])
         col(bwd[i + 1], W)[...] += col(bwd[i], W)
         col(bwd[i + 1], Z)[...] += col(bwd[i], Z) + dd[k] * col(bwd[i], W)
+    # to (cells, D + 1, n, d), one at a time (at most three arrays of the
+    # table's size alive)
+    del S, E
     order = (3, 0, 1, 2) if entrywise else (1, 0, 2, 3)
-    fwd, bwd = (np.ascontiguousarray(v.transpose(order)) for v in (fwd, bwd))
+    fwd = np.ascontiguousarray(fwd.transpose(order))
+    bwd = np.ascontiguousarray(bwd.transpose(order))
     return (fwd[..., :n], fwd[..., W], fwd[..., Z]), (bwd[..., :n], bwd[..., W], bwd[..., Z])
 
 

@@ -73,6 +73,28 @@ def test_nonuniform_grid_and_chunks(monkeypatch):
     assert rel(resp.outputs[:40], short.outputs) < 1e-8
 
 
+def test_a_cell_table_larger_than_the_memory_gives_way_to_bounded_chunks(monkeypatch):
+    # a jittered grid whose cell table would take more than half the memory
+    # available: the steps are integrated one by one, in chunks whose arrays
+    # stay within _CHUNK_BYTES (here 20 steps), with the same result
+    import ltpcontrol._core.cellmarch as cellmarch
+    rng = np.random.default_rng(8)
+    sys = ltp.ltpss(ltp.PeriodicMatrix([[[0.1, 0.0], [0.2, 0.0]], [[0.0, 1.0], [-4.0, -0.4]],
+                                        [[0.1, 0.0], [0.2, 0.0]]], 1.0),
+                    [[0.0], [1.0]], [[1.0, 0.0]], 0, period=1.0)
+    t = np.arange(600) / 40 + rng.uniform(-0.2, 0.2, 600) / 40
+    u = np.cos(2.1 * t)
+    table = ltp.forced_response(sys, t, u)
+    marches = []
+    monkeypatch.setattr(cellmarch, '_numpy_march', lambda *a: marches.append(a))
+    monkeypatch.setattr(gridmarch, 'available_memory', lambda: 10 ** 4)
+    monkeypatch.setattr(gridmarch, '_CHUNK_BYTES', 8 * 4 * 4 * 20)
+    chunked = ltp.forced_response(sys, t, u)
+    assert not marches
+    assert rel(chunked.states, table.states) < 1e-11
+    assert rel(chunked.outputs, table.outputs) < 1e-11
+
+
 @settings(derandomize=True, max_examples=12, deadline=None, database=None)
 @given(ratio=st.floats(0.011, 0.3), t0=st.floats(0.0, 3.0), n=st.integers(20, 400))
 def test_any_uniform_grid_matches_per_step_data(ratio, t0, n):
