@@ -13,6 +13,7 @@ the cells of the record, compiled once per environment (cached on disk):
         if sample k lies in the cell (ξ = (t_k - e_c) / h_c):
             x(t_k) = Σ_d T_d(2ξ - 1) F_{j,d} z
             f      = Σ_d T_d(2ξ - 1) K_{j,d} kink_k
+            y(t_k) = C(t_k) x(t_k) + D(t_k) u_k    (C, D Fourier series or constant)
         x(e_{c+1}) = Φ_j x(e_c) + [W_j Z_j] (a_c, σ_c) + f
 
 with the coefficients of `cell_march` (F those of the first part's
@@ -44,7 +45,7 @@ MAX_STATES = 16
 _COMPILED = {}
 
 
-def compiled_kernel(n, m, q, D1, p):
+def compiled_kernel(n, m, q, D1, p, H=0):
     """The compiled loop for these sizes (`march_kernel`), or None without numba.
 
     The sizes are compile-time constants of the loop (its small loops
@@ -54,14 +55,14 @@ def compiled_kernel(n, m, q, D1, p):
     Examples
     --------
     >>> from ltpcontrol._core.cellkernel import compiled_kernel
-    >>> kernel = compiled_kernel(2, 1, 2, 7, 1)
+    >>> kernel = compiled_kernel(2, 1, 2, 7, 1, 0)
     >>> kernel is None or callable(kernel)
     True
     """
     global _COMPILED
     if _COMPILED is False:
         return None
-    sizes = (int(n), int(m), int(q), int(D1), int(p))
+    sizes = (int(n), int(m), int(q), int(D1), int(p), int(H))
     if sizes not in _COMPILED:
         try:
             import numba
@@ -102,10 +103,11 @@ def _guarded(kernel):
     return call
 
 
-def march_kernel(n, m, q, D1, p):
+def march_kernel(n, m, q, D1, p, H=0):
     """`march_cells` for n states, m inputs, q = m (zero-order hold) or 2m
-    (first-order hold) forcing columns, D1 Chebyshev orders and p output rows
-    (0: outputs not written), the sizes fixed (a closure), as Python.
+    (first-order hold) forcing columns, D1 Chebyshev orders, p output rows
+    (0: outputs not written) and output matrices of H harmonics, the sizes
+    fixed (a closure), as Python.
 
     Examples
     --------
@@ -113,26 +115,26 @@ def march_kernel(n, m, q, D1, p):
     constant input held: the state grows as t.
 
     >>> from ltpcontrol._core.cellkernel import march_kernel
-    >>> march_cells = march_kernel(1, 1, 1, 2, 1)
+    >>> march_cells = march_kernel(1, 1, 1, 2, 1, 0)
     >>> Phi, WZ = np.ones((2, 1, 1)), np.full((2, 1, 1), 0.5)
     >>> F = np.zeros((2, 2, 1, 2)); F[:, 0, 0, 0] = 1.0        # Φ_f = 1
     >>> F[:, 0, 0, 1], F[:, 1, 0, 1] = 0.25, 0.25             # W_f = ℓ = (1 + T_1) / 4
     >>> K = np.zeros((2, 2, 1, 1))
     >>> t = np.array([0.0, 0.8, 1.3])
     >>> x, y = np.zeros((1, 1, 3)), np.zeros((1, 1, 3))
+    >>> Cs, Ds = np.full((2, 1, 1, 1), 2.0), np.zeros((2, 1, 1, 1))   # y = 2x
     >>> march_cells(Phi, WZ, F, K, np.array([0.0, 0.5, 1.0]), 1.0, 0.0, 0.0, 0.5,
     ...             np.array([0]), np.zeros(1), t, np.ones((1, 1, 3)), np.array([[0.5]]),
-    ...             x, np.array([[2.0]]), np.zeros((1, 1)), y)
+    ...             x, Cs, Ds, 2 * np.pi, y)
     True
-    >>> x[0, 0], y[0, 0]
-    (array([0. , 0.8, 1.3]), array([0. , 1.6, 2.6]))
+    >>> x[0, 0], y[0, 0, 1:]                                  # (y at t[0] not written)
+    (array([0. , 0.8, 1.3]), array([1.6, 2.6]))
     """
     nq = n + q
     foh = q == 2 * m
-    # coefficient entries: [F[j, d, i nq + e] | K[j, d, i m + l]]
-    E = n * nq + n * m
 
-    def march_cells(Phi, WZ, F, K, edges, T, offset, base, w, g, xi, t, u, x1, x, Cc, Dc, y):
+    def march_cells(Phi, WZ, F, K, edges, T, offset, base, w, g, xi, t, u, x1, x, Cs, Ds, omega,
+                    y):
         """States `x` and outputs `y` at the samples from the cells' data (module notes).
 
         The input is held between samples: first order when ``WZ`` has 2m
@@ -167,10 +169,13 @@ def march_kernel(n, m, q, D1, p):
             State at the start of the cell after the first sample's.
         x : ndarray (n, R, L)
             States, written at samples 1 .. L-1 (sample 0 holds x0).
-        Cc, Dc : ndarray (p, n), (p, m)
-            Constant output matrices, or Cc with no rows: `y` is not written.
+        Cs, Ds : ndarray (2, H + 1, p, n), (2, H + 1, p, m)
+            Output matrices as real Fourier series: ``C(t) = Σ_h Cs[0, h]
+            cos hωt + Cs[1, h] sin hωt`` (and D), h = 0..H.
+        omega : float
+            Their fundamental ω.
         y : ndarray (p, R, L)
-            Outputs ``Cc x + Dc u``.
+            Outputs ``C(t) x + D(t) u`` at the samples 1 .. L-1 (p = 0: none).
 
         Returns
         -------
@@ -178,12 +183,9 @@ def march_kernel(n, m, q, D1, p):
             False when two samples fall in one cell (`x` and `y` incomplete).
         """
         N, R, L = Phi.shape[0], u.shape[1], t.shape[0]
-        # coefficients by phase and order, entries flat
-        FK = np.empty((N, D1, E))
-        FK[:, :, :n * nq] = F.reshape(N, D1, n * nq)
-        FK[:, :, n * nq:] = K.reshape(N, D1, n * m)
         Td, z = np.empty(D1), np.empty(nq)
-        M = np.empty(E)
+        cs, sn = np.zeros(H + 1), np.zeros(H + 1)
+        cs[0] = 1.0
         xc, fk = np.empty(n), np.empty(n)
         slope, kink = np.zeros(m), np.empty(m)
         shift = base * N
@@ -196,13 +198,6 @@ def march_kernel(n, m, q, D1, p):
         for r in range(R):
             for i in range(n):
                 xc[i] = x1[i, r]
-            for o in range(p):
-                acc = 0.0
-                for i in range(n):
-                    acc += Cc[o, i] * x[i, r, 0]
-                for l in range(m):
-                    acc += Dc[o, l] * u[l, r, 0]
-                y[o, r, 0] = acc
             if foh:
                 for l in range(m):
                     slope[l] = (u[l, r, 1] - u[l, r, 0]) / (t[1] - t[0])
@@ -236,10 +231,9 @@ def march_kernel(n, m, q, D1, p):
                         for l in range(m):
                             z[n + l] = u[l, r, kp]
                     if c == gk:
-                        # the sample's cell: the first part's [Φ W Z] and the kink's
-                        # part at ξ (sums over the orders, entries in the inner
-                        # loop), the state and output at the sample, the kink's
-                        # forcing
+                        # the sample's cell: the state at the sample, Σ_d T_d (F_d z),
+                        # and the kink's forcing, Σ_d T_d (K_d kink) (each order's
+                        # products summed in registers), and the output
                         for l in range(m):
                             if foh:
                                 new = (u[l, r, k + 1] - u[l, r, k]) / (t[k + 1] - t[k]) \
@@ -248,34 +242,45 @@ def march_kernel(n, m, q, D1, p):
                                 slope[l] = new
                             else:
                                 kink[l] = u[l, r, k] - u[l, r, kp]
-                        sx = 2.0 * xk - 1.0
+                        s = 2.0 * xk - 1.0
                         Td[0] = 1.0
                         if D1 > 1:
-                            Td[1] = sx
+                            Td[1] = s
                         for d in range(2, D1):
-                            Td[d] = 2.0 * sx * Td[d - 1] - Td[d - 2]
-                        for a in range(E):
-                            M[a] = FK[ph, 0, a]
-                        for d in range(1, D1):
-                            wd = Td[d]
-                            for a in range(E):
-                                M[a] += wd * FK[ph, d, a]
+                            Td[d] = 2.0 * s * Td[d - 1] - Td[d - 2]
                         for i in range(n):
-                            acc = 0.0
-                            for e in range(nq):
-                                acc += M[i * nq + e] * z[e]
+                            acc, acck = 0.0, 0.0
+                            for d in range(D1):
+                                sx = 0.0
+                                for e in range(nq):
+                                    sx += F[ph, d, i, e] * z[e]
+                                sk = 0.0
+                                for l in range(m):
+                                    sk += K[ph, d, i, l] * kink[l]
+                                acc += Td[d] * sx
+                                acck += Td[d] * sk
                             x[i, r, k] = acc
-                            acc = 0.0
-                            for l in range(m):
-                                acc += M[n * nq + i * m + l] * kink[l]
-                            fk[i] = acc
-                        for o in range(p):
-                            acc = 0.0
-                            for i in range(n):
-                                acc += Cc[o, i] * x[i, r, k]
-                            for l in range(m):
-                                acc += Dc[o, l] * u[l, r, k]
-                            y[o, r, k] = acc
+                            fk[i] = acck
+                        if p > 0:
+                            # cos hωt, sin hωt by the recurrence of the multiple angles
+                            if H > 0:
+                                angle = omega * t[k]
+                                cs[1], sn[1] = np.cos(angle), np.sin(angle)
+                                for h in range(2, H + 1):
+                                    cs[h] = 2.0 * cs[1] * cs[h - 1] - cs[h - 2]
+                                    sn[h] = 2.0 * cs[1] * sn[h - 1] - sn[h - 2]
+                            for o in range(p):
+                                acc = 0.0
+                                for h in range(H + 1):
+                                    a0, a1 = 0.0, 0.0
+                                    for i in range(n):
+                                        a0 += Cs[0, h, o, i] * x[i, r, k]
+                                        a1 += Cs[1, h, o, i] * x[i, r, k]
+                                    for l in range(m):
+                                        a0 += Ds[0, h, o, l] * u[l, r, k]
+                                        a1 += Ds[1, h, o, l] * u[l, r, k]
+                                    acc += cs[h] * a0 + sn[h] * a1
+                                y[o, r, k] = acc
                     if k + 1 < L or c < gk:
                         # x(e_{c+1}) (not needed after the last sample)
                         for i in range(n):

@@ -120,9 +120,13 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
         x1 += Zb[0] @ (u[:, :, 1] - u[:, :, 0]) / (t[1] - t[0])
     x = np.empty((n, R, len(t)))
     x[:, :, 0] = x0
-    kernel = _kernel(n, m, q, first.shape[1], C, D, len(t))
+    # output matrices as real Fourier series (constant: H = 0) are applied in the loop
+    series = _real_series(C, D)
+    kernel = _kernel(n, m, q, first.shape[1], C.shape[0] if series else 0,
+                     series[0].shape[1] - 1 if series else 0, len(t))
     if kernel is not None:
-        marched = _compiled_march(kernel, table, WZ, first, kcoef, C, D, t, u, x1, x, base)
+        marched = _compiled_march(kernel, table, WZ, first, kcoef, C, D, series, t, u, x1, x,
+                                  base)
         if marched is not _UNAVAILABLE:
             return marched if marched is None else ((x if states else None), marched)
     # the NumPy march
@@ -137,7 +141,7 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
 _UNAVAILABLE = object()
 
 
-def _compiled_march(kernel, table, WZ, first, kcoef, C, D, t, u, x1, x, base):
+def _compiled_march(kernel, table, WZ, first, kcoef, C, D, series, t, u, x1, x, base):
     """States (into `x`) and outputs by the compiled loop (`cellkernel`).
 
     Returns the outputs, None when two samples share a cell, or
@@ -150,20 +154,21 @@ def _compiled_march(kernel, table, WZ, first, kcoef, C, D, t, u, x1, x, base):
         g, xi = np.zeros(1, np.int64), np.zeros(1)
     else:
         g, xi, _ = _cells_of_samples(table, t)
-    # constant output matrices: the outputs in the loop too
-    const = C.is_constant and D.is_constant
-    Cc, Dc = (C(t[0]), D(t[0])) if const else (np.zeros((0, n)), np.zeros((0, m)))
-    y = np.empty((len(Cc), R, L))
+    # output matrices as Fourier series: the outputs in the loop too (but at t[0])
+    Cs, Ds = series if series else (np.zeros((2, 1, 0, n)), np.zeros((2, 1, 0, m)))
+    y = np.empty((Cs.shape[2], R, L))
     ok = kernel(np.ascontiguousarray(table.fwd[0][:, -1]), np.ascontiguousarray(WZ),
                 np.ascontiguousarray(first), np.ascontiguousarray(kcoef), table.edges,
                 float(table.edges[-1]), table.offset, float(base), w, g, xi, t,
-                np.ascontiguousarray(u), x1, x, np.ascontiguousarray(Cc, float),
-                np.ascontiguousarray(Dc, float), y)
+                np.ascontiguousarray(u), x1, x, Cs, Ds, float(C.omega_p), y)
     if ok is None:
         return _UNAVAILABLE
     if not ok:
         return None                     # two samples in one cell: not this table
-    return y if const else outputs(C, D, t, x, u)
+    if not series:
+        return outputs(C, D, t, x, u)
+    y[:, :, 0] = C(t[0]) @ x[:, :, 0] + D(t[0]) @ u[:, :, 0]
+    return y
 
 
 def _numpy_march(table, WZ, first, kcoef, t, u, x1, x, g, xi, base, hold):
@@ -279,14 +284,41 @@ def _numpy_march(table, WZ, first, kcoef, t, u, x1, x, g, xi, base, hold):
                 np.take(xt[i, r], cs, out=x[i, r, ks], mode='clip')
 
 
-def _kernel(n, m, q, D1, C, D, L):
+def _kernel(n, m, q, D1, p, H, L):
     """The compiled cell march when enabled, installed and worthwhile (`cellkernel`), else None."""
     if not (_get('timeresp.compiled') and L >= cellkernel.MIN_SAMPLES
             and n <= cellkernel.MAX_STATES):
         return None
-    # outputs in the loop for constant output matrices only
-    p = C.shape[0] if C.is_constant and D.is_constant else 0
-    return cellkernel.compiled_kernel(n, m, q, D1, p)
+    return cellkernel.compiled_kernel(n, m, q, D1, p, H)
+
+
+def _real_series(C, D):
+    """``(Cs, Ds)``: C and D as real Fourier series of H harmonics (2, H + 1, rows, cols),
+    ``M(t) = Σ_h Ms[0, h] cos hωt + Ms[1, h] sin hωt``; None unless both are
+    Fourier series (or constant) of at most `_FEW_HARMONICS` harmonics.
+
+    Examples
+    --------
+    >>> from ltpcontrol._core.cellmarch import _real_series
+    >>> C = ltp.PeriodicMatrix([[[0.5j]], [[1.0]], [[-0.5j]]], 1.0)       # 1 + sin ωt
+    >>> Cs, Ds = _real_series(C, ltp.PeriodicMatrix.constant([[0.0]], 1.0))
+    >>> Cs[:, :, 0, 0]
+    array([[1., 0.],
+           [0., 1.]])
+    """
+    Hs = [M.nharmonics for M in (C, D)]
+    if None in Hs or max(Hs) > _FEW_HARMONICS:
+        return None
+    H = max(Hs)
+    out = []
+    for M in (C, D):
+        c = M.fourier(H)                                   # M_k, k = -H..H
+        s = np.zeros((2, H + 1) + M.shape)
+        s[0, 0] = c[H].real
+        s[0, 1:] = 2 * c[H + 1:].real                      # 2 Re M_k e^{jkωt}
+        s[1, 1:] = -2 * c[H + 1:].imag
+        out.append(s)
+    return tuple(out)
 
 
 def _equal_width(table):
@@ -339,13 +371,16 @@ def outputs(C, D, t, x, u):
         i = slice(s0, s0 + chunk)
         for M, v in ((C, x), (D, u)):
             if not M.is_constant and (M.nharmonics or _FEW_HARMONICS + 1) <= _FEW_HARMONICS:
-                # a Fourier series: M(t) v = M_0 v + 2 Re Σ_k e^{jkωt} (M_k v)
+                # a Fourier series: M(t) v = M_0 v + 2 Σ_k (Re M_k v cos kωt - Im M_k v sin kωt),
+                # the products with v in one
                 K = M.nharmonics
                 Mk = M.fourier(K)
-                y[:, :, i] += np.tensordot(Mk[K].real, v[:, :, i], axes=1)
+                G = np.concatenate([Mk[K:].real, Mk[K + 1:].imag])             # (2K+1, p, b)
+                Gv = np.tensordot(G, v[:, :, i], axes=1)                        # (2K+1, p, R, s)
+                y[:, :, i] += Gv[0]
+                angle = M.omega_p * t[i]
                 for k in range(1, K + 1):
-                    w = np.exp(1j * k * M.omega_p * t[i])
-                    y[:, :, i] += 2 * (np.tensordot(Mk[K + k], v[:, :, i], axes=1) * w).real
+                    y[:, :, i] += 2 * (Gv[k] * np.cos(k * angle) - Gv[K + k] * np.sin(k * angle))
                 continue
             if not M.is_constant:
                 y[:, :, i] += _apply(M(t[i]), v[:, :, i])

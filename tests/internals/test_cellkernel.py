@@ -61,6 +61,20 @@ def periodic_output(n, m, seed):
     return ltp.ltpss(sys.A, sys.B, ltp.PeriodicMatrix(c, 1.0), sys.D, period=1.0)
 
 
+def periodic_feedthrough(n, m, seed):
+    """The plant of `plant` with C and D of two harmonics, sines and cosines."""
+    sys = plant(n, m, seed)
+    rng = np.random.default_rng(seed + 1)
+    C, D = np.zeros((5, 2, n), complex), np.zeros((5, 2, m), complex)
+    C[2], D[2] = sys.C(0.0), sys.D(0.0)
+    for M in (C, D):
+        M[3] = 0.2 * rng.normal(size=M.shape[1:]) + 0.2j * rng.normal(size=M.shape[1:])
+        M[4] = 0.1j * rng.normal(size=M.shape[1:])
+        M[1], M[0] = M[3].conj(), M[4].conj()
+    return ltp.ltpss(sys.A, sys.B, ltp.PeriodicMatrix(C, 1.0), ltp.PeriodicMatrix(D, 1.0),
+                     period=1.0)
+
+
 def switching(n, m, seed):
     """A plant whose A switches at 0.3 and 0.8 of the period (cells split there)."""
     rng = np.random.default_rng(seed)
@@ -71,7 +85,8 @@ def switching(n, m, seed):
 
 
 CASES = [(plant, 2, 1, 'foh'), (plant, 2, 1, 'zoh'), (plant, 3, 2, 'foh'),
-         (periodic_output, 2, 1, 'foh'), (switching, 2, 1, 'foh'), (switching, 3, 1, 'zoh')]
+         (periodic_output, 2, 1, 'foh'), (periodic_feedthrough, 3, 2, 'foh'),
+         (periodic_feedthrough, 2, 1, 'zoh'), (switching, 2, 1, 'foh'), (switching, 3, 1, 'zoh')]
 
 
 @pytest.mark.parametrize("make, n, m, hold", CASES)
@@ -155,7 +170,7 @@ def test_without_numba_the_numpy_march_runs(monkeypatch):
     monkeypatch.setattr(cellkernel, 'MIN_SAMPLES', 0)
     monkeypatch.setattr(cellkernel.importlib.util, 'find_spec', lambda name: None)
     assert not cellkernel.available()
-    assert cellkernel.compiled_kernel(2, 1, 2, 7, 1) is None
+    assert cellkernel.compiled_kernel(2, 1, 2, 7, 1, 0) is None
     sys, t = plant(2, 1, seed=4), grid(3)
     u = np.sin(2.0 * t)
     resp = ltp.forced_response(sys, t, u)
@@ -183,7 +198,7 @@ def test_a_kernel_numba_cannot_compile_falls_back_to_numpy(monkeypatch):
     with pytest.warns(UserWarning, match='simulating with NumPy'):
         resp = ltp.forced_response(sys, t, u)
     assert cellkernel._COMPILED is False
-    assert cellkernel.compiled_kernel(2, 1, 2, 7, 1) is None
+    assert cellkernel.compiled_kernel(2, 1, 2, 7, 1, 0) is None
     assert not cellkernel.available()
     with ltp.config.defaults_context({'timeresp.compiled': False}):
         ref = ltp.forced_response(sys, t, u)
