@@ -367,21 +367,30 @@ def outputs(C, D, t, x, u):
     (n, R, L), m, p = x.shape, u.shape[0], C.shape[0]
     y = np.zeros((p, R, L))
     chunk = max(256, _CHUNK_ENTRIES // max(1, p * (n + m)))
+    series = None if C.is_constant and D.is_constant else _real_series(C, D)
     for s0 in range(0, L, chunk):
         i = slice(s0, s0 + chunk)
+        if series is not None:
+            # Fourier series: y = Σ_h cos hωt (Cs_0h x + Ds_0h u) + sin hωt (Cs_1h x + Ds_1h u),
+            # the products with x and u in one each, cos and sin by the
+            # multiple-angle recurrence
+            Cs, Ds = series
+            H = Cs.shape[1] - 1
+            # (2 (H + 1) p rows) @ (states of trace r): BLAS on the strided rows of x
+            Cf, Df = Cs.reshape(-1, n), Ds.reshape(-1, m)
+            P = np.stack([Cf @ x[:, r, i] + Df @ u[:, r, i] for r in range(R)], axis=1)
+            P = P.reshape(Cs.shape[:3] + P.shape[1:])                          # (2, H+1, p, R, s)
+            y[:, :, i] = P[0, 0]
+            angle = C.omega_p * t[i]
+            cos = [np.ones_like(angle), np.cos(angle)]
+            sin = [np.zeros_like(angle), np.sin(angle)]
+            for h in range(1, H + 1):
+                if h > 1:
+                    cos.append(2 * cos[1] * cos[h - 1] - cos[h - 2])
+                    sin.append(2 * cos[1] * sin[h - 1] - sin[h - 2])
+                y[:, :, i] += P[0, h] * cos[h] + P[1, h] * sin[h]
+            continue
         for M, v in ((C, x), (D, u)):
-            if not M.is_constant and (M.nharmonics or _FEW_HARMONICS + 1) <= _FEW_HARMONICS:
-                # a Fourier series: M(t) v = M_0 v + 2 Σ_k (Re M_k v cos kωt - Im M_k v sin kωt),
-                # the products with v in one
-                K = M.nharmonics
-                Mk = M.fourier(K)
-                G = np.concatenate([Mk[K:].real, Mk[K + 1:].imag])             # (2K+1, p, b)
-                Gv = np.tensordot(G, v[:, :, i], axes=1)                        # (2K+1, p, R, s)
-                y[:, :, i] += Gv[0]
-                angle = M.omega_p * t[i]
-                for k in range(1, K + 1):
-                    y[:, :, i] += 2 * (Gv[k] * np.cos(k * angle) - Gv[K + k] * np.sin(k * angle))
-                continue
             if not M.is_constant:
                 y[:, :, i] += _apply(M(t[i]), v[:, :, i])
                 continue
