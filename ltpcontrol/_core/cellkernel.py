@@ -69,7 +69,7 @@ def compiled_kernel(n, m, q, D1, p, H=0):
         except ImportError:
             _COMPILED = False
             return None
-        # reassociated and fused sums (the loops over orders vectorise);
+        # reassociated and fused sums (the sums over columns vectorise);
         # no checks for division by zero (steps are positive)
         _COMPILED[sizes] = _guarded(numba.njit(
             cache=True, nogil=True, error_model='numpy',

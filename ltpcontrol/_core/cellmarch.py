@@ -57,7 +57,7 @@ __all__ = []
 
 _CHUNK_ENTRIES = 2 ** 18       # entries of a chunk's arrays (fresh memory pages cost)
 _FEW_COLUMNS = 8              # constant output matrices with fewer columns: rows summed
-_FEW_HARMONICS = 16           # Fourier output matrices with at most these harmonics: by harmonic
+_FEW_HARMONICS = 16           # Fourier output matrices with at most these harmonics: as series
 _CELL_ENTRIES = 2 ** 19        # entries of a block of phases of the cell march (cache-sized)
 
 
