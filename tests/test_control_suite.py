@@ -1,7 +1,7 @@
 """python-control's own tests pass with ltpcontrol's bridge enabled exactly as without.
 
 Runs ``tools/control_suite.py --subset`` (the test modules of the entry
-points the bridge wraps, about 35 s of CPU, with the bridge; then each test
+points the bridge wraps, about a minute of CPU, with the bridge; then each test
 that did not pass, without it); ``python tools/control_suite.py`` runs the
 whole suite (about 4 minutes).
 """

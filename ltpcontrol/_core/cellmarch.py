@@ -122,7 +122,7 @@ def cell_march(table, C, D, t, u, x0, hold, states=True):
     x[:, :, 0] = x0
     # output matrices as real Fourier series (constant: H = 0) are applied in the loop
     series = _real_series(C, D)
-    kernel = _kernel(n, m, q, first.shape[1], C.shape[0] if series else 0,
+    kernel = _kernel(n, m, q, D1, C.shape[0] if series else 0,
                      series[0].shape[1] - 1 if series else 0, len(t))
     if kernel is not None:
         marched = _compiled_march(kernel, table, WZ, first, kcoef, C, D, series, t, u, x1, x,
