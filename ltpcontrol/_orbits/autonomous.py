@@ -449,18 +449,20 @@ def _newton(prob, sec, x, T, tol, max_iter, npoints, returns, tried):
     """One Newton attempt on [φ_T(x) − x; s(x)] = 0; a PeriodicOrbit or None."""
     hp, n, mode = prob.hp, prob.hp.nstates, sec.mode
     where = f"Newton after {returns} returns"
-    last, stalled, tight, start = np.inf, 0, False, (x, T)
+    # `best`: the point (and period) whose residual is `last`
+    last, stalled, tight, best = np.inf, 0, False, (x, T)
     for it in range(max_iter + 1):
         if not 0 < T < np.inf:
             tried.append(f"{where}: the period left (0, ∞)")
             return None
         # inexact Newton: loose integration while the residual is large,
-        # the requested accuracy once it is small or a loose step misled
+        # the requested accuracy once it is small or a loose step misled;
+        # the iterations need Φ only to first order: no product form
+        # (`_finish` takes the multipliers from one flow at the solution)
         options = prob.opts if tight else inexact_options(prob.opts, last)
         exact = options['rtol'] == prob.opts['rtol']
         try:
-            # at full accuracy in product form: the multipliers of the last one
-            fl = prob.flow(x, mode, T, variational=True, options=options, factored=exact)
+            fl = prob.flow(x, mode, T, variational=True, options=options)
         except RuntimeError as err:
             tried.append(f"{where}: {err}")
             return None
@@ -475,8 +477,9 @@ def _newton(prob, sec, x, T, tol, max_iter, npoints, returns, tried):
             _check_not_equilibrium(prob, mode, x, T, "Newton")
             return _finish(prob, sec, fl, x, T, npoints, res, it, returns)
         if not exact and res > 0.9 * last:
-            # no progress with loose integration: restart at full accuracy
-            tight, (x, T), last, stalled = True, start, np.inf, 0
+            # no progress with loose integration: on at full accuracy from the
+            # best point so far
+            tight, (x, T), last, stalled = True, best, np.inf, 0
             continue
         stalled = stalled + 1 if res > 0.9 * last else 0
         if res > 1e3 * last or stalled >= 3 or it == max_iter:
@@ -484,7 +487,7 @@ def _newton(prob, sec, x, T, tol, max_iter, npoints, returns, tried):
                          + (" (no progress)" if stalled >= 3 else "")
                          + _floor_hint(res, prob.opts['rtol']))
             return None
-        last = res
+        last, best = res, (x, T)
         # bordered system [[Φ − I, f(φ_T(x))], [∇s, 0]] [δx; δT] = −[φ_T(x) − x; s(x)]
         jac = np.zeros((n + 1, n + 1))
         jac[:n, :n] = fl.phi - np.eye(n)
@@ -494,7 +497,8 @@ def _newton(prob, sec, x, T, tol, max_iter, npoints, returns, tried):
         step = np.linalg.lstsq(jac, -np.append(gap, phase), rcond=None)[0]
         if np.max(np.abs(step[:n])) > 10 * scale:
             if not exact:
-                tight, (x, T), last, stalled = True, start, np.inf, 0
+                # a loose Jacobian misled: again from here at full accuracy
+                tight, last, stalled = True, np.inf, 0
                 continue
             tried.append(f"{where}: step of size {np.max(np.abs(step[:n])):.3g} "
                          "rejected (divergence)")

@@ -490,15 +490,17 @@ class _PeriodShooter:
     def newton(self, x, mode, tol, max_iter, where, tried):
         """Newton on ``P(x) − x = 0``: (flow, x, residual, iterations) or None."""
         names, n = self.hp.mode_names, self.hp.nstates
-        last, stalled, tight, start = np.inf, 0, False, x
+        # `best`: the point whose residual is `last`
+        last, stalled, tight, best = np.inf, 0, False, x
         for it in range(max_iter + 1):
             # inexact Newton: loose integration while the residual is large,
-            # the requested accuracy once it is small or a loose step misled
+            # the requested accuracy once it is small or a loose step misled;
+            # the iterations need Φ only to first order: no product form
+            # (the caller takes the multipliers from one flow at the solution)
             options = self.opts if tight else inexact_options(self.opts, last)
             exact = options['rtol'] == self.opts['rtol']
             try:
-                # at full accuracy in product form: the multipliers of the last one
-                fl = self.flow(x, mode, True, options, factored=exact)
+                fl = self.flow(x, mode, True, options)
             except IntegrationError as err:
                 tried.append(f"{where}: {err}")
                 return None
@@ -510,8 +512,9 @@ class _PeriodShooter:
             if res <= tol and exact:
                 return fl, x, res, it
             if not exact and res > 0.9 * last:
-                # no progress with loose integration: restart at full accuracy
-                tight, x, last, stalled = True, start, np.inf, 0
+                # no progress with loose integration: on at full accuracy from
+                # the best point so far
+                tight, x, last, stalled = True, best, np.inf, 0
                 continue
             stalled = stalled + 1 if res > 0.9 * last else 0
             if res > 1e3 * last or stalled >= 3 or it == max_iter:
@@ -519,7 +522,7 @@ class _PeriodShooter:
                              + (" (no progress)" if stalled >= 3 else "")
                              + _floor_hint(res, self.opts['rtol']))
                 return None
-            last = res
+            last, best = res, x
             # (∂P/∂x − I) δ = −(P(x) − x); least squares handles neutral
             # directions (multipliers equal to 1)
             step, _, rank, _ = np.linalg.lstsq(fl.phi - np.eye(n), x - fl.x_final, rcond=None)
@@ -529,7 +532,8 @@ class _PeriodShooter:
                 return None
             if np.max(np.abs(step)) > 10 * (1 + np.max(np.abs(x))):
                 if not exact:
-                    tight, x, last, stalled = True, start, np.inf, 0
+                    # a loose Jacobian misled: again from here at full accuracy
+                    tight, last, stalled = True, np.inf, 0
                     continue
                 tried.append(f"{where}: step of size {np.max(np.abs(step)):.3g} rejected "
                              "(divergence)")
