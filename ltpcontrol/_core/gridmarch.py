@@ -78,6 +78,7 @@ _SAMPLES = (12, 20, 32)      # Chebyshev samples of A and B per piece, tried in 
 _LADDER = ((4, 1), (5, 1), (6, 1), (8, 1), (8, 2), (10, 2), (12, 4))
 _LAYOUT_STEPS = 16384        # steps of a long record from which cells are laid out first
 _PHASE_MAX = 1024            # most phases of the interpolated step data of a uniform grid
+_PHASE_COPIES = 6            # arrays of 2M phases' size alive while they are interpolated
 
 
 
@@ -302,9 +303,19 @@ def _phase_table(A, B, h, T, rtol):
         Phi, G0, G1 = step_transitions(A, B, phases, h, rtol)
         return np.concatenate([Phi, G0, G1], axis=2)
 
+    # the samples at 2M phases, (n, n + 2m) each, and their transforms (complex):
+    # no doubling beyond what the memory holds (the step by step march instead)
+    avail = available_memory()
+
+    def fits(M):
+        need = _PHASE_COPIES * 8.0 * 2 * M * n * (n + 2 * m)
+        return avail is None or need <= _TABLE_SHARE * avail
+
     M = 32
+    if not fits(M):
+        return None
     X = data(T * np.arange(M) / M)
-    while M <= _PHASE_MAX:
+    while M <= _PHASE_MAX and fits(M):
         mid = data(T * (np.arange(M) + 0.5) / M)
         scale = max(1.0, np.abs(X).max())
         ks = np.fft.fftfreq(M, 1.0 / M)

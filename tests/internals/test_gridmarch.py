@@ -95,6 +95,29 @@ def test_a_cell_table_larger_than_the_memory_gives_way_to_bounded_chunks(monkeyp
     assert rel(chunked.outputs, table.outputs) < 1e-11
 
 
+def test_phase_data_larger_than_the_memory_give_way_to_bounded_chunks(monkeypatch):
+    # a uniform grid whose step does not divide the period, when its cells do not
+    # serve: the step data interpolated in the phase, unless their samples would
+    # take more than half the memory available (then step by step, same result)
+    sys = damped_mathieu()
+    t = 0.0137 * np.arange(300)
+    u = np.cos(2.3 * t)
+    monkeypatch.setattr(gridmarch, '_cell_table', lambda *a, **k: None)
+    made = []
+    phase_table = gridmarch._phase_table
+    monkeypatch.setattr(gridmarch, '_phase_table', lambda *a: made.append(phase_table(*a))
+                        or made[-1])
+    interpolated = ltp.forced_response(sys, t, u)
+    assert made[-1] is not None
+    monkeypatch.setattr(gridmarch, 'available_memory', lambda: 10 ** 4)
+    stepwise = ltp.forced_response(sys, t, u)
+    assert made[-1] is None
+    with pytest.MonkeyPatch.context() as mp:
+        ref = direct(mp, sys, t, u)
+    assert rel(interpolated.outputs, ref.outputs) < 1e-11
+    assert rel(stepwise.outputs, ref.outputs) < 1e-12
+
+
 @settings(derandomize=True, max_examples=12, deadline=None, database=None)
 @given(ratio=st.floats(0.011, 0.3), t0=st.floats(0.0, 3.0), n=st.integers(20, 400))
 def test_any_uniform_grid_matches_per_step_data(ratio, t0, n):
