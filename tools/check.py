@@ -76,6 +76,11 @@ def main(names):
     results = {}
     workers = max(1, min(cores(), len(chosen)))
     env = dict(os.environ, **(SINGLE_THREAD if workers > 1 else {}))
+    # the checks start dozens of Python processes (test workers, subprocess
+    # tests, parallel jobs, the documentation build) that import the package
+    # from its source tree: its bytecode is written once and reused, even where
+    # the environment asks Python not to write bytecode (a second per process)
+    env.pop('PYTHONDONTWRITEBYTECODE', None)
     with ThreadPoolExecutor(max_workers=workers) as pool:
         jobs = [pool.submit(run, n, c, env) for n, c in chosen.items()]
         for job in as_completed(jobs):
