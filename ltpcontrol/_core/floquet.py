@@ -74,7 +74,7 @@ def monodromy(sys, nsteps=None):
         are badly scaled) clipped to [16, 4096] and to a memory budget of
         512 MB for the factors, so that every factor is well conditioned.
         Each factor is integrated with the sub-steps its error estimate
-        asks for (fourth-order Magnus, relative accuracy 1e-12).  The
+        asks for (sixth-order Magnus, relative accuracy 1e-12).  The
         factors are accumulated in chunks of steps, so the memory is
         O(n²) whatever `nsteps` and the stiffness, and the time linear in
         the steps.  A matrix that is

@@ -3,7 +3,7 @@
 On a uniform grid whose step divides the period the step data repeat and
 one period of them is computed (``_march``).  On any other grid every step
 ``[t_k, t_k + h_k]`` has its own phase, and computing every step's
-transition data afresh costs as many fourth-order Magnus integrations as
+transition data afresh costs as many sixth-order Magnus integrations as
 there are samples.  Instead:
 
 * **Repeating phases.**  When ``q h = p T`` for small integers (a uniform

@@ -8,10 +8,12 @@ exact solution is
 
 where ``[[Φ, Γ0, Γ1], [0, I, 0], [0, 0, I]]`` is the transition matrix of the
 augmented system ``ż = M(τ) z``, ``M = [[A, B, σB], [0, 0, 0], [0, 0, 0]]``.
-It is computed with the fourth-order Magnus integrator
+It is computed with the sixth-order Magnus integrator (Blanes, Casas and Ros)
 
-    Ω = δ/2 (M1 + M2) + √3/12 δ² [M2, M1],   M_i = M(τ + c_i δ),
-    c_{1,2} = 1/2 ∓ √3/6,
+    α1 = δ M2,  α2 = √15/3 δ (M3 - M1),  α3 = 10/3 δ (M3 - 2 M2 + M1),
+    C1 = [α1, α2],  C2 = -[α1, 2 α3 + C1]/60,
+    Ω = α1 + α3/12 + [-20 α1 - α3 + C1, α2 + C2]/240,
+    M_i = M(τ + c_i δ),  c_{1,2,3} = 1/2 - √15/10, 1/2, 1/2 + √15/10,
 
 on m sub-steps of each smooth piece (switching instants split a step), with m
 doubled until two resolutions agree (the Richardson-extrapolated value is
@@ -30,7 +32,11 @@ from .threads import small_blas
 
 __all__ = []
 
-_C1, _C2 = 0.5 - np.sqrt(3) / 6, 0.5 + np.sqrt(3) / 6
+#: Gauss-Legendre nodes of the sixth-order Magnus sub-step
+_NODES = np.array([0.5 - np.sqrt(15) / 10, 0.5, 0.5 + np.sqrt(15) / 10])
+#: sixth order: halving the sub-steps divides the error by 2^6; the error of
+#: the finer of two resolutions is about their difference / (2^6 - 1)
+_RICHARDSON = 2 ** 6 - 1
 
 
 def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=2 ** 16, info=None):
@@ -49,9 +55,9 @@ def step_transitions(A, B, t0, h, rtol=1e-12, max_substeps=2 ** 16, info=None):
     info : dict, optional
         Receives ``'substeps'``, the number of Magnus sub-steps per segment
         that met `rtol` (1 for exact exponentials), and ``'excess'``, the
-        largest error estimate with two sub-steps (against four) relative
+        largest error estimate with one sub-step (against two) relative
         to the accepted error (0 for exact exponentials; the error of a
-        fourth-order step scales as its length to the fifth).
+        sixth-order step scales as its length to the seventh).
 
     Returns
     -------
@@ -163,7 +169,7 @@ def uniform_transitions(A, t0, h, rtol=1e-12, max_substeps=2 ** 16):
             half = _magnus(A, None, t0[check], t0[check] + h[check], t0[check], h[check],
                            nsub // 2, n, 0, n, scale)
             E = out[check]
-            err = np.abs(E - half).max(axis=(1, 2)) / 15
+            err = np.abs(E - half).max(axis=(1, 2)) / _RICHARDSON
             if np.any(err > rtol * np.maximum(1.0, np.abs(E).max(axis=(1, 2)))):
                 return step_transitions(A, None, t0, h, rtol, max_substeps)[0]
     if scale is not None:
@@ -218,7 +224,7 @@ def _segment_transitions(A, B, a, b, step_t0, step_h, rtol, max_substeps):
     with small_blas(d):
         for c0 in range(0, S, chunk):
             sel = np.arange(c0, min(S, c0 + chunk))
-            nsub = 2
+            nsub = 1
             prev = _magnus(A, B, a[sel], b[sel], step_t0[sel], step_h[sel], nsub, n, m, d,
                            scale)
             initial = True
@@ -228,8 +234,7 @@ def _segment_transitions(A, B, a, b, step_t0, step_h, rtol, max_substeps):
                             scale)
                 err = np.abs(E - prev).max(axis=(1, 2))
                 size = np.maximum(1.0, np.abs(E).max(axis=(1, 2)))
-                # fourth-order method: the error of E is about (E - prev)/15
-                ratio = err / 15 / (rtol * size)
+                ratio = err / _RICHARDSON / (rtol * size)
                 if initial:
                     excess = max(excess, float(ratio.max()))
                     initial = False
@@ -237,11 +242,11 @@ def _segment_transitions(A, B, a, b, step_t0, step_h, rtol, max_substeps):
                 if nsub >= max_substeps:
                     short = short or not np.all(done)
                     out[sel] = E
-                    out[sel[done]] = E[done] + (E[done] - prev[done]) / 15
+                    out[sel[done]] = E[done] + (E[done] - prev[done]) / _RICHARDSON
                     nsub_max = max(nsub_max, nsub)
                     break
                 if np.any(done):
-                    out[sel[done]] = E[done] + (E[done] - prev[done]) / 15
+                    out[sel[done]] = E[done] + (E[done] - prev[done]) / _RICHARDSON
                     nsub_max = max(nsub_max, nsub)
                 sel, prev = sel[~done], E[~done]
     if short:
@@ -296,7 +301,7 @@ def _tree_product(E):
 
 
 def _magnus(A, B, a, b, step_t0, step_h, nsub, n, m, d, scale=None):
-    """Product of `nsub` Magnus sub-steps on each segment, accumulated in blocks.
+    """Product of `nsub` sixth-order Magnus sub-steps on each segment, in blocks.
 
     Blocks of sub-steps whose node values fit the chunk budget are
     evaluated and exponentiated together and multiplied into the running
@@ -304,13 +309,13 @@ def _magnus(A, B, a, b, step_t0, step_h, nsub, n, m, d, scale=None):
     """
     nseg = len(a)
     delta = (b - a) / nsub                                   # (S,)
-    block = int(max(1, min(nsub, _CHUNK_ENTRIES // max(1, 2 * nseg * d * d))))
+    block = int(max(1, min(nsub, _CHUNK_ENTRIES // max(1, 3 * nseg * d * d))))
     ratio = None if scale is None else scale[None, :] / scale[:, None]
     E = None
     for j0 in range(0, nsub, block):
         J = min(block, nsub - j0)
         starts = a[:, None] + delta[:, None] * np.arange(j0, j0 + J)   # (S, J)
-        nodes = np.stack([starts + _C1 * delta[:, None], starts + _C2 * delta[:, None]], -1)
+        nodes = starts[..., None] + _NODES * delta[:, None, None]      # (S, J, 3)
         tflat = nodes.ravel()
         if m:
             Mt = np.zeros((tflat.size, d, d))
@@ -323,11 +328,20 @@ def _magnus(A, B, a, b, step_t0, step_h, nsub, n, m, d, scale=None):
             Mt = A._eval(tflat)
         if ratio is not None:
             Mt = Mt * ratio
-        Mt = Mt.reshape(nseg, J, 2, d, d)
-        M1, M2 = Mt[:, :, 0], Mt[:, :, 1]
+        Mt = Mt.reshape(nseg, J, 3, d, d)
+        M1, M2, M3 = Mt[:, :, 0], Mt[:, :, 1], Mt[:, :, 2]
         dl = delta[:, None, None, None]
-        Omega = 0.5 * dl * (M1 + M2) + (np.sqrt(3) / 12) * dl ** 2 * (M2 @ M1 - M1 @ M2)
-        del Mt, M1, M2
+        a1 = dl * M2
+        a2 = (np.sqrt(15) / 3) * dl * (M3 - M1)
+        a3 = (10 / 3) * dl * (M3 - 2 * M2 + M1)
+        del Mt, M1, M2, M3
+        C1 = a1 @ a2 - a2 @ a1
+        X = 2 * a3 + C1
+        C2 = (X @ a1 - a1 @ X) / 60                              # -[α1, 2 α3 + C1]/60
+        X = C1 - 20 * a1 - a3
+        Y = a2 + C2
+        Omega = a1 + a3 / 12 + (X @ Y - Y @ X) / 240
+        del a1, a2, a3, C1, C2, X, Y
         P = _tree_product(expm_batch(Omega.reshape(-1, d, d)).reshape(nseg, J, d, d))
         E = P if E is None else P @ E
     return E

@@ -1,9 +1,10 @@
 """`step_transitions` equals a plain re-implementation of its documented scheme
 (to rounding: the sum of many sub-step products).
 
-Fourth-order Magnus on ``nsub`` sub-steps, ``nsub = 2, 4, ...`` doubled
-until two resolutions agree on every step, Richardson-extrapolated; here
-one step and one sub-step at a time with `scipy.linalg.expm`.
+Sixth-order Magnus (Blanes, Casas and Ros: three Gauss points) on ``nsub``
+sub-steps, ``nsub = 1, 2, 4, ...`` doubled until two resolutions agree on
+every step, Richardson-extrapolated; here one step and one sub-step at a
+time with `scipy.linalg.expm`.
 
 Tests of internals: they import private names (see the Developer notes).
 """
@@ -13,9 +14,31 @@ import pytest
 import scipy.linalg as la
 
 import ltpcontrol as ltp
-from ltpcontrol._core.transition import step_transitions
+from ltpcontrol._core.transition import _magnus, step_transitions
 
-C1, C2 = 0.5 - np.sqrt(3) / 6, 0.5 + np.sqrt(3) / 6
+NODES = (0.5 - np.sqrt(15) / 10, 0.5, 0.5 + np.sqrt(15) / 10)
+
+
+def _magnus6(A, s, dl):
+    """Ω of one sub-step [s, s + dl]."""
+    M1, M2, M3 = (A(s + c * dl) for c in NODES)
+    a1 = dl * M2
+    a2 = np.sqrt(15) / 3 * dl * (M3 - M1)
+    a3 = 10 / 3 * dl * (M3 - 2 * M2 + M1)
+
+    def comm(X, Y):
+        return X @ Y - Y @ X
+    C1 = comm(a1, a2)
+    C2 = -comm(a1, 2 * a3 + C1) / 60
+    return a1 + a3 / 12 + comm(-20 * a1 - a3 + C1, a2 + C2) / 240
+
+
+def _product(A, p, q, nsub):
+    dl = (q - p) / nsub
+    E = np.eye(A.shape[0])
+    for j in range(nsub):
+        E = la.expm(_magnus6(A, p + j * dl, dl)) @ E
+    return E
 
 
 def _reference(A, t0, h, rtol=1e-12):
@@ -27,26 +50,16 @@ def _reference(A, t0, h, rtol=1e-12):
         segs += [(k, p, q) for p, q in zip(pts[:-1], pts[1:])]
 
     def level(nsub):
-        out = []
-        for _, p, q in segs:
-            dl = (q - p) / nsub
-            E = np.eye(A.shape[0])
-            for j in range(nsub):
-                s = p + j * dl
-                M1, M2 = A(s + C1 * dl), A(s + C2 * dl)
-                E = la.expm(0.5 * dl * (M1 + M2) + np.sqrt(3) / 12 * dl ** 2
-                            * (M2 @ M1 - M1 @ M2)) @ E
-            out.append(E)
-        return np.array(out)
-    nsub, prev = 2, level(2)
+        return np.array([_product(A, p, q, nsub) for _, p, q in segs])
+    nsub, prev = 1, level(1)
     while True:
         nsub *= 2
         E = level(nsub)
-        err = np.abs(E - prev).max(axis=(1, 2)) / 15
+        err = np.abs(E - prev).max(axis=(1, 2)) / 63
         if np.all(err <= rtol * np.maximum(1.0, np.abs(E).max(axis=(1, 2)))):
             break
         prev = E
-    E = E + (E - prev) / 15
+    E = E + (E - prev) / 63
     Phi = np.broadcast_to(np.eye(A.shape[0]), (len(t0),) + A.shape).copy()
     for (k, _, _), Ek in zip(segs, E):
         Phi[k] = Ek @ Phi[k]
@@ -73,3 +86,20 @@ def test_step_transitions_match_plain_scheme(seed):
         ref = _reference(A, t0, h)
         scale = np.maximum(1.0, np.abs(ref).max(axis=(1, 2)))
         assert np.all(np.abs(Phi - ref).max(axis=(1, 2)) <= 5e-14 * scale), name
+
+
+def test_sub_step_error_is_sixth_order():
+    # halving the sub-steps divides the error of a step by about 2^6 = 64
+    # (against a resolution 64 times finer), the factor the Richardson
+    # extrapolation and the error estimate assume
+    rng = np.random.default_rng(3)
+    A = next(_systems(rng, 3))[1]
+    exact = _product(A, 0.1, 0.6, 256)
+    a, b = np.array([0.1]), np.array([0.6])
+
+    def library(nsub):
+        return _magnus(A, None, a, b, a, b - a, nsub, 3, 0, 3)[0]
+    for integrate in (library, lambda nsub: _product(A, 0.1, 0.6, nsub)):
+        errors = [np.abs(integrate(nsub) - exact).max() for nsub in (2, 4, 8)]
+        ratios = np.array(errors[:-1]) / np.array(errors[1:])
+        assert np.all((ratios > 40) & (ratios < 100)), ratios
