@@ -50,8 +50,10 @@ of load on a shared machine hits both sides of a pair alike.
 
 Where the time goes on the non-uniform rows: the cell table of a jittered
 grid (400 cells of a period, one sample each, Chebyshev-Lobatto lengths of
-degree 6) costs about as much as the aligned grid's 400 step integrations;
-the march then costs per sample about 0.06 µs compiled (the loop
+degree 6) integrates the D sub-intervals of every cell, where the aligned
+grid integrates one sixth-order Magnus step of one to a few sub-steps per
+sample of a period, so the table costs more than the aligned grid's step
+data (P10a-P10c: about twice their whole call); the march then costs per sample about 0.06 µs compiled (the loop
 specialised to the system's sizes) and 0.2-0.25 µs with NumPy, against
 about 0.03-0.05 µs on the aligned grid, so without numba the ratio grows
 with the record (P10i, P10l); for 20 states the table is
