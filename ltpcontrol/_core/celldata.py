@@ -32,7 +32,8 @@ import numpy as np
 
 from .memory import check_allocation
 from .threads import small_blas
-from .transition import _balancing, _tree_product, expm_batch
+from .transition import (_balancing, _entries_product, _magnus6,
+                         _tree_product, expm_batch)
 
 __all__ = []
 
@@ -60,50 +61,6 @@ def chebyshev_first_kind(G):
 
 #: up to this many states, the short steps' products are taken entry by entry
 _ENTRYWISE_STATES = 4
-
-
-def _rows_product(X, Y):
-    """``X Y`` of stacks of first rows (..., n, d) (zero rows below): ``X[..., :n] @ Y``."""
-    return X[..., :X.shape[-2]] @ Y
-
-
-def _entries_product(X, Y):
-    """The same for stacks stored entry by entry, (n, d, S): ``Σ_j X[:, j] Y[j]``.
-
-    For a few states this is a few vector operations over the stack, where
-    a batched matrix product pays a call per small matrix.
-    """
-    n = X.shape[0]
-    out = X[:, 0, None] * Y[0]
-    for j in range(1, n):
-        out += X[:, j, None] * Y[j]
-    return out
-
-
-def _magnus6(M1, M2, M3, h, entrywise=False):
-    """Sixth-order Magnus exponent from M at the three Gauss points of a step h.
-
-    With ``α1 = h M2``, ``α2 = √15/3 h (M3 - M1)``, ``α3 = 10/3 h (M3 - 2 M2 + M1)``:
-    ``Ω = α1 + α3/12 + [-20 α1 - α3 + C1, α2 + C2]/240``, ``C1 = [α1, α2]``,
-    ``C2 = -[α1, 2 α3 + C1]/60`` (Blanes, Casas and Ros).
-
-    The augmented M has zero rows below its first n (module notes), and so
-    have all the α, commutators and Ω: the arguments and the result are
-    those first n rows (shape (..., n, d), or (n, d, S) entry by entry with
-    `entrywise`), and a product ``X Y`` of two such matrices is
-    ``X[:, :n] Y`` (n²d instead of d³ multiplications).
-    """
-    product = _entries_product if entrywise else _rows_product
-
-    def comm(X, Y):
-        return product(X, Y) - product(Y, X)
-
-    a1 = h * M2
-    a2 = (np.sqrt(15) / 3) * h * (M3 - M1)
-    a3 = (10 / 3) * h * (M3 - 2 * M2 + M1)
-    C1 = comm(a1, a2)
-    C2 = comm(a1, 2 * a3 + C1) / -60
-    return a1 + a3 / 12 + comm(C1 - 20 * a1 - a3, a2 + C2) / 240
 
 
 def _expm_small(X, entrywise=False):

@@ -52,13 +52,12 @@ from fractions import Fraction
 
 import numpy as np
 
-from .celldata import (_ENTRYWISE_STATES, CellSamples, CellTable, _entries_product,
-                       interpolate, lobatto)
+from .celldata import _ENTRYWISE_STATES, CellSamples, CellTable, interpolate, lobatto
 from .cellmarch import cell_march
 from .march import periodic_march
 from .memory import available_memory
 from .threads import small_blas
-from .transition import step_transitions
+from .transition import _entries_product, step_transitions
 
 __all__ = []
 

@@ -300,6 +300,50 @@ def _tree_product(E):
     return E[:, 0]
 
 
+def _rows_product(X, Y):
+    """``X Y`` of stacks of first rows (..., n, d) (zero rows below): ``X[..., :n] @ Y``."""
+    return X[..., :X.shape[-2]] @ Y
+
+
+def _entries_product(X, Y):
+    """The same for stacks stored entry by entry, (n, d, S): ``Σ_j X[:, j] Y[j]``.
+
+    For a few states this is a few vector operations over the stack, where
+    a batched matrix product pays a call per small matrix.
+    """
+    n = X.shape[0]
+    out = X[:, 0, None] * Y[0]
+    for j in range(1, n):
+        out += X[:, j, None] * Y[j]
+    return out
+
+
+def _magnus6(M1, M2, M3, h, entrywise=False):
+    """Sixth-order Magnus exponent from M at the three Gauss points of a step h.
+
+    With ``α1 = h M2``, ``α2 = √15/3 h (M3 - M1)``, ``α3 = 10/3 h (M3 - 2 M2 + M1)``:
+    ``Ω = α1 + α3/12 + [-20 α1 - α3 + C1, α2 + C2]/240``, ``C1 = [α1, α2]``,
+    ``C2 = -[α1, 2 α3 + C1]/60`` (Blanes, Casas and Ros).
+
+    The augmented M has zero rows below its first n (module notes), and so
+    have all the α, commutators and Ω: the arguments and the result are
+    those first n rows (shape (..., n, d), or (n, d, S) entry by entry with
+    `entrywise`), and a product ``X Y`` of two such matrices is
+    ``X[:, :n] Y`` (n²d instead of d³ multiplications).
+    """
+    product = _entries_product if entrywise else _rows_product
+
+    def comm(X, Y):
+        return product(X, Y) - product(Y, X)
+
+    a1 = h * M2
+    a2 = (np.sqrt(15) / 3) * h * (M3 - M1)
+    a3 = (10 / 3) * h * (M3 - 2 * M2 + M1)
+    C1 = comm(a1, a2)
+    C2 = comm(a1, 2 * a3 + C1) / -60
+    return a1 + a3 / 12 + comm(C1 - 20 * a1 - a3, a2 + C2) / 240
+
+
 def _magnus(A, B, a, b, step_t0, step_h, nsub, n, m, d, scale=None):
     """Product of `nsub` sixth-order Magnus sub-steps on each segment, in blocks.
 
@@ -310,39 +354,32 @@ def _magnus(A, B, a, b, step_t0, step_h, nsub, n, m, d, scale=None):
     nseg = len(a)
     delta = (b - a) / nsub                                   # (S,)
     block = int(max(1, min(nsub, _CHUNK_ENTRIES // max(1, 3 * nseg * d * d))))
-    ratio = None if scale is None else scale[None, :] / scale[:, None]
+    ratio = None if scale is None else (scale[None, :] / scale[:, None])[:n]
     E = None
     for j0 in range(0, nsub, block):
         J = min(block, nsub - j0)
         starts = a[:, None] + delta[:, None] * np.arange(j0, j0 + J)   # (S, J)
         nodes = starts[..., None] + _NODES * delta[:, None, None]      # (S, J, 3)
         tflat = nodes.ravel()
+        # M's first n rows (the rows below are zero, and so are Ω's)
         if m:
-            Mt = np.zeros((tflat.size, d, d))
-            Mt[:, :n, :n] = A._eval(tflat)
+            Mt = np.empty((tflat.size, n, d))
+            Mt[:, :, :n] = A._eval(tflat)
             Bt = B._eval(tflat)
             sigma = ((nodes - step_t0[:, None, None]) / step_h[:, None, None]).ravel()
-            Mt[:, :n, n:n + m] = Bt
-            Mt[:, :n, n + m:] = sigma[:, None, None] * Bt
+            Mt[:, :, n:n + m] = Bt
+            Mt[:, :, n + m:] = sigma[:, None, None] * Bt
         else:
             Mt = A._eval(tflat)
         if ratio is not None:
             Mt = Mt * ratio
-        Mt = Mt.reshape(nseg, J, 3, d, d)
-        M1, M2, M3 = Mt[:, :, 0], Mt[:, :, 1], Mt[:, :, 2]
-        dl = delta[:, None, None, None]
-        a1 = dl * M2
-        a2 = (np.sqrt(15) / 3) * dl * (M3 - M1)
-        a3 = (10 / 3) * dl * (M3 - 2 * M2 + M1)
-        del Mt, M1, M2, M3
-        C1 = a1 @ a2 - a2 @ a1
-        X = 2 * a3 + C1
-        C2 = (X @ a1 - a1 @ X) / 60                              # -[α1, 2 α3 + C1]/60
-        X = C1 - 20 * a1 - a3
-        Y = a2 + C2
-        Omega = a1 + a3 / 12 + (X @ Y - Y @ X) / 240
-        del a1, a2, a3, C1, C2, X, Y
-        P = _tree_product(expm_batch(Omega.reshape(-1, d, d)).reshape(nseg, J, d, d))
+        Mt = Mt.reshape(nseg, J, 3, n, d)
+        rows = _magnus6(Mt[:, :, 0], Mt[:, :, 1], Mt[:, :, 2], delta[:, None, None, None])
+        del Mt
+        Omega = np.zeros((nseg * J, d, d))
+        Omega[:, :n] = rows.reshape(-1, n, d)
+        del rows
+        P = _tree_product(expm_batch(Omega).reshape(nseg, J, d, d))
         E = P if E is None else P @ E
     return E
 
