@@ -377,7 +377,7 @@ def _magnus(A, B, a, b, step_t0, step_h, nsub, n, m, d, scale=None):
         rows = _magnus6(Mt[:, :, 0], Mt[:, :, 1], Mt[:, :, 2], delta[:, None, None, None])
         del Mt
         Omega = np.zeros((nseg * J, d, d))
-        Omega[:, :n] = rows.reshape(-1, n, d)
+        Omega[:, :n] = rows.reshape(nseg * J, n, d)
         del rows
         P = _tree_product(expm_batch(Omega).reshape(nseg, J, d, d))
         E = P if E is None else P @ E

@@ -103,3 +103,11 @@ def test_sub_step_error_is_sixth_order():
         errors = [np.abs(integrate(nsub) - exact).max() for nsub in (2, 4, 8)]
         ratios = np.array(errors[:-1]) / np.array(errors[1:])
         assert np.all((ratios > 40) & (ratios < 100)), ratios
+
+
+def test_a_plant_without_states_has_empty_step_data():
+    # a static gain written as an LTP system (no states, one input)
+    A = ltp.PeriodicMatrix.constant(np.zeros((0, 0)), 1.0)
+    B = ltp.PeriodicMatrix.constant(np.zeros((0, 1)), 1.0)
+    Phi, G0, G1 = step_transitions(A, B, np.arange(3) / 3, np.full(3, 1 / 3))
+    assert Phi.shape == (3, 0, 0) and G0.shape == (3, 0, 1) and G1.shape == (3, 0, 1)
